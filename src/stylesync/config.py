@@ -1,0 +1,195 @@
+"""Configuration: frozen dataclasses with named, typed fields, validated when built.
+
+Defaults are the paper's values (Cao et al. 2022) and say where they come from. Where a default departs from
+the paper, the comment says how and why (see also docs/decisions.md).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+
+from stylesync.errors import ConfigError
+
+
+def _positive(name: str, value: float) -> None:
+    if not (value > 0):
+        raise ConfigError(f"{name} must be > 0, got {value!r}")
+
+
+def _non_negative(name: str, value: float) -> None:
+    if not (value >= 0):
+        raise ConfigError(f"{name} must be >= 0, got {value!r}")
+
+
+@dataclass(frozen=True)
+class PidGains:
+    """Gains of one joint's PID (Eq. 13), continuous-time: tau = kp e + ki ∫e dt + kd de/dt.
+
+    Units: kp [N·m/rad], ki [N·m/(rad·s)], kd [N·m·s/rad]. Eq. 13 prints the sum and difference without the time
+    step; we read Table 3 as continuous gains (at 600 Hz the printed per-step reading would scale kd by 1/600 and
+    ki by 600, which neither tracks nor stays stable).
+    """
+
+    kp: float
+    ki: float
+    kd: float
+
+    def __post_init__(self) -> None:
+        for n in ("kp", "ki", "kd"):
+            _non_negative(f"PidGains.{n}", getattr(self, n))
+
+
+def _table3() -> dict[str, PidGains]:
+    # Table 3, PID controller gains per joint.
+    return {
+        "chest": PidGains(2500.0, 40.0, 36.0),
+        "neck": PidGains(30.0, 5.0, 3.0),
+        "hip": PidGains(500.0, 100.0, 20.0),
+        "knee": PidGains(360.0, 72.0, 20.0),
+        "ankle": PidGains(60.0, 15.0, 2.0),
+        "shoulder": PidGains(60.0, 15.0, 7.0),
+        "elbow": PidGains(60.0, 15.0, 1.0),
+    }
+
+
+@dataclass(frozen=True)
+class ClockConfig:
+    mocap_hz: float = 16.0  # Sec. 7.1, Kinect update rate
+    control_hz: float = 133.0  # Sec. 7.1, control loop
+    physics_hz: float = 600.0  # Sec. 7.1, integration step 1/600 s
+
+    def __post_init__(self) -> None:
+        for n in ("mocap_hz", "control_hz", "physics_hz"):
+            _positive(f"ClockConfig.{n}", getattr(self, n))
+        if self.control_hz > self.physics_hz:
+            raise ConfigError(
+                f"control_hz ({self.control_hz}) must not exceed physics_hz ({self.physics_hz})"
+            )
+
+
+@dataclass(frozen=True)
+class WorldConfig:
+    gravity_mps2: float = 9.8  # Sec. 7.1
+    contact_stiffness_npm: float = 30000.0  # Sec. 7.1, ground damped spring
+    contact_damping_nspm: float = 10000.0  # Sec. 7.1
+    friction: float = 0.9  # Sec. 7.1
+
+    def __post_init__(self) -> None:
+        _positive("WorldConfig.gravity_mps2", self.gravity_mps2)
+        _positive("WorldConfig.contact_stiffness_npm", self.contact_stiffness_npm)
+        _non_negative("WorldConfig.contact_damping_nspm", self.contact_damping_nspm)
+        _non_negative("WorldConfig.friction", self.friction)
+
+
+@dataclass(frozen=True)
+class FilterConfig:
+    one_euro_beta: float = 1.0  # Fig. 5a, beta = 1
+    one_euro_min_cutoff_hz: float = 1.0  # Fig. 5a, f_cmin = 1
+    one_euro_derivative_cutoff_hz: float = 1.0  # Casiez et al. 2012 default d_cutoff
+    floor_threshold_m: float = 0.01  # Sec. 4.3, floor filter threshold
+
+    def __post_init__(self) -> None:
+        _non_negative("FilterConfig.one_euro_beta", self.one_euro_beta)
+        _positive("FilterConfig.one_euro_min_cutoff_hz", self.one_euro_min_cutoff_hz)
+        _positive("FilterConfig.one_euro_derivative_cutoff_hz", self.one_euro_derivative_cutoff_hz)
+        _non_negative("FilterConfig.floor_threshold_m", self.floor_threshold_m)
+
+
+@dataclass(frozen=True)
+class MotionConfig:
+    # Sec. 5.1 leaves the foot-height threshold open: 4 cm on the operator's ankle heights, with hysteresis.
+    stance_height_threshold_m: float = 0.04
+    stance_hysteresis_m: float = 0.01
+    # Late contact (Sec. 5.1): the reference is held until the character's foot touches down, at most this long.
+    late_contact_timeout_s: float = 0.4
+    # Early contact (Sec. 5.1) only counts once the swing has lasted this long (a lifting foot still touches).
+    min_swing_s: float = 0.12
+    stance_hip_weight_w0: float = 0.5  # Eq. 11 weight w0 (not given in the paper)
+    swing_hip_cd: float = 0.0  # Eq. 12, Sec. 7.2 sets c_d = 0
+    swing_hip_cv: float = 0.0  # Eq. 12, Sec. 7.2 sets c_v = 0
+    max_swing_foot_lift_m: float = 0.25  # clamp of the scaled swing-ankle height above the ground [m]
+
+    def __post_init__(self) -> None:
+        _positive("MotionConfig.stance_height_threshold_m", self.stance_height_threshold_m)
+        _non_negative("MotionConfig.stance_hysteresis_m", self.stance_hysteresis_m)
+        _positive("MotionConfig.late_contact_timeout_s", self.late_contact_timeout_s)
+        _non_negative("MotionConfig.min_swing_s", self.min_swing_s)
+        if not 0.0 <= self.stance_hip_weight_w0 <= 1.0:
+            raise ConfigError(f"stance_hip_weight_w0 must be in [0, 1], got {self.stance_hip_weight_w0}")
+
+
+@dataclass(frozen=True)
+class ControlConfig:
+    pid: dict[str, PidGains] = field(default_factory=_table3)
+    integral_limit_rad_s: float = 0.2  # anti-windup clamp of ∫e dt per DOF [rad·s]
+    # CR-VC, Eq. 16; Table 3 prints two "Kp" columns, the second is read as Kd.
+    com_force_kp_npm: float = 50.0  # Table 3, virtual force Kp [N/m]
+    com_force_kd_nspm: float = 30.0  # Table 3, virtual force Kd [N·s/m]
+    root_torque_kp: float = 5000.0  # Table 3, virtual torque Kp [N·m/rad]
+    root_torque_kd: float = 1000.0  # Table 3, virtual torque Kd [N·m·s/rad]
+    # Departure: the yaw axis of the pelvis has ~10x less inertia than pitch/roll; Kd = 1000 about yaw is
+    # explicitly unstable at 600 Hz, so yaw gains are scaled by this factor.
+    root_yaw_gain_scale: float = 0.1
+    gravity_compensation: bool = True  # Eq. 14-15
+    com_virtual_force: bool = True  # Eq. 16-17
+    root_virtual_torque: bool = True  # Eq. 16, 18
+    ipm_ankle_compensation: bool = True  # Eq. 20
+    lipm_time_sync: bool = True  # Eq. 21-23
+    enforce_bounds: bool = True  # Eq. 24-28
+    lipm_force_limit_n: float = 150.0  # clamp of |f_cro| before the bounds check [N]
+
+    def __post_init__(self) -> None:
+        for n in ("com_force_kp_npm", "com_force_kd_nspm", "root_torque_kp", "root_torque_kd"):
+            _non_negative(f"ControlConfig.{n}", getattr(self, n))
+        _positive("ControlConfig.integral_limit_rad_s", self.integral_limit_rad_s)
+        _positive("ControlConfig.root_yaw_gain_scale", self.root_yaw_gain_scale)
+        for group in ("chest", "neck", "hip", "knee", "ankle", "shoulder", "elbow"):
+            if group not in self.pid:
+                raise ConfigError(f"ControlConfig.pid lacks gains for '{group}'")
+
+
+@dataclass(frozen=True)
+class OperatorConfig:
+    """The built-in operator: a recorded clip played by a human-scale skeleton through a Kinect-like sensor."""
+
+    clip: str = "walk"  # pybullet_data humanoid3d_<clip>.txt
+    height_m: float = 1.75
+    mass_kg: float = 75.8  # Table 2, human column total
+    position_noise_m: float = 0.005  # Kinect-like joint position noise (1 sigma) [m]
+    orientation_noise_rad: float = 0.02  # joint orientation noise (1 sigma) [rad]
+    timestamp_jitter_s: float = 0.004  # sample-time jitter (1 sigma) [s]
+    standing_lead_in_s: float = 1.0  # operator stands in the first frame's pose before the clip plays [s]
+
+    def __post_init__(self) -> None:
+        _positive("OperatorConfig.height_m", self.height_m)
+        _positive("OperatorConfig.mass_kg", self.mass_kg)
+        _non_negative("OperatorConfig.position_noise_m", self.position_noise_m)
+        _non_negative("OperatorConfig.orientation_noise_rad", self.orientation_noise_rad)
+        _non_negative("OperatorConfig.timestamp_jitter_s", self.timestamp_jitter_s)
+        _non_negative("OperatorConfig.standing_lead_in_s", self.standing_lead_in_s)
+
+
+@dataclass(frozen=True)
+class SessionConfig:
+    clocks: ClockConfig = field(default_factory=ClockConfig)
+    world: WorldConfig = field(default_factory=WorldConfig)
+    filters: FilterConfig = field(default_factory=FilterConfig)
+    motion: MotionConfig = field(default_factory=MotionConfig)
+    control: ControlConfig = field(default_factory=ControlConfig)
+    operator: OperatorConfig = field(default_factory=OperatorConfig)
+    duration_s: float = 12.0
+    seed: int = 0
+    realtime: bool = False  # paced to the wall clock (interactive) or as fast as possible (offline)
+    gui: bool = False
+
+    def __post_init__(self) -> None:
+        _positive("SessionConfig.duration_s", self.duration_s)
+
+    def replace(self, **changes) -> SessionConfig:
+        return dataclasses.replace(self, **changes)
+
+
+def pid_group(joint_name: str) -> str:
+    """Table 3 row of a joint ('right_hip' -> 'hip')."""
+    return joint_name.split("_")[-1]

@@ -1,0 +1,122 @@
+"""The body balance and synchronisation controller (Sec. 6, Fig. 8): Eq. 18 put together.
+
+Two rates. At each control tick (133 Hz) :meth:`update` takes the reference pose and the full state and computes
+the slowly varying parts: gravity compensation (Eq. 14-15), the COM virtual force through the stance legs
+(Eq. 16-17) with the LIPM time-sync force (Eq. 21-23) bounded by Eq. 25-27, and the IPM ankle torque (Eq. 20).
+At each physics step (600 Hz) :meth:`torques` adds the PID (Eq. 13, "for each joint DOF at each timestep of
+simulation", Sec. 6.1) and the root virtual torque on the stance hips (Eq. 16, 18), whose damping would not be
+stable if held for 4.5 physics steps, then clamps to the joint torque limits.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from stylesync import rotations as rot
+from stylesync.config import ControlConfig
+from stylesync.control import bounds as bnd
+from stylesync.control.crvc import (
+    com_virtual_force,
+    hip_torques_for_root,
+    root_virtual_torque,
+    stance_force_torques,
+)
+from stylesync.control.gravity_compensation import gravity_torques
+from stylesync.control.jacobian_transpose import JointFrames
+from stylesync.control.model_compensation import ipm_ankle_moments, lipm_sync_force
+from stylesync.control.pid import IS_BALL, JointPid
+from stylesync.motion.reference import ReferencePose
+from stylesync.sim.backend import CharacterState, JointFeedback, MassProperties, Torques
+from stylesync.sim.character import JOINT_NAMES, JOINTS
+
+TORQUE_LIMIT = np.array([j.torque_limit_nm for j in JOINTS])[:, None]
+_HIP_INDEX = {s: JOINT_NAMES.index(f"{s}_hip") for s in ("left", "right")}
+
+
+@dataclass
+class ControlTelemetry:
+    com_force_n: np.ndarray
+    lipm_force_n: np.ndarray
+    root_torque_nm: np.ndarray
+
+
+class BalanceController:
+    def __init__(self, cfg: ControlConfig, mass: MassProperties, gravity_mps2: float, physics_dt_s: float,
+                 control_dt_s: float):
+        self.cfg = cfg
+        self.mass = mass
+        self.g = gravity_mps2
+        self.pid = JointPid(cfg, physics_dt_s, mass.joint_min_inertia_kgm2)
+        self.control_dt_s = control_dt_s
+        self.bounds = bnd.BoundsMonitor()
+        self._ff = np.zeros((len(JOINTS), 3))
+        self._ref: ReferencePose | None = None
+        self._prev_ref_pos: np.ndarray | None = None
+        self._ref_vel = np.zeros((len(JOINTS), 3))
+        self.telemetry = ControlTelemetry(np.zeros(3), np.zeros(3), np.zeros(3))
+
+    def update(self, state: CharacterState, ref: ReferencePose) -> None:
+        cfg = self.cfg
+        frames = JointFrames(state)
+        ff = np.zeros((len(JOINTS), 3))
+        w = ref.stance_weight
+        if cfg.gravity_compensation:  # Eq. 14-15
+            ff += gravity_torques(state, frames, self.mass.link_mass_kg, self.g, w,
+                                  skip_stance_ankle=cfg.ipm_ankle_compensation)
+        com = self.mass.com(state)
+        force = np.zeros(3)
+        if cfg.com_virtual_force:  # Eq. 16 (first line), Eq. 19
+            force += com_virtual_force(ref.com_world, ref.com_vel_world, com, self.mass.com_velocity(state),
+                                       self.mass.total_kg, cfg.com_force_kp_npm, cfg.com_force_kd_nspm)
+        f_lipm = np.zeros(3)
+        if cfg.lipm_time_sync and ref.lipm is not None:  # Eq. 21-23
+            f_lipm = lipm_sync_force(ref.lipm.d_a_human, ref.lipm.h_human_m, ref.lipm.d_a_char, ref.lipm.h_char_m,
+                                     self.mass.total_kg, self.g)
+            limit = min(cfg.lipm_force_limit_n, bnd.lipm_force_bound_n(self.mass.total_kg, self.g, ref.lipm.h_char_m))
+            mag = float(np.linalg.norm(f_lipm))
+            exceeded = mag > limit
+            self.bounds.report("lipm_force", exceeded and cfg.enforce_bounds, state.time_s,
+                               f"|f_cro| {mag:.0f} N > {limit:.0f} N (Eq. 26)")
+            if exceeded and cfg.enforce_bounds:
+                f_lipm *= limit / mag
+            force += f_lipm
+        if ref.character_stance.value == "DS":  # Eq. 24
+            centre = 0.5 * (ref.ankle_world["left"] + ref.ankle_world["right"])
+            d_c = float(np.linalg.norm((ref.com_world - centre)[:2]))
+            self.bounds.report("ds_com", d_c > bnd.ds_com_bound_m(), state.time_s,
+                               f"COM {d_c:.3f} m from the support centre > {bnd.ds_com_bound_m():.3f} m (Eq. 24)")
+        if np.any(force):
+            ff += stance_force_torques(frames, com, force, w)  # Eq. 17
+        if cfg.ipm_ankle_compensation:  # Eq. 20
+            ff += frames.torque_from_moment(ipm_ankle_moments(ref.com_world, ref.ankle_world, w,
+                                                              self.mass.total_kg, self.g))
+        self._ff = ff
+        # Reference velocity for the derivative term, from successive references at the control rate.
+        if self._prev_ref_pos is not None:
+            vel = np.zeros_like(self._ref_vel)
+            prev, cur = self._prev_ref_pos, ref.joint_pos
+            vel[IS_BALL] = rot.batch_rotvec(rot.batch_multiply(rot.batch_conjugate(prev[IS_BALL]), cur[IS_BALL]))
+            vel[~IS_BALL, 0] = cur[~IS_BALL, 0] - prev[~IS_BALL, 0]
+            self._ref_vel = vel / self.control_dt_s
+        self._prev_ref_pos = ref.joint_pos.copy()
+        self._ref = ref
+        self.telemetry = ControlTelemetry(force, f_lipm, self.telemetry.root_torque_nm)
+
+    def torques(self, fb: JointFeedback) -> Torques:
+        ref = self._ref
+        if ref is None:
+            return Torques.zeros()
+        tau = self.pid(fb.joint_pos, fb.joint_vel, ref.joint_pos, self._ref_vel)  # Eq. 13
+        tau += self._ff
+        if self.cfg.root_virtual_torque:  # Eq. 16 (second line), Eq. 18
+            tau_r = root_virtual_torque(ref.root_quat_wxyz, fb.root_quat_wxyz, fb.root_ang_vel_world,
+                                        self.cfg.root_torque_kp, self.cfg.root_torque_kd,
+                                        self.cfg.root_yaw_gain_scale)
+            self.telemetry.root_torque_nm = tau_r
+            hips = {s: fb.joint_pos[_HIP_INDEX[s]] for s in ("left", "right")}
+            for j, t in hip_torques_for_root(tau_r, fb.root_quat_wxyz, hips, ref.stance_weight).items():
+                tau[j] += t
+        tau[~IS_BALL, 1:] = 0.0
+        return Torques(np.clip(tau, -TORQUE_LIMIT, TORQUE_LIMIT))

@@ -1,0 +1,58 @@
+"""COM and root virtual control, CR-VC (Sec. 6.2, Eq. 16-18).
+
+* COM virtual force (Eq. 16, 17): ``f_r = m_C (Kp_vf e_p + Kd_vf e_v)``, realised through the stance leg(s) by
+  the Jacobian transpose of the COM with the stance foot as base. Table 3 gives Kp = 50, Kd = 30 (its second
+  "Kp" column read as Kd); as plain N/m these could not move a 45 kg body (2.5 N for 5 cm), so we read them as
+  gains per unit mass, i.e. acceleration gains [1/s^2], [1/s].
+* Root virtual torque (Eq. 16): ``τ_r = Kp_vt e_q + Kd_vt e_ω`` on the pelvis orientation, realised as internal
+  torques on the stance hip(s) (SIMBICON [2]): a hip torque τ acts +τ on the thigh and -τ on the pelvis, so each
+  stance hip receives ``-w τ_r`` (w its stance weight). Eq. 18 then sums the parts.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from stylesync import rotations as rot
+from stylesync.control.gravity_compensation import LEG_JOINTS
+from stylesync.control.jacobian_transpose import JointFrames
+from stylesync.sim.character import JOINTS, Q_WORLD_MODEL
+
+HIP_JOINT = {side: next(k for k, j in enumerate(JOINTS) if j.name == f"{side}_hip") for side in ("left", "right")}
+
+
+def com_virtual_force(com_desired, com_vel_desired, com, com_vel, mass_kg: float, kp: float, kd: float):
+    """Eq. 16 (first line) with Eq. 19 errors [N]."""
+    return mass_kg * (kp * (np.asarray(com_desired) - com) + kd * (np.asarray(com_vel_desired) - com_vel))
+
+
+def stance_force_torques(frames: JointFrames, com: np.ndarray, force_world: np.ndarray,
+                         stance_weight: dict[str, float]) -> np.ndarray:
+    """Eq. 17: ``τ_fr = J_r^T f_r`` through each stance leg (foot as base), weighted by its stance share."""
+    moment = np.zeros((len(JOINTS), 3))
+    for side, w in stance_weight.items():
+        if w <= 0:
+            continue
+        idx = LEG_JOINTS[side]
+        moment[idx] += -w * np.cross(com[None, :] - frames.origin[idx], force_world[None, :])
+    return frames.torque_from_moment(moment)
+
+
+def root_virtual_torque(q_root_desired, q_root, ang_vel_world, kp: float, kd: float, yaw_scale: float):
+    """Eq. 16 (second line): world-frame PD torque [N·m] on the pelvis orientation."""
+    e = rot.rotvec_from_quat(rot.multiply(q_root_desired, rot.conjugate(q_root)))  # world-frame error
+    scale = np.array([1.0, 1.0, yaw_scale])
+    return scale * (kp * e - kd * np.asarray(ang_vel_world))
+
+
+def hip_torques_for_root(tau_root_world: np.ndarray, q_root: np.ndarray, hip_quat_model: dict[str, np.ndarray],
+                         stance_weight: dict[str, float]) -> dict[int, np.ndarray]:
+    """Child-frame (thigh) torques that give the pelvis ``tau_root_world`` through the stance hips."""
+    out: dict[int, np.ndarray] = {}
+    q_pelvis_model = rot.multiply(q_root, Q_WORLD_MODEL)
+    for side, w in stance_weight.items():
+        if w <= 0:
+            continue
+        R_thigh = rot.matrix_from_quat(rot.multiply(q_pelvis_model, hip_quat_model[side]))
+        out[HIP_JOINT[side]] = R_thigh.T @ (-w * tau_root_world)
+    return out

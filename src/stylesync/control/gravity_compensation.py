@@ -1,0 +1,73 @@
+"""Gravity compensation by Jacobian transpose (Sec. 6.1, Eq. 14-15).
+
+Eq. 14-15 apply the virtual force ``f_i = -m_i g`` at each link's COM through the chain from the root to link i.
+For a joint j this sums to ``τ_j = J^T (M_sub g ẑ)`` at the COM of the subtree below j. With a floating base that
+alone leaves the pelvis unsupported, so, as in GENBICON [3] which the paper follows for this method, a leg whose
+foot is in stance carries the links above it through the chain from its foot (the joint is then driven "in
+reverse": ``τ_j = -(c_above - o_j) × (M_above g ẑ)``). A leg with stance weight w blends the two
+(w = 0 swing, w = 1 full stance; the weights of the two legs sum to 1 in double stance).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from stylesync.control.jacobian_transpose import JointFrames
+from stylesync.sim.backend import CharacterState
+from stylesync.sim.character import JOINTS, LINK_NAMES, LINK_PARENT
+
+_UP = np.array([0.0, 0.0, 1.0])
+
+
+def _subtree_links(joint_name: str) -> list[int]:
+    out = []
+    for i, name in enumerate(LINK_NAMES):
+        cur: str | None = name
+        while cur is not None:
+            if cur == joint_name:
+                out.append(i)
+                break
+            cur = LINK_PARENT[cur]
+    return out
+
+
+SUBTREE_MASK = np.zeros((len(JOINTS), len(LINK_NAMES)))
+for _j, _spec in enumerate(JOINTS):
+    SUBTREE_MASK[_j, _subtree_links(_spec.name)] = 1.0
+LEG_JOINTS = {side: np.array([k for k, j in enumerate(JOINTS) if j.name.startswith(side) and
+                              j.name.split("_")[1] in ("hip", "knee", "ankle")]) for side in ("left", "right")}
+ANKLE_JOINT = {side: next(k for k, j in enumerate(JOINTS) if j.name == f"{side}_ankle")
+               for side in ("left", "right")}
+
+
+def gravity_torques(
+    state: CharacterState,
+    frames: JointFrames,
+    link_mass_kg: np.ndarray,
+    gravity_mps2: float,
+    stance_weight: dict[str, float],
+    skip_stance_ankle: bool = False,
+) -> np.ndarray:
+    """Eq. 14-15 with stance-leg support. Returns the (n_joints, 3) torque layout [N·m].
+
+    ``skip_stance_ankle`` leaves the stance ankles' reverse (weight-bearing) part to the IPM ankle torque (Eq. 20).
+    """
+    m = link_mass_kg
+    weighted = m[:, None] * state.link_com_world  # (n_links, 3)
+    m_sub = SUBTREE_MASK @ m  # (n_joints,)
+    c_sub = (SUBTREE_MASK @ weighted) / m_sub[:, None]
+    m_all = m.sum()
+    c_all = weighted.sum(axis=0) / m_all
+    fwd = np.cross(c_sub - frames.origin, (m_sub * gravity_mps2)[:, None] * _UP)  # (n_joints, 3)
+    moment = fwd.copy()
+    for side, w in stance_weight.items():
+        if w <= 0:
+            continue
+        idx = LEG_JOINTS[side]
+        m_above = m_all - m_sub[idx]
+        c_above = (m_all * c_all - m_sub[idx, None] * c_sub[idx]) / m_above[:, None]
+        rev = -np.cross(c_above - frames.origin[idx], (m_above * gravity_mps2)[:, None] * _UP)
+        if skip_stance_ankle:
+            rev[idx == ANKLE_JOINT[side]] = 0.0
+        moment[idx] = (1.0 - w) * fwd[idx] + w * rev
+    return frames.torque_from_moment(moment)

@@ -1,0 +1,41 @@
+"""Model-based torque compensation for the CR-VC (Sec. 6.3, Eq. 20-23).
+
+* IPM ankle torque (Eq. 20): ``τ_am = m_C g d_C``, d_C the horizontal offset of the (desired) COM from the
+  stance ankle, i.e. the torque that holds an inverted pendulum leaning like the operator. As a vector on the
+  ankle joint: ``τ = -(c_d - a) × (m_C g ẑ)`` (horizontal part), shared by the stance feet.
+* LIPM time-synchronising force (Eq. 21-23): in single stance the character COM is made to accelerate like the
+  operator's, scaled by dynamic similarity: desired ``p̈_CC = p̈_CH h_C / h_H`` (Eq. 22 as in the notes: the text's
+  first derivative is a typo for the second), with both accelerations from the LIPM (Eq. 21):
+  ``f_cro = m_C g (d_aH / h_H · h_C / h_H - d_aC / h_C)`` (Eq. 23), d_a the horizontal COM offset from the
+  stance ankle (the CoP).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from stylesync.control.gravity_compensation import ANKLE_JOINT
+from stylesync.sim.character import JOINTS
+
+
+def ipm_ankle_moments(com_desired: np.ndarray, ankle_pos: dict[str, np.ndarray], stance_weight: dict[str, float],
+                      mass_kg: float, gravity_mps2: float) -> np.ndarray:
+    """Eq. 20 as world moments on the stance ankle joints, (n_joints, 3) [N·m]."""
+    moment = np.zeros((len(JOINTS), 3))
+    weight = np.array([0.0, 0.0, mass_kg * gravity_mps2])
+    for side, w in stance_weight.items():
+        if w <= 0:
+            continue
+        d = np.asarray(com_desired, dtype=float) - ankle_pos[side]
+        d[2] = 0.0  # horizontal distance d_C only (Eq. 20)
+        moment[ANKLE_JOINT[side]] = -w * np.cross(d, weight)
+    return moment
+
+
+def lipm_sync_force(d_a_human: np.ndarray, h_human_m: float, d_a_char: np.ndarray, h_char_m: float,
+                    mass_kg: float, gravity_mps2: float) -> np.ndarray:
+    """Eq. 23: horizontal force [N] (z component 0)."""
+    f = mass_kg * gravity_mps2 * (np.asarray(d_a_human) / h_human_m * (h_char_m / h_human_m)
+                                  - np.asarray(d_a_char) / h_char_m)
+    f = np.array([f[0], f[1], 0.0])
+    return f

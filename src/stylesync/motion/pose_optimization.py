@@ -1,0 +1,225 @@
+"""Style-based pose optimisation (Sec. 5.3) and the motion-optimisation stage that wires Sec. 5 together.
+
+Per control tick, from the smoothed operator sample and the character's current state:
+1. stance FSMs (Sec. 5.1) and style features (Sec. 5.2);
+2. lower-body retargeting on the character's *current* feet: pelvis height by Eq. 9 and horizontal position by
+   Eq. 10, read (see the notes) as keeping the operator's *fraction* of the way between the ankles per axis of the
+   heading frame; where the ankles are less than ``_MIN_AXIS_SPREAD_M`` apart along an axis the fraction is
+   undefined and the operator's offset from the ankle midpoint, scaled, is used instead. In single stance the
+   pelvis keeps the operator's scaled offset from the stance ankle. The desired COM (Eq. 19) is mapped the same
+   way;
+3. leg IK in the motion plane N of each leg (unique 2D solution), stance feet where they are, the swing foot
+   where the operator's is (scaled, relative to the pelvis), its step length bounded by Eq. 28;
+4. feet flat, heading from the operator's foot (twist T) for the swing foot, current heading for a planted foot;
+5. balance strategy (Sec. 5.4): level root with heading H, Eq. 11 on the stance hips, Eq. 12 on the swing hip.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from stylesync import rotations as rot
+from stylesync.config import MotionConfig
+from stylesync.control.bounds import BoundsMonitor, step_length_bound_m
+from stylesync.motion.balance_strategy import level_root, stance_hip_blend, swing_hip_feedback
+from stylesync.motion.leg_ik import solve_leg
+from stylesync.motion.reference import LipmMap, ReferencePose
+from stylesync.motion.stance_fsm import CharacterStanceFsm, OperatorStanceFsm, Stance, stance_weights, swing_side
+from stylesync.motion.style_features import StyleExtractor, StyleFeatures
+from stylesync.processing.body_parameters import link_length
+from stylesync.processing.joint_map import hinge_angle
+from stylesync.processing.operator_processing import OperatorSample
+from stylesync.sim.backend import CharacterState, MassProperties
+from stylesync.sim.character import (
+    ANKLE_HEIGHT_M,
+    HIP_HALF_WIDTH_M,
+    JOINT_NAMES,
+    JOINTS,
+    LINK_NAMES,
+    SHANK_LENGTH_M,
+    THIGH_LENGTH_M,
+    JointKind,
+    model_quat_from_canonical,
+)
+
+_MIN_AXIS_SPREAD_M = 0.08
+_CONTACT_FORCE_N = 5.0  # a foot with more normal force than this is in contact
+_SCALE_SMOOTHING = 0.02  # per tick, exponential average of the operator's leg length
+_SIDE_UP = {"left": "LEFT", "right": "RIGHT"}
+_LINK = {n: i for i, n in enumerate(LINK_NAMES)}
+CHAR_LEG_LENGTH_M = THIGH_LENGTH_M + SHANK_LENGTH_M
+
+
+def _heading_frame_fraction(p_h, al_h, ar_h, al_c, ar_c, scale: float, heading: float) -> np.ndarray:
+    """Eq. 10 (fraction reading) in the heading frame, horizontal components only."""
+    R = rot.matrix_from_quat(rot.quat_from_yaw(heading))
+    ph, lh, rh = (R.T @ np.asarray(v) for v in (p_h, al_h, ar_h))
+    lc, rc = (R.T @ np.asarray(v) for v in (al_c, ar_c))
+    out = np.zeros(3)
+    for ax in (0, 1):
+        spread_h, spread_c = rh[ax] - lh[ax], rc[ax] - lc[ax]
+        if abs(spread_h) >= _MIN_AXIS_SPREAD_M and abs(spread_c) >= _MIN_AXIS_SPREAD_M:
+            frac = (ph[ax] - lh[ax]) / spread_h
+            out[ax] = lc[ax] + spread_c * frac
+        else:
+            out[ax] = 0.5 * (lc[ax] + rc[ax]) + scale * (ph[ax] - 0.5 * (lh[ax] + rh[ax]))
+    return R @ out
+
+
+class MotionOptimizer:
+    def __init__(self, cfg: MotionConfig, control_hz: float):
+        self.cfg = cfg
+        self.dt_s = 1.0 / control_hz
+        self.op_fsm = OperatorStanceFsm(cfg.stance_height_threshold_m, cfg.stance_hysteresis_m)
+        self.char_fsm = CharacterStanceFsm(cfg.late_contact_timeout_s, cfg.min_swing_s)
+        self.op_style = StyleExtractor()
+        self._op_leg_m: float | None = None
+        self._held: OperatorSample | None = None
+        self._prev_com_h: np.ndarray | None = None
+        self._com_vel_h = np.zeros(3)
+        self.bounds = BoundsMonitor()
+
+    def operator_features(self, s: OperatorSample) -> StyleFeatures:
+        hip = {k: s.pos[f"HIP_{v}"] for k, v in _SIDE_UP.items()}
+        knee = {k: s.pos[f"KNEE_{v}"] for k, v in _SIDE_UP.items()}
+        ankle = {k: s.pos[f"ANKLE_{v}"] for k, v in _SIDE_UP.items()}
+        shank = {k: s.quat[f"KNEE_{v}"] for k, v in _SIDE_UP.items()}
+        foot = {k: s.quat[f"ANKLE_{v}"] for k, v in _SIDE_UP.items()}
+        return self.op_style(hip, knee, ankle, shank, foot, s.com_world, s.quat["PELVIS"])
+
+    def update(self, sample: OperatorSample, state: CharacterState, mass: MassProperties) -> ReferencePose:
+        cfg = self.cfg
+        features = self.operator_features(sample)
+        op_state = self.op_fsm.update(sample.pos["ANKLE_LEFT"][2], sample.pos["ANKLE_RIGHT"][2])
+        contact = {side: state.foot_contact_force_n[f"{side}_ankle"] > _CONTACT_FORCE_N for side in ("left", "right")}
+        ch_state = self.char_fsm.update(op_state, contact, state.time_s)
+        if self.char_fsm.hold_reference and self._held is not None:
+            s = self._held  # late contact: keep the reference until the character's foot lands
+        else:
+            s = sample
+            self._held = sample
+
+        # Operator size: leg length by Eq. 1, smoothed; scale = h_C / h_H (Eq. 9).
+        leg = np.mean([link_length(s.pos[f"HIP_{v}"], s.pos[f"KNEE_{v}"]) +
+                       link_length(s.pos[f"KNEE_{v}"], s.pos[f"ANKLE_{v}"]) for v in _SIDE_UP.values()])
+        self._op_leg_m = leg if self._op_leg_m is None else self._op_leg_m + _SCALE_SMOOTHING * (leg - self._op_leg_m)
+        scale = CHAR_LEG_LENGTH_M / self._op_leg_m
+
+        heading = features.H
+        q_root_d = level_root(heading)
+        R_root_d = rot.matrix_from_quat(q_root_d)
+        a_h = {k: s.pos[f"ANKLE_{v}"] for k, v in _SIDE_UP.items()}
+        a_c = {k: state.link_origin_world[_LINK[f"{k}_ankle"]].copy() for k in _SIDE_UP}
+        p_h = s.pos["PELVIS"]
+        com_h = s.com_world
+        com_c = mass.com(state)
+
+        # Lower-body retargeting (Eq. 9-10) for the pelvis and the COM.
+        if ch_state is Stance.DS:
+            pelvis_xy = _heading_frame_fraction(p_h, a_h["left"], a_h["right"], a_c["left"], a_c["right"],
+                                                scale, heading)
+            com_xy = _heading_frame_fraction(com_h, a_h["left"], a_h["right"], a_c["left"], a_c["right"],
+                                             scale, heading)
+            ankle_h_z = 0.5 * (a_h["left"][2] + a_h["right"][2])
+            ankle_c_z = 0.5 * (a_c["left"][2] + a_c["right"][2])
+        else:
+            st = "left" if ch_state is Stance.LS else "right"
+            pelvis_xy = a_c[st] + scale * (p_h - a_h[st])
+            com_xy = a_c[st] + scale * (com_h - a_h[st])
+            ankle_h_z, ankle_c_z = a_h[st][2], a_c[st][2]
+        pelvis_d = np.array([pelvis_xy[0], pelvis_xy[1], ankle_c_z + scale * (p_h[2] - ankle_h_z)])  # Eq. 9
+        # The operator's COM height reflects his own mass distribution, not the character's: the vertical is left
+        # to the pelvis height (Eq. 9) through the leg IK, and the COM target keeps the character's own height.
+        com_d = np.array([com_xy[0], com_xy[1], com_c[2]])
+        if self._prev_com_h is not None:
+            v = (com_h - self._prev_com_h) / self.dt_s
+            self._com_vel_h += 0.2 * (v - self._com_vel_h)
+        self._prev_com_h = com_h.copy()
+        com_vel_d = scale * self._com_vel_h
+        com_vel_d[2] = 0.0
+
+        # Leg IK in the motion plane N, feet flat (Sec. 5.3) and the balance strategy (Sec. 5.4).
+        weights = stance_weights(ch_state, self._ds_left_share(com_c, a_c))
+        sw = swing_side(ch_state)
+        local: dict[str, np.ndarray] = {}
+        knee_angle: dict[str, float] = {}
+        step_exceeded = False
+        q_cur = state.joint_pos
+        for side, sign in (("left", 1.0), ("right", -1.0)):
+            hip_w = pelvis_d + R_root_d @ np.array([0.0, sign * HIP_HALF_WIDTH_M, 0.0])
+            N = features.N_l if side == "left" else features.N_r
+            if side == sw:
+                target = pelvis_d + scale * (a_h[side] - p_h)
+                target[2] = min(max(target[2], ankle_c_z), ankle_c_z + cfg.max_swing_foot_lift_m)
+                st = "left" if side == "right" else "right"
+                bound = step_length_bound_m(CHAR_LEG_LENGTH_M, self._op_leg_m)  # Eq. 28
+                step = target[:2] - a_c[st][:2]
+                dist = float(np.linalg.norm(step))
+                step_exceeded = dist > bound
+                self.bounds.report("step_length", step_exceeded, state.time_s,
+                                   f"step {dist:.2f} m > bound {bound:.2f} m (Eq. 28)")
+                if step_exceeded:
+                    target[:2] = a_c[st][:2] + step * (bound / dist)
+                foot_yaw = rot.yaw_from_quat(s.quat[f"ANKLE_{_SIDE_UP[side]}"])
+            else:
+                target = a_c[side]
+                foot_yaw = rot.yaw_from_quat(state.link_quat_wxyz[_LINK[f"{side}_ankle"]])
+            ik = solve_leg(hip_w, target, THIGH_LENGTH_M, SHANK_LENGTH_M, N)
+            q_thigh = ik.thigh_quat_wxyz
+            if side == sw:
+                st = "left" if side == "right" else "right"
+                q_thigh = swing_hip_feedback(q_thigh, com_d - a_c[st], com_c - a_c[st], com_vel_d,
+                                             mass.com_velocity(state), cfg.swing_hip_cd, cfg.swing_hip_cv, heading)
+            q_hip = rot.multiply(rot.conjugate(q_root_d), q_thigh)
+            if weights[side] > 0 and ch_state is not Stance.DS:
+                q_hip_cur = _canonical_local(q_cur[JOINT_NAMES.index(f"{side}_hip")])
+                q_hip = stance_hip_blend(q_hip, q_hip_cur, cfg.stance_hip_weight_w0)  # Eq. 11
+            local[f"{side}_hip"] = q_hip
+            knee_angle[f"{side}_knee"] = ik.knee_angle_rad
+            q_foot = rot.quat_from_yaw(foot_yaw)
+            local[f"{side}_ankle"] = rot.multiply(rot.conjugate(ik.shank_quat_wxyz), q_foot)
+
+        # Upper body from the joint map; the chest keeps the operator's torso orientation in the world.
+        local["chest"] = rot.multiply(rot.conjugate(q_root_d), s.quat["SPINE_CHEST"])
+        local["neck"] = rot.multiply(rot.conjugate(s.quat["SPINE_CHEST"]), s.quat["NECK"])
+        for side in ("left", "right"):
+            S = _SIDE_UP[side]
+            local[f"{side}_shoulder"] = rot.multiply(rot.conjugate(s.quat["SPINE_CHEST"]), s.quat[f"SHOULDER_{S}"])
+            q_el = rot.multiply(rot.conjugate(s.quat[f"SHOULDER_{S}"]), s.quat[f"ELBOW_{S}"])
+            knee_angle[f"{side}_elbow"] = hinge_angle(q_el, f"{side}_elbow")
+
+        joint_pos = np.zeros((len(JOINTS), 4))
+        for k, spec in enumerate(JOINTS):
+            if spec.kind is JointKind.BALL:
+                joint_pos[k] = rot.align_sign(model_quat_from_canonical(local[spec.name]), q_cur[k])
+            else:
+                joint_pos[k, 0] = knee_angle[spec.name]
+
+        lipm = None
+        if ch_state is not Stance.DS:
+            st = "left" if ch_state is Stance.LS else "right"
+            dh, dc = com_h - a_h[st], com_c - a_c[st]
+            lipm = LipmMap(np.array([dh[0], dh[1], 0.0]), float(max(dh[2], 0.1)),
+                           np.array([dc[0], dc[1], 0.0]), float(max(dc[2], 0.1)))
+        return ReferencePose(
+            time_s=state.time_s, joint_pos=joint_pos, root_quat_wxyz=q_root_d, com_world=com_d,
+            com_vel_world=com_vel_d, operator_stance=op_state, character_stance=ch_state, stance_weight=weights,
+            ankle_world=a_c, lipm=lipm, operator_features=features, held=self.char_fsm.hold_reference,
+            scale=scale, step_bound_exceeded=step_exceeded,
+        )
+
+    @staticmethod
+    def _ds_left_share(com: np.ndarray, ankles: dict[str, np.ndarray]) -> float:
+        """Share of the weight on the left foot in double stance: COM position along the line of the ankles."""
+        d = ankles["right"][:2] - ankles["left"][:2]
+        n2 = float(d @ d)
+        if n2 < 1e-6:
+            return 0.5
+        t = float((com[:2] - ankles["left"][:2]) @ d) / n2
+        return 1.0 - min(max(t, 0.0), 1.0)
+
+
+def _canonical_local(q_model: np.ndarray) -> np.ndarray:
+    from stylesync.sim.character import canonical_quat_from_model
+
+    return canonical_quat_from_model(q_model)

@@ -1,0 +1,38 @@
+"""The reference pose: what the motion optimisation hands to the balance and synchronisation controller."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from stylesync.motion.stance_fsm import Stance
+from stylesync.motion.style_features import StyleFeatures
+
+
+@dataclass
+class LipmMap:
+    """Inputs of Eq. 23 for the current single stance."""
+
+    d_a_human: np.ndarray  # (3,) operator COM minus stance ankle, horizontal [m]
+    h_human_m: float  # operator COM height above the stance ankle [m]
+    d_a_char: np.ndarray  # (3,) character COM minus stance ankle, horizontal [m]
+    h_char_m: float
+
+
+@dataclass
+class ReferencePose:
+    time_s: float
+    joint_pos: np.ndarray  # (n_joints, 4) desired local rotations (model axes), hinge angle in column 0
+    root_quat_wxyz: np.ndarray  # desired canonical pelvis orientation (level, heading H)
+    com_world: np.ndarray  # desired character COM [m]
+    com_vel_world: np.ndarray  # [m/s]
+    operator_stance: Stance
+    character_stance: Stance
+    stance_weight: dict[str, float]
+    ankle_world: dict[str, np.ndarray]  # current character ankle joints [m]
+    lipm: LipmMap | None
+    operator_features: StyleFeatures
+    held: bool  # the reference is held waiting for a late contact
+    scale: float  # character / operator size ratio (h_C / h_H of Eq. 9)
+    step_bound_exceeded: bool

@@ -1,0 +1,104 @@
+"""Motion states and state transitions (Sec. 5.1, Fig. 6): LS, RS and DS.
+
+Operator side: DS while the height difference of the two ankles is within a threshold (with hysteresis);
+otherwise the lower foot is the stance foot. Character side: follows the operator, with the contact-driven
+transitions of Sec. 5.1:
+* early contact: the swing foot touches down before the operator's state changes -> DS at once (held until the
+  operator's state changes, so that it does not flip back);
+* late contact: the operator is back in DS but the character's swing foot is still in the air -> the reference
+  is held (``hold_reference``) until the foot touches down (or a timeout passes).
+"""
+
+from __future__ import annotations
+
+from enum import Enum
+
+
+class Stance(Enum):
+    LS = "LS"  # left stance (right foot swinging)
+    RS = "RS"  # right stance
+    DS = "DS"  # double stance
+
+
+def swing_side(s: Stance) -> str | None:
+    return {Stance.LS: "right", Stance.RS: "left", Stance.DS: None}[s]
+
+
+def stance_weights(s: Stance, ds_left_share: float) -> dict[str, float]:
+    if s is Stance.LS:
+        return {"left": 1.0, "right": 0.0}
+    if s is Stance.RS:
+        return {"left": 0.0, "right": 1.0}
+    w = min(max(ds_left_share, 0.0), 1.0)
+    return {"left": w, "right": 1.0 - w}
+
+
+class OperatorStanceFsm:
+    def __init__(self, threshold_m: float, hysteresis_m: float):
+        self.threshold_m = threshold_m
+        self.hysteresis_m = hysteresis_m
+        self.state = Stance.DS
+
+    def update(self, ankle_left_z: float, ankle_right_z: float) -> Stance:
+        diff = ankle_left_z - ankle_right_z  # > 0: left foot higher
+        if self.state is Stance.DS:
+            leave = self.threshold_m + self.hysteresis_m
+            if diff > leave:
+                self.state = Stance.RS
+            elif diff < -leave:
+                self.state = Stance.LS
+        else:
+            if abs(diff) < self.threshold_m - self.hysteresis_m:
+                self.state = Stance.DS
+            elif diff > self.threshold_m + self.hysteresis_m:
+                self.state = Stance.RS
+            elif diff < -(self.threshold_m + self.hysteresis_m):
+                self.state = Stance.LS
+        return self.state
+
+
+class CharacterStanceFsm:
+    def __init__(self, late_contact_timeout_s: float, min_swing_s: float):
+        self.timeout_s = late_contact_timeout_s
+        self.min_swing_s = min_swing_s
+        self.state = Stance.DS
+        self.hold_reference = False
+        self._swing_start_s = 0.0
+        self._hold_start_s = 0.0
+        self._early_latched_for: Stance | None = None
+
+    def update(self, op: Stance, contact: dict[str, bool], time_s: float) -> Stance:
+        self.hold_reference = False
+        if self._early_latched_for is not None:
+            if op is self._early_latched_for:
+                return self.state  # early contact: stay in DS until the operator's state changes
+            self._early_latched_for = None
+        sw = swing_side(self.state)
+        if self.state is op:
+            # Early contact: swing foot down before the operator's transition.
+            if sw is not None and contact[sw] and time_s - self._swing_start_s >= self.min_swing_s:
+                self._early_latched_for = op
+                self.state = Stance.DS
+            return self.state
+        if op is Stance.DS or (sw is not None and swing_side(op) != sw):
+            # The character's swing foot must land first (late contact holds the reference).
+            if sw is None or contact[sw]:
+                self._enter(op, time_s)
+            else:
+                if not self._holding:
+                    self._holding, self._hold_start_s = True, time_s
+                if time_s - self._hold_start_s >= self.timeout_s:
+                    self._enter(op, time_s)
+                else:
+                    self.hold_reference = True
+            return self.state
+        self._enter(op, time_s)  # lift-off from DS is the operator's decision: follow at once
+        return self.state
+
+    _holding = False
+
+    def _enter(self, s: Stance, time_s: float) -> None:
+        self._holding = False
+        if s is not Stance.DS and self.state is not s:
+            self._swing_start_s = time_s
+        self.state = s

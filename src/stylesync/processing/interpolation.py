@@ -1,0 +1,73 @@
+"""Time-varying interpolation of mocap frames to the control rate (Sec. 4.3, Eq. 7).
+
+Eq. 7 as printed, ``q_{n,i+1} = (q_ref_{n+1} - q_{n,i}) k i + q_{n,i}`` with ``k = f_mcp / f_itp``, calls k "the
+number of interpolations" although 16/133 < 1, and lets the factor k*i grow with i. We read it as: at control
+step i after mocap frame n arrived, the output is the fraction ``min(k i, 1)`` of the way from the value held when
+frame n arrived to the reference of frame n (the newest), so that the output reaches each new reference one
+mocap period after it arrives. A new frame restarts the ramp from the current output (no jump). Quaternions are
+interpolated by slerp on the same fraction.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from stylesync import rotations as rot
+
+
+class LinearRamp:
+    """Eq. 7 for a vector of scalars (positions [m], angles [rad])."""
+
+    def __init__(self, mocap_hz: float, control_hz: float):
+        self.k = mocap_hz / control_hz  # Eq. 7, k = f_mcp / f_itp
+        self._start: np.ndarray | None = None
+        self._target: np.ndarray | None = None
+        self._out: np.ndarray | None = None
+        self._i = 0
+
+    def push(self, reference: np.ndarray) -> None:
+        """A new mocap frame: ramp from the current output to ``reference``."""
+        ref = np.array(reference, dtype=float)
+        if self._out is None:
+            self._out = ref.copy()
+            self._start = ref.copy()
+        else:
+            self._start = self._out.copy()
+        self._target = ref
+        self._i = 0
+
+    def step(self) -> np.ndarray:
+        """The interpolated value for the next control step."""
+        if self._out is None or self._start is None or self._target is None:
+            raise ValueError("LinearRamp.step() before the first push()")
+        self._i += 1
+        frac = min(self.k * self._i, 1.0)
+        self._out = self._start + (self._target - self._start) * frac
+        return self._out.copy()
+
+
+class SlerpRamp:
+    """Eq. 7 for a set of unit quaternions (n, 4), wxyz."""
+
+    def __init__(self, mocap_hz: float, control_hz: float):
+        self.k = mocap_hz / control_hz
+        self._start: np.ndarray | None = None
+        self._target: np.ndarray | None = None
+        self._out: np.ndarray | None = None
+        self._i = 0
+
+    def push(self, reference: np.ndarray) -> None:
+        ref = np.array(reference, dtype=float)
+        if self._out is None:
+            self._out = ref.copy()
+        self._start = self._out.copy()
+        self._target = np.array([rot.align_sign(r, s) for r, s in zip(ref, self._start, strict=True)])
+        self._i = 0
+
+    def step(self) -> np.ndarray:
+        if self._out is None or self._start is None or self._target is None:
+            raise ValueError("SlerpRamp.step() before the first push()")
+        self._i += 1
+        frac = min(self.k * self._i, 1.0)
+        self._out = np.array([rot.slerp(a, b, frac) for a, b in zip(self._start, self._target, strict=True)])
+        return self._out.copy()

@@ -1,0 +1,205 @@
+"""Rotation helpers.
+
+Convention, stated once for the whole package: quaternions are arrays ``(w, x, y, z)`` (scalar first), unit norm,
+acting on column vectors (``R @ v``). Rotation vectors ("log maps") are axis * angle [rad]. PyBullet speaks
+``(x, y, z, w)``: convert only at the engine boundary with :func:`wxyz_from_xyzw` / :func:`xyzw_from_wxyz`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+Array = NDArray[np.float64]
+
+IDENTITY_WXYZ: Array = np.array([1.0, 0.0, 0.0, 0.0])
+
+
+def wxyz_from_xyzw(q_xyzw) -> Array:
+    """Reorder a PyBullet quaternion (x, y, z, w) into our (w, x, y, z)."""
+    q = np.asarray(q_xyzw, dtype=float)
+    return np.array([q[3], q[0], q[1], q[2]])
+
+
+def xyzw_from_wxyz(q_wxyz) -> Array:
+    """Reorder our quaternion (w, x, y, z) into PyBullet's (x, y, z, w)."""
+    q = np.asarray(q_wxyz, dtype=float)
+    return np.array([q[1], q[2], q[3], q[0]])
+
+
+def normalize(q: Array) -> Array:
+    n = float(np.linalg.norm(q))
+    if not np.isfinite(n) or n < 1e-12:
+        return IDENTITY_WXYZ.copy()
+    return q / n
+
+
+def multiply(a: Array, b: Array) -> Array:
+    """Hamilton product a ⊗ b (apply b first, then a)."""
+    aw, ax, ay, az = a
+    bw, bx, by, bz = b
+    return np.array(
+        [
+            aw * bw - ax * bx - ay * by - az * bz,
+            aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw,
+        ]
+    )
+
+
+def conjugate(q: Array) -> Array:
+    return np.array([q[0], -q[1], -q[2], -q[3]])
+
+
+def matrix_from_quat(q: Array) -> Array:
+    """3x3 rotation matrix of a unit quaternion (w, x, y, z)."""
+    w, x, y, z = q
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def quat_from_matrix(R: Array) -> Array:
+    """Unit quaternion (w, x, y, z) with w >= 0 of a rotation matrix (Shepperd's method)."""
+    m = np.asarray(R, dtype=float)
+    tr = m[0, 0] + m[1, 1] + m[2, 2]
+    if tr > 0:
+        s = 2.0 * np.sqrt(tr + 1.0)
+        q = np.array([0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s])
+    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
+        s = 2.0 * np.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2])
+        q = np.array([(m[2, 1] - m[1, 2]) / s, 0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s])
+    elif m[1, 1] > m[2, 2]:
+        s = 2.0 * np.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2])
+        q = np.array([(m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s])
+    else:
+        s = 2.0 * np.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1])
+        q = np.array([(m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s])
+    q = normalize(q)
+    return q if q[0] >= 0 else -q
+
+
+def rotate(q: Array, v: Array) -> Array:
+    """Rotate vector v [any unit] by quaternion q."""
+    return matrix_from_quat(q) @ np.asarray(v, dtype=float)
+
+
+def quat_from_axis_angle(axis: Array, angle_rad: float) -> Array:
+    axis = np.asarray(axis, dtype=float)
+    n = np.linalg.norm(axis)
+    if n < 1e-12:
+        return IDENTITY_WXYZ.copy()
+    axis = axis / n
+    h = 0.5 * angle_rad
+    return np.concatenate([[np.cos(h)], np.sin(h) * axis])
+
+
+def quat_from_rotvec(rv: Array) -> Array:
+    rv = np.asarray(rv, dtype=float)
+    angle = float(np.linalg.norm(rv))
+    if angle < 1e-12:
+        return normalize(np.array([1.0, 0.5 * rv[0], 0.5 * rv[1], 0.5 * rv[2]]))
+    return quat_from_axis_angle(rv / angle, angle)
+
+
+def rotvec_from_quat(q: Array) -> Array:
+    """Log map: rotation vector [rad] of the shortest rotation equal to q (q and -q give the same)."""
+    q = np.asarray(q, dtype=float)
+    if q[0] < 0:
+        q = -q
+    v = q[1:]
+    s = float(np.linalg.norm(v))
+    if s < 1e-12:
+        return 2.0 * v
+    angle = 2.0 * np.arctan2(s, q[0])
+    return v / s * angle
+
+
+def slerp(q0: Array, q1: Array, t: float) -> Array:
+    """Spherical interpolation from q0 (t = 0) to q1 (t = 1) along the shorter arc."""
+    q1 = q1 if float(np.dot(q0, q1)) >= 0 else -q1
+    d = multiply(conjugate(q0), q1)
+    return normalize(multiply(q0, quat_from_rotvec(t * rotvec_from_quat(d))))
+
+
+def yaw_from_quat(q: Array) -> float:
+    """Heading [rad] about world z of the body x axis of q."""
+    fwd = rotate(q, np.array([1.0, 0.0, 0.0]))
+    return float(np.arctan2(fwd[1], fwd[0]))
+
+
+def quat_from_yaw(yaw_rad: float) -> Array:
+    return quat_from_axis_angle(np.array([0.0, 0.0, 1.0]), yaw_rad)
+
+
+def swing_twist(q: Array, axis: Array) -> tuple[Array, Array]:
+    """Split q = swing ⊗ twist, twist being the rotation of q about ``axis`` (unit, in q's frame)."""
+    axis = np.asarray(axis, dtype=float)
+    p = float(np.dot(q[1:], axis)) * axis
+    twist = np.array([q[0], p[0], p[1], p[2]])
+    if np.linalg.norm(twist) < 1e-12:
+        twist = IDENTITY_WXYZ.copy()
+    twist = normalize(twist)
+    swing = multiply(q, conjugate(twist))
+    return swing, twist
+
+
+def twist_angle(q: Array, axis: Array) -> float:
+    """Signed twist angle [rad] of q about the unit ``axis``."""
+    _, tw = swing_twist(q, axis)
+    if tw[0] < 0:
+        tw = -tw
+    return float(2.0 * np.arctan2(np.dot(tw[1:], axis), tw[0]))
+
+
+def rotation_between(a: Array, b: Array) -> Array:
+    """Shortest rotation taking direction a onto direction b."""
+    a = np.asarray(a, dtype=float) / np.linalg.norm(a)
+    b = np.asarray(b, dtype=float) / np.linalg.norm(b)
+    c = np.cross(a, b)
+    d = float(np.dot(a, b))
+    if d < -1 + 1e-9:
+        ortho = np.cross(a, [1.0, 0.0, 0.0])
+        if np.linalg.norm(ortho) < 1e-6:
+            ortho = np.cross(a, [0.0, 1.0, 0.0])
+        return quat_from_axis_angle(ortho, np.pi)
+    return normalize(np.array([1.0 + d, c[0], c[1], c[2]]))
+
+
+def align_sign(q: Array, reference: Array) -> Array:
+    """Return q or -q, whichever is closer to ``reference`` (double cover q ≡ -q)."""
+    return q if float(np.dot(q, reference)) >= 0 else -q
+
+
+# ---- batched versions for the per-physics-step controller: arrays of shape (n, 4) / (n, 3) --------------------
+def batch_multiply(a: Array, b: Array) -> Array:
+    aw, ax, ay, az = a[:, 0], a[:, 1], a[:, 2], a[:, 3]
+    bw, bx, by, bz = b[:, 0], b[:, 1], b[:, 2], b[:, 3]
+    return np.stack(
+        [
+            aw * bw - ax * bx - ay * by - az * bz,
+            aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw,
+        ],
+        axis=1,
+    )
+
+
+def batch_conjugate(q: Array) -> Array:
+    return q * np.array([1.0, -1.0, -1.0, -1.0])
+
+
+def batch_rotvec(q: Array) -> Array:
+    """Log map of each row (shortest rotation), (n, 4) -> (n, 3) [rad]."""
+    q = np.where(q[:, :1] < 0, -q, q)
+    v = q[:, 1:]
+    s = np.linalg.norm(v, axis=1)
+    angle = 2.0 * np.arctan2(s, q[:, 0])
+    scale = np.where(s > 1e-12, angle / np.maximum(s, 1e-12), 2.0)
+    return v * scale[:, None]

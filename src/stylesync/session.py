@@ -1,0 +1,212 @@
+"""The clocks and the loop that wires the stages (Fig. 2): source -> processing -> motion -> control -> physics.
+
+Three clocks (Sec. 7.1): mocap frames arrive at their own rate (16 Hz), the control tick runs at 133 Hz, the
+physics at 600 Hz. Simulated time is the master clock: a control tick runs on the first physics step at or after
+its due time, so the same input, configuration and seed give the same simulation whether the loop is paced to the
+wall clock (interactive) or runs as fast as possible (offline).
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from stylesync import rotations as rot
+from stylesync.config import SessionConfig
+from stylesync.control.controller import BalanceController
+from stylesync.errors import SourceError
+from stylesync.motion.pose_optimization import MotionOptimizer
+from stylesync.motion.stance_fsm import Stance
+from stylesync.motion.style_features import StyleExtractor
+from stylesync.processing.operator_processing import OperatorProcessing
+from stylesync.sim.backend import CharacterState, PhysicsBackend, make_backend
+from stylesync.sim.character import LINK_NAMES, STANDING_ROOT_HEIGHT_M
+from stylesync.sources.base import OperatorSource
+
+log = logging.getLogger("stylesync.session")
+FALL_ROOT_HEIGHT_M = 0.5  # a fall: pelvis below this height, or a non-foot link on the ground
+SILENT_STREAM_TIMEOUT_S = 2.0
+_LINK = {n: i for i, n in enumerate(LINK_NAMES)}
+STANCE_CODE = {Stance.LS: 0, Stance.DS: 1, Stance.RS: 2}
+
+
+@dataclass
+class TickLog:
+    """Per-control-tick record of a run (lists of equal length)."""
+
+    columns: dict[str, list] = field(default_factory=dict)
+
+    def add(self, **values) -> None:
+        for k, v in values.items():
+            self.columns.setdefault(k, []).append(v)
+
+    def array(self, key: str) -> np.ndarray:
+        return np.asarray(self.columns.get(key, []), dtype=float)
+
+
+@dataclass
+class SessionResult:
+    log: TickLog
+    fell: bool
+    fall_time_s: float | None
+    fall_reason: str
+    sim_duration_s: float
+    wall_duration_s: float
+    physics_steps: int
+    rejected_frames: int
+    dropped_joint_values: int
+    bound_counts: dict[str, int]
+    stage_ms: dict[str, list[float]]
+    first_character_frame: np.ndarray | None = None
+
+
+class Session:
+    def __init__(self, config: SessionConfig, source: OperatorSource, backend: PhysicsBackend | None = None,
+                 on_tick: Callable[[CharacterState, object], None] | None = None):
+        self.cfg = config
+        self.source = source
+        self.backend = backend or make_backend(config.world, config.clocks.physics_hz, gui=config.gui)
+        self.mass = self.backend.mass_properties()
+        self.processing = OperatorProcessing(config.clocks, config.filters)
+        self.motion = MotionOptimizer(config.motion, config.clocks.control_hz)
+        self.controller = BalanceController(config.control, self.mass, config.world.gravity_mps2,
+                                            1.0 / config.clocks.physics_hz, 1.0 / config.clocks.control_hz)
+        self.char_style = StyleExtractor()
+        self.on_tick = on_tick
+        self.renders: list[tuple[float, np.ndarray]] = []
+
+    def _place_character(self) -> None:
+        """Stand the character where the operator stands (scaled), facing the operator's heading."""
+        frames = self.source.poll(0.0)
+        if not frames:
+            raise SourceError("the operator source delivered no frame at start (t = 0 s)")
+        for f in frames:
+            self.processing.push(f)
+        f0 = frames[-1]
+        yaw = rot.yaw_from_quat(f0.quat("PELVIS"))
+        pelvis = f0.pos("PELVIS")
+        self.backend.reset(np.array([pelvis[0], pelvis[1], STANDING_ROOT_HEIGHT_M + 0.003]), rot.quat_from_yaw(yaw))
+
+    def run(self, progress: Callable[[float, float], None] | None = None,
+            render_every_s: float | None = None) -> SessionResult:
+        cfg = self.cfg
+        clocks = cfg.clocks
+        dt = 1.0 / clocks.physics_hz
+        control_dt = 1.0 / clocks.control_hz
+        n_steps = int(round(cfg.duration_s * clocks.physics_hz))
+        self._place_character()
+        tick_log = TickLog()
+        stage_ms: dict[str, list[float]] = {"processing": [], "motion": [], "control_update": [], "torques": [],
+                                            "physics": []}
+        next_control = 0.0
+        next_render = 0.0
+        last_frame_wall = time.perf_counter()
+        last_frame_sim = 0.0
+        fell, fall_time, fall_reason = False, None, ""
+        wall0 = time.perf_counter()
+        step = 0
+        for step in range(n_steps):
+            t = step * dt
+            if t + 1e-12 >= next_control:
+                next_control += control_dt
+                c0 = time.perf_counter()
+                frames = self.source.poll(t)
+                for f in frames:
+                    self.processing.push(f)
+                if frames:
+                    last_frame_sim, last_frame_wall = t, time.perf_counter()
+                elif t - last_frame_sim > SILENT_STREAM_TIMEOUT_S and self._source_is_live():
+                    raise SourceError(f"operator stream silent for more than {SILENT_STREAM_TIMEOUT_S:.0f} s")
+                sample = self.processing.step(t)
+                c1 = time.perf_counter()
+                state = self.backend.read_state(t)
+                ref = self.motion.update(sample, state, self.mass)
+                c2 = time.perf_counter()
+                self.controller.update(state, ref)
+                c3 = time.perf_counter()
+                stage_ms["processing"].append((c1 - c0) * 1e3)
+                stage_ms["motion"].append((c2 - c1) * 1e3)
+                stage_ms["control_update"].append((c3 - c2) * 1e3)
+                self._log(tick_log, t, sample, state, ref, (c3 - c0) * 1e3)
+                if self.on_tick is not None:
+                    self.on_tick(state, ref)
+                fall_reason = self._fall_reason(state)
+                if fall_reason:
+                    fell, fall_time = True, t
+                    log.warning("character fell at t=%.2f s (%s)", t, fall_reason)
+                    break
+                if render_every_s is not None and t >= next_render and hasattr(self.backend, "render_rgb"):
+                    next_render += render_every_s
+                    com = self.mass.com(state)
+                    self.renders.append((t, self.backend.render_rgb([com[0], com[1], 0.8])))  # type: ignore[attr-defined]
+                if progress is not None:
+                    progress(t, time.perf_counter() - wall0)
+            p0 = time.perf_counter()
+            fb = self.backend.read_joint_feedback()
+            self.backend.apply_torques(self.controller.torques(fb))
+            p1 = time.perf_counter()
+            self.backend.step()
+            p2 = time.perf_counter()
+            stage_ms["torques"].append((p1 - p0) * 1e3)
+            stage_ms["physics"].append((p2 - p1) * 1e3)
+            if cfg.realtime:
+                lag = (t + dt) - (time.perf_counter() - wall0)
+                if lag > 0:
+                    time.sleep(lag)
+        wall = time.perf_counter() - wall0
+        sim_t = (step + 1) * dt if not fell else float(fall_time or 0.0)
+        counts = dict(self.controller.bounds.counts)
+        counts["step_length"] = self.motion.bounds.counts["step_length"]
+        return SessionResult(tick_log, fell, fall_time, fall_reason, sim_t, wall, step + 1,
+                             getattr(self.source, "rejected_frames", 0), self.processing.dropped_joint_values,
+                             counts, stage_ms)
+
+    def _source_is_live(self) -> bool:
+        return bool(getattr(self.source, "live", False))
+
+    @staticmethod
+    def _fall_reason(state: CharacterState) -> str:
+        if state.root_pos_world[2] < FALL_ROOT_HEIGHT_M:
+            return f"pelvis at {state.root_pos_world[2]:.2f} m < {FALL_ROOT_HEIGHT_M} m"
+        if state.non_foot_ground_contact:
+            return "a link other than a foot touched the ground"
+        return ""
+
+    def _log(self, lg: TickLog, t: float, sample, state: CharacterState, ref, tick_ms: float) -> None:
+        com = self.mass.com(state)
+        hips = {s: state.link_origin_world[_LINK[f"{s}_hip"]] for s in ("left", "right")}
+        knees = {s: state.link_origin_world[_LINK[f"{s}_knee"]] for s in ("left", "right")}
+        ankles = {s: state.link_origin_world[_LINK[f"{s}_ankle"]] for s in ("left", "right")}
+        shank = {s: state.link_quat_wxyz[_LINK[f"{s}_knee"]] for s in ("left", "right")}
+        foot = {s: state.link_quat_wxyz[_LINK[f"{s}_ankle"]] for s in ("left", "right")}
+        cf = self.char_style(hips, knees, ankles, shank, foot, com, state.root_quat_wxyz)
+        from stylesync.control.pid import joint_error
+
+        err = joint_error(state.joint_pos, ref.joint_pos)
+        lg.add(
+            t=t, tick_ms=tick_ms,
+            op_state=STANCE_CODE[ref.operator_stance], char_state=STANCE_CODE[ref.character_stance],
+            held=float(ref.held), scale=ref.scale,
+            com_x=com[0], com_y=com[1], com_z=com[2],
+            com_d_x=ref.com_world[0], com_d_y=ref.com_world[1], com_d_z=ref.com_world[2],
+            op_com_x=sample.com_world[0], op_com_y=sample.com_world[1], op_com_z=sample.com_world[2],
+            op_al_x=sample.pos["ANKLE_LEFT"][0], op_al_y=sample.pos["ANKLE_LEFT"][1],
+            op_al_z=sample.pos["ANKLE_LEFT"][2],
+            op_ar_x=sample.pos["ANKLE_RIGHT"][0], op_ar_y=sample.pos["ANKLE_RIGHT"][1],
+            op_ar_z=sample.pos["ANKLE_RIGHT"][2],
+            al_x=ankles["left"][0], al_y=ankles["left"][1], al_z=ankles["left"][2],
+            ar_x=ankles["right"][0], ar_y=ankles["right"][1], ar_z=ankles["right"][2],
+            root_z=state.root_pos_world[2],
+            contact_l=state.foot_contact_force_n["left_ankle"], contact_r=state.foot_contact_force_n["right_ankle"],
+            joint_err_deg=float(np.degrees(np.linalg.norm(err, axis=1)).mean()),
+            lipm_fx=self.controller.telemetry.lipm_force_n[0], lipm_fy=self.controller.telemetry.lipm_force_n[1],
+            **{f"op_{k}": v for k, v in zip(_FEATURES, ref.operator_features.as_row(), strict=True)},
+            **{f"ch_{k}": v for k, v in zip(_FEATURES, cf.as_row(), strict=True)},
+        )
+
+
+from stylesync.motion.style_features import ROW_NAMES as _FEATURES  # noqa: E402

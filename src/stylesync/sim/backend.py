@@ -1,0 +1,115 @@
+"""The physics backend interface and the typed values that cross it.
+
+The controller only sees these values; only ``sim/`` imports an engine. World frame: z up, x forward, y left,
+metres, seconds, radians. Quaternions (w, x, y, z). Ball-joint rotations, velocities and torques are expressed in
+the joint's child link frame (model axes); hinge values are scalars about the hinge axis.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+
+import numpy as np
+
+from stylesync.config import WorldConfig
+from stylesync.sim.character import JOINT_NAMES, LINK_NAMES
+
+
+@dataclass
+class CharacterState:
+    """Full kinematic state of the character at one instant (read at the control rate)."""
+
+    time_s: float
+    root_pos_world: np.ndarray  # (3,) pelvis frame origin [m]
+    root_quat_wxyz: np.ndarray  # (4,) canonical pelvis orientation (identity when standing, facing +x)
+    root_lin_vel_world: np.ndarray  # (3,) [m/s]
+    root_ang_vel_world: np.ndarray  # (3,) [rad/s]
+    joint_pos: np.ndarray  # (n_joints, 4): ball joints wxyz (model axes), hinge angle in column 0 [rad]
+    joint_vel: np.ndarray  # (n_joints, 3): ball joints child-frame angular velocity, hinge rate in col 0
+    link_com_world: np.ndarray  # (n_links, 3) centre of mass of each link [m]
+    link_com_vel_world: np.ndarray  # (n_links, 3) [m/s]
+    link_origin_world: np.ndarray  # (n_links, 3) link frame origin = joint position [m]
+    link_quat_wxyz: np.ndarray  # (n_links, 4) canonical world orientation of each link
+    link_ang_vel_world: np.ndarray  # (n_links, 3) [rad/s]
+    foot_contact_force_n: dict[str, float]  # normal ground force per foot link [N]
+    non_foot_ground_contact: bool  # a link other than a foot touches the ground
+
+    def link(self, name: str) -> int:
+        return LINK_NAMES.index(name)
+
+
+@dataclass(frozen=True)
+class MassProperties:
+    link_mass_kg: np.ndarray  # (n_links,)
+    joint_min_inertia_kgm2: np.ndarray  # (n_joints,) smallest principal inertia of each joint's subtree
+
+    @property
+    def total_kg(self) -> float:
+        return float(self.link_mass_kg.sum())
+
+    def com(self, state: CharacterState) -> np.ndarray:
+        """Whole-body centre of mass [m] (world)."""
+        return self.link_mass_kg @ state.link_com_world / self.total_kg
+
+    def com_velocity(self, state: CharacterState) -> np.ndarray:
+        return self.link_mass_kg @ state.link_com_vel_world / self.total_kg
+
+
+@dataclass
+class JointFeedback:
+    """What the per-physics-step PD needs, read cheaply every step."""
+
+    joint_pos: np.ndarray  # (n_joints, 4) as in CharacterState
+    joint_vel: np.ndarray  # (n_joints, 3)
+    root_quat_wxyz: np.ndarray  # (4,) canonical pelvis orientation
+    root_ang_vel_world: np.ndarray  # (3,)
+
+
+@dataclass
+class Torques:
+    """Joint torques for one physics step: (n_joints, 3) child-frame for ball joints, column 0 for hinges [N·m]."""
+
+    values: np.ndarray
+
+    @staticmethod
+    def zeros() -> Torques:
+        return Torques(np.zeros((len(JOINT_NAMES), 3)))
+
+
+class PhysicsBackend(ABC):
+    """A physics engine holding one character on a flat ground, stepped at a fixed rate."""
+
+    @abstractmethod
+    def reset(
+        self, root_pos_world: np.ndarray, root_quat_wxyz: np.ndarray, joint_pos: np.ndarray | None = None
+    ) -> None: ...
+
+    @abstractmethod
+    def mass_properties(self) -> MassProperties: ...
+
+    @abstractmethod
+    def read_state(self, time_s: float) -> CharacterState: ...
+
+    @abstractmethod
+    def read_joint_feedback(self) -> JointFeedback: ...
+
+    @abstractmethod
+    def apply_torques(self, torques: Torques) -> None:
+        """Torques act during the next :meth:`step` only."""
+
+    @abstractmethod
+    def step(self) -> None: ...
+
+    @abstractmethod
+    def close(self) -> None: ...
+
+
+def make_backend(
+    world: WorldConfig, physics_hz: float, gui: bool = False, fixed_root: bool = False
+) -> PhysicsBackend:
+    """The default engine. ``fixed_root`` loads the pelvis welded to the world, only for gain tuning and tests
+    "with the root fixed" (Sec. 7.2); a teleoperated character always has a free root."""
+    from stylesync.sim.pybullet_backend import PyBulletBackend
+
+    return PyBulletBackend(world, physics_hz, gui=gui, fixed_root=fixed_root)

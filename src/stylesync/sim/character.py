@@ -1,0 +1,103 @@
+"""Description of the simulated character: the DeepMimic humanoid shipped in pybullet_data (Sec. 7.1, Table 2).
+
+Engine-independent: joint names, kinds, parents, torque limits. The URDF is Y-up; our world is z-up, x forward,
+y left. The model's link frames equal the base frame in the rest pose (all joint origins have rpy = 0), and the
+base is loaded rotated by ``Q_WORLD_MODEL`` (+90 deg about x). A *canonical segment orientation* is the world
+orientation of a link with that constant rotation removed, so that in the rest pose (standing straight, arms
+down, feet forward along +x) every canonical segment orientation is the identity.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import Enum
+
+import numpy as np
+
+from stylesync import rotations as rot
+
+URDF_PATH_IN_PYBULLET_DATA = "humanoid/humanoid.urdf"
+URDF_GLOBAL_SCALING = 0.25  # the URDF is authored at 4x scale; DeepMimic loads it at 0.25
+CHARACTER_HEIGHT_M = 1.62  # Sec. 7.1
+CHARACTER_MASS_KG = 45.0  # Sec. 7.1
+STANDING_ROOT_HEIGHT_M = 0.895  # pelvis origin height with straight legs and feet flat [m]
+
+# World orientation of the model's frame: +90 deg about x maps the URDF's +y (up) to world +z.
+Q_WORLD_MODEL = rot.quat_from_axis_angle(np.array([1.0, 0.0, 0.0]), np.pi / 2)
+
+
+class JointKind(Enum):
+    BALL = "ball"  # 3 DOF, spherical; torque and velocity in the child link frame
+    HINGE = "hinge"  # 1 DOF, revolute about its axis
+
+
+@dataclass(frozen=True)
+class JointSpec:
+    name: str
+    kind: JointKind
+    parent: str  # parent link name; "root" is the pelvis
+    torque_limit_nm: float  # per-axis torque limit [N·m], DeepMimic humanoid3d character file
+    axis_in_model: tuple[float, float, float] = (0.0, 0.0, 1.0)  # hinge axis in the child frame (model axes)
+
+
+# Actuated joints in URDF order. Torque limits follow the DeepMimic humanoid3d character definition
+# (chest 200, neck 50, hip 200, knee 150, ankle 90, shoulder 100, elbow 60 N·m).
+JOINTS: tuple[JointSpec, ...] = (
+    JointSpec("chest", JointKind.BALL, "root", 200.0),
+    JointSpec("neck", JointKind.BALL, "chest", 50.0),
+    JointSpec("right_hip", JointKind.BALL, "root", 200.0),
+    JointSpec("right_knee", JointKind.HINGE, "right_hip", 150.0),
+    JointSpec("right_ankle", JointKind.BALL, "right_knee", 90.0),
+    JointSpec("right_shoulder", JointKind.BALL, "chest", 100.0),
+    JointSpec("right_elbow", JointKind.HINGE, "right_shoulder", 60.0),
+    JointSpec("left_hip", JointKind.BALL, "root", 200.0),
+    JointSpec("left_knee", JointKind.HINGE, "left_hip", 150.0),
+    JointSpec("left_ankle", JointKind.BALL, "left_knee", 90.0),
+    JointSpec("left_shoulder", JointKind.BALL, "chest", 100.0),
+    JointSpec("left_elbow", JointKind.HINGE, "left_shoulder", 60.0),
+)
+JOINT_NAMES: tuple[str, ...] = tuple(j.name for j in JOINTS)
+JOINT_BY_NAME: dict[str, JointSpec] = {j.name: j for j in JOINTS}
+
+# All rigid links with mass, in URDF order ("root" is the pelvis; wrists are fixed hands).
+LINK_NAMES: tuple[str, ...] = (
+    "root", "chest", "neck", "right_hip", "right_knee", "right_ankle", "right_shoulder", "right_elbow",
+    "right_wrist", "left_hip", "left_knee", "left_ankle", "left_shoulder", "left_elbow", "left_wrist",
+)
+LINK_PARENT: dict[str, str | None] = {
+    "root": None, "chest": "root", "neck": "chest", "right_hip": "root", "right_knee": "right_hip",
+    "right_ankle": "right_knee", "right_shoulder": "chest", "right_elbow": "right_shoulder",
+    "right_wrist": "right_elbow", "left_hip": "root", "left_knee": "left_hip", "left_ankle": "left_knee",
+    "left_shoulder": "chest", "left_elbow": "left_shoulder", "left_wrist": "left_elbow",
+}
+FOOT_LINKS: tuple[str, str] = ("left_ankle", "right_ankle")
+SIDES: tuple[str, str] = ("left", "right")
+
+# Segment geometry of the character [m] (joint offsets of the URDF times its 0.25 scaling).
+THIGH_LENGTH_M = 1.686184 * URDF_GLOBAL_SCALING
+SHANK_LENGTH_M = 1.639480 * URDF_GLOBAL_SCALING
+ANKLE_HEIGHT_M = 0.045 + 0.0225  # ankle joint above the sole with the foot flat [m]
+HIP_HALF_WIDTH_M = 0.339548 * URDF_GLOBAL_SCALING
+FOOT_LENGTH_M = 0.708 * URDF_GLOBAL_SCALING  # Table 2: 0.18
+FOOT_WIDTH_M = 0.36 * URDF_GLOBAL_SCALING  # box x-extent 0.177, z-extent 0.09 (model axes)
+FOOT_CENTER_AHEAD_OF_ANKLE_M = 0.18 * URDF_GLOBAL_SCALING
+
+
+def chain_to_root(link: str) -> list[str]:
+    """Joint names from ``link`` up to (not including) the pelvis, child first."""
+    chain: list[str] = []
+    cur: str | None = link
+    while cur is not None and cur != "root":
+        if cur in JOINT_BY_NAME:
+            chain.append(cur)
+        cur = LINK_PARENT[cur]
+    return chain
+
+
+def model_quat_from_canonical(q_canonical_wxyz: np.ndarray) -> np.ndarray:
+    """Joint rotation in model axes from the same relative rotation in canonical (world-aligned) axes."""
+    return rot.multiply(rot.multiply(rot.conjugate(Q_WORLD_MODEL), q_canonical_wxyz), Q_WORLD_MODEL)
+
+
+def canonical_quat_from_model(q_model_wxyz: np.ndarray) -> np.ndarray:
+    return rot.multiply(rot.multiply(Q_WORLD_MODEL, q_model_wxyz), rot.conjugate(Q_WORLD_MODEL))

@@ -1,0 +1,259 @@
+"""PyBullet 3.2.7 implementation of :class:`PhysicsBackend` (Sec. 7.1).
+
+The only module (with ``sim/scene.py``) that imports pybullet. PyBullet quaternions are (x, y, z, w); they are
+converted here, at the boundary. The character is moved by joint torques only: the default joint motors are
+disabled at load time and :meth:`apply_torques` is the only actuation.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import sys
+
+import numpy as np
+import pybullet as pb
+import pybullet_data
+from pybullet_utils.bullet_client import BulletClient
+
+from stylesync import rotations as rot
+from stylesync.config import WorldConfig
+from stylesync.errors import SimulationError
+from stylesync.sim.backend import CharacterState, JointFeedback, MassProperties, PhysicsBackend, Torques
+from stylesync.sim.character import (
+    FOOT_LINKS,
+    JOINT_NAMES,
+    JOINTS,
+    LINK_NAMES,
+    Q_WORLD_MODEL,
+    URDF_GLOBAL_SCALING,
+    URDF_PATH_IN_PYBULLET_DATA,
+    JointKind,
+)
+
+_Q_MODEL_WORLD = rot.conjugate(Q_WORLD_MODEL)
+SOCCER_BALL_URDF = "soccerball.urdf"
+
+
+@contextlib.contextmanager
+def _quiet_stdout():
+    """Silence C-level stdout/stderr (file descriptors 1 and 2) for the duration."""
+    saved = [os.dup(1), os.dup(2)]
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os.dup2(devnull, 1)
+        os.dup2(devnull, 2)
+        yield
+    finally:
+        os.dup2(saved[0], 1)
+        os.dup2(saved[1], 2)
+        for fd in (*saved, devnull):
+            os.close(fd)
+
+
+def _canonical_from_link_xyzw(q_xyzw) -> np.ndarray:
+    return rot.multiply(rot.wxyz_from_xyzw(q_xyzw), _Q_MODEL_WORLD)
+
+
+class PyBulletBackend(PhysicsBackend):
+    def __init__(self, world: WorldConfig, physics_hz: float, gui: bool = False, fixed_root: bool = False):
+        try:
+            self._pb = BulletClient(connection_mode=pb.GUI if gui else pb.DIRECT)
+        except Exception as exc:  # pybullet raises a bare error when no display is available
+            raise SimulationError(f"could not start PyBullet ({'GUI' if gui else 'DIRECT'}): {exc}") from exc
+        c = self._pb
+        c.setAdditionalSearchPath(pybullet_data.getDataPath())
+        c.setGravity(0.0, 0.0, -world.gravity_mps2)
+        c.setTimeStep(1.0 / physics_hz)
+        c.setPhysicsEngineParameter(numSolverIterations=10)
+        self._world = world
+        self._fixed_root = fixed_root
+        self.plane = c.loadURDF("plane.urdf", [0, 0, 0], useFixedBase=True)
+        with _quiet_stdout():  # the URDF importer prints warnings about axis-less spherical joints
+            self.body = c.loadURDF(
+                URDF_PATH_IN_PYBULLET_DATA,
+                [0.0, 0.0, 1.0],
+                rot.xyzw_from_wxyz(Q_WORLD_MODEL).tolist(),
+                globalScaling=URDF_GLOBAL_SCALING,
+                useFixedBase=fixed_root,
+                flags=pb.URDF_MAINTAIN_LINK_ORDER,
+            )
+        index_by_name = {c.getJointInfo(self.body, j)[1].decode(): j for j in range(c.getNumJoints(self.body))}
+        missing = [n for n in JOINT_NAMES if n not in index_by_name]
+        if missing:
+            raise SimulationError(f"character model lacks joints {missing}")
+        self._joint_idx = [index_by_name[n] for n in JOINT_NAMES]
+        self._link_idx = [index_by_name[n] for n in LINK_NAMES]
+        self._foot_idx = {index_by_name[n]: n for n in FOOT_LINKS}
+        self._is_ball = np.array([j.kind is JointKind.BALL for j in JOINTS])
+        for j, spec in zip(self._joint_idx, JOINTS, strict=True):
+            if spec.kind is JointKind.BALL:
+                c.setJointMotorControlMultiDof(
+                    self.body, j, pb.POSITION_CONTROL, targetPosition=[0, 0, 0, 1],
+                    positionGain=0, velocityGain=0, force=[0, 0, 0],
+                )
+            else:
+                c.setJointMotorControl2(self.body, j, pb.VELOCITY_CONTROL, force=0)
+        for link in [-1, *range(c.getNumJoints(self.body))]:
+            c.changeDynamics(
+                self.body, link, contactStiffness=world.contact_stiffness_npm,
+                contactDamping=world.contact_damping_nspm, lateralFriction=world.friction,
+            )
+        c.changeDynamics(
+            self.plane, -1, contactStiffness=world.contact_stiffness_npm,
+            contactDamping=world.contact_damping_nspm, lateralFriction=world.friction,
+        )
+        masses = [c.getDynamicsInfo(self.body, i)[0] for i in self._link_idx]
+        base_mass = c.getDynamicsInfo(self.body, -1)[0]
+        masses[0] += base_mass  # the 0.1 g dummy base is welded to the pelvis
+        self._mass = MassProperties(np.array(masses), self._rest_joint_inertia())
+        self.balls: list[int] = []
+
+    def _rest_joint_inertia(self) -> np.ndarray:
+        """Smallest principal moment of inertia [kg·m^2] of each joint's subtree about the joint, rest pose."""
+        c = self._pb
+        self.reset(np.array([0.0, 0.0, 3.0]), rot.IDENTITY_WXYZ)
+        links = c.getLinkStates(self.body, self._link_idx, computeForwardKinematics=1)
+        inertia_world = []
+        for i, ls in zip(self._link_idx, links, strict=True):
+            m, _, diag = c.getDynamicsInfo(self.body, i)[:3]
+            R = rot.matrix_from_quat(rot.wxyz_from_xyzw(ls[1]))
+            inertia_world.append((m, np.array(ls[0]), R @ np.diag(diag) @ R.T))
+        names = list(LINK_NAMES)
+        out = np.zeros(len(JOINT_NAMES))
+        from stylesync.sim.character import LINK_PARENT
+
+        for k, jn in enumerate(JOINT_NAMES):
+            origin = np.array(links[names.index(jn)][4])
+            total = np.zeros((3, 3))
+            for li, name in enumerate(names):
+                cur: str | None = name
+                while cur is not None and cur != jn:
+                    cur = LINK_PARENT[cur]
+                if cur is None:
+                    continue
+                m, com, I = inertia_world[li]
+                r = com - origin
+                total += I + m * (np.dot(r, r) * np.eye(3) - np.outer(r, r))
+            out[k] = float(np.linalg.eigvalsh(total)[0])
+        return out
+
+    # ------------------------------------------------------------------------------------------------------
+    def reset(self, root_pos_world, root_quat_wxyz, joint_pos=None) -> None:
+        c = self._pb
+        q_link = rot.multiply(np.asarray(root_quat_wxyz, dtype=float), Q_WORLD_MODEL)
+        c.resetBasePositionAndOrientation(self.body, list(root_pos_world), rot.xyzw_from_wxyz(q_link).tolist())
+        c.resetBaseVelocity(self.body, [0, 0, 0], [0, 0, 0])
+        for k, j in enumerate(self._joint_idx):
+            if self._is_ball[k]:
+                q = rot.IDENTITY_WXYZ if joint_pos is None else rot.normalize(joint_pos[k])
+                c.resetJointStateMultiDof(self.body, j, rot.xyzw_from_wxyz(q).tolist(), [0, 0, 0])
+            else:
+                angle = 0.0 if joint_pos is None else float(joint_pos[k, 0])
+                c.resetJointState(self.body, j, angle, 0.0)
+
+    def mass_properties(self) -> MassProperties:
+        return self._mass
+
+    def read_state(self, time_s: float) -> CharacterState:
+        c = self._pb
+        fb = self.read_joint_feedback()
+        base_pos, _ = c.getBasePositionAndOrientation(self.body)
+        lin_vel, _ = c.getBaseVelocity(self.body)
+        links = c.getLinkStates(self.body, self._link_idx, computeLinkVelocity=1, computeForwardKinematics=1)
+        n = len(links)
+        com = np.empty((n, 3))
+        com_vel = np.empty((n, 3))
+        origin = np.empty((n, 3))
+        quat = np.empty((n, 4))
+        ang = np.empty((n, 3))
+        for i, ls in enumerate(links):
+            com[i] = ls[0]
+            origin[i] = ls[4]
+            quat[i] = _canonical_from_link_xyzw(ls[5])
+            com_vel[i] = ls[6]
+            ang[i] = ls[7]
+        foot_force = {name: 0.0 for name in FOOT_LINKS}
+        non_foot = False
+        for cp in c.getContactPoints(bodyA=self.body, bodyB=self.plane):
+            link = cp[3]
+            if link in self._foot_idx:
+                foot_force[self._foot_idx[link]] += cp[9]
+            else:
+                non_foot = True
+        return CharacterState(
+            time_s=time_s,
+            root_pos_world=np.array(base_pos),
+            root_quat_wxyz=fb.root_quat_wxyz,
+            root_lin_vel_world=np.array(lin_vel),
+            root_ang_vel_world=fb.root_ang_vel_world,
+            joint_pos=fb.joint_pos,
+            joint_vel=fb.joint_vel,
+            link_com_world=com,
+            link_com_vel_world=com_vel,
+            link_origin_world=origin,
+            link_quat_wxyz=quat,
+            link_ang_vel_world=ang,
+            foot_contact_force_n=foot_force,
+            non_foot_ground_contact=non_foot,
+        )
+
+    def read_joint_feedback(self) -> JointFeedback:
+        c = self._pb
+        states = c.getJointStatesMultiDof(self.body, self._joint_idx)
+        n = len(states)
+        pos = np.zeros((n, 4))
+        vel = np.zeros((n, 3))
+        for k, st in enumerate(states):
+            if self._is_ball[k]:
+                x, y, z, w = st[0]
+                pos[k] = (w, x, y, z)
+                vel[k] = st[1]
+            else:
+                pos[k, 0] = st[0][0]
+                vel[k, 0] = st[1][0]
+        _, base_q = c.getBasePositionAndOrientation(self.body)
+        _, ang_vel = c.getBaseVelocity(self.body)
+        return JointFeedback(pos, vel, _canonical_from_link_xyzw(base_q), np.array(ang_vel))
+
+    def apply_torques(self, torques: Torques) -> None:
+        v = torques.values
+        if not np.all(np.isfinite(v)):
+            raise SimulationError("non-finite joint torque requested; refusing to drive the character with it")
+        forces = [list(v[k]) if self._is_ball[k] else [float(v[k, 0])] for k in range(len(self._joint_idx))]
+        self._pb.setJointMotorControlMultiDofArray(self.body, self._joint_idx, pb.TORQUE_CONTROL, forces=forces)
+
+    def step(self) -> None:
+        self._pb.stepSimulation()
+
+    def close(self) -> None:
+        try:
+            self._pb.disconnect()
+        except pb.error:
+            pass
+
+    # ---- scripted disturbances and rendering (not actuation of the character) ------------------------------
+    def throw_ball(self, pos_world, vel_world, mass_kg: float = 0.43, radius_m: float = 0.11) -> int:
+        """Spawn a football at ``pos_world`` [m] moving at ``vel_world`` [m/s] (a scripted disturbance)."""
+        c = self._pb
+        ball = c.loadURDF(SOCCER_BALL_URDF, list(pos_world), globalScaling=2 * radius_m)
+        c.changeDynamics(ball, -1, mass=mass_kg, lateralFriction=0.6, restitution=0.5,
+                         rollingFriction=0.001, spinningFriction=0.001)
+        c.resetBaseVelocity(ball, list(vel_world), [0, 0, 0])
+        self.balls.append(ball)
+        return ball
+
+    def body_position(self, body: int) -> np.ndarray:
+        return np.array(self._pb.getBasePositionAndOrientation(body)[0])
+
+    def render_rgb(self, target_world, width: int = 320, height: int = 240, distance_m: float = 3.0,
+                   yaw_deg: float = 60.0, pitch_deg: float = -15.0) -> np.ndarray:
+        """An RGB image (height, width, 3) uint8 from the engine's software renderer."""
+        c = self._pb
+        view = c.computeViewMatrixFromYawPitchRoll(list(target_world), distance_m, yaw_deg, pitch_deg, 0, 2)
+        proj = c.computeProjectionMatrixFOV(50, width / height, 0.05, 50)
+        img = c.getCameraImage(width, height, view, proj, renderer=pb.ER_TINY_RENDERER)
+        rgba = np.reshape(np.asarray(img[2], dtype=np.uint8), (height, width, 4))
+        return rgba[:, :, :3].copy()

@@ -1,0 +1,63 @@
+"""Operator sources: anything that yields :class:`OperatorFrame` values in time order."""
+
+from __future__ import annotations
+
+import logging
+from abc import ABC, abstractmethod
+
+import numpy as np
+
+from stylesync.sources.frame import OperatorFrame
+
+log = logging.getLogger("stylesync.sources")
+
+
+class OperatorSource(ABC):
+    """A stream of operator frames. ``poll(now_s)`` returns the frames that have arrived by ``now_s`` [s]."""
+
+    rejected_frames: int = 0
+
+    @abstractmethod
+    def poll(self, now_s: float) -> list[OperatorFrame]: ...
+
+    def close(self) -> None:  # noqa: B027 - optional hook
+        """Release devices or sockets."""
+
+
+class RecordedSource(OperatorSource):
+    """Frames known in advance (a file or a clip), released as their timestamps come due.
+
+    Frames with non-finite values or going back in time are rejected, counted and logged, never passed on.
+    """
+
+    def __init__(self, frames: list[OperatorFrame], name: str = "recorded"):
+        self.name = name
+        self.rejected_frames = 0
+        clean: list[OperatorFrame] = []
+        last_t = -np.inf
+        for f in frames:
+            if not f.is_finite() or not np.isfinite(f.timestamp_s):
+                self._reject(f, "non-finite values")
+                continue
+            if f.timestamp_s <= last_t:
+                self._reject(f, f"timestamp {f.timestamp_s:.3f} s not after {last_t:.3f} s")
+                continue
+            clean.append(f)
+            last_t = f.timestamp_s
+        self.frames = clean
+        self._next = 0
+
+    def _reject(self, f: OperatorFrame, why: str) -> None:
+        self.rejected_frames += 1
+        log.warning("%s: rejected frame at %.3f s (%s)", self.name, f.timestamp_s, why)
+
+    @property
+    def duration_s(self) -> float:
+        return self.frames[-1].timestamp_s if self.frames else 0.0
+
+    def poll(self, now_s: float) -> list[OperatorFrame]:
+        out: list[OperatorFrame] = []
+        while self._next < len(self.frames) and self.frames[self._next].timestamp_s <= now_s + 1e-9:
+            out.append(self.frames[self._next])
+            self._next += 1
+        return out
