@@ -128,9 +128,8 @@ class ControlConfig:
     com_force_kd_nspm: float = 30.0  # Table 3, virtual force Kd [N·s/m]
     root_torque_kp: float = 5000.0  # Table 3, virtual torque Kp [N·m/rad]
     root_torque_kd: float = 1000.0  # Table 3, virtual torque Kd [N·m·s/rad]
-    # Departure: the yaw axis of the pelvis has ~10x less inertia than pitch/roll; Kd = 1000 about yaw is
-    # explicitly unstable at 600 Hz, so yaw gains are scaled by this factor.
-    root_yaw_gain_scale: float = 0.1
+    # Extra scaling of the root torque about the vertical (heading), which the stance hips also carry.
+    root_yaw_gain_scale: float = 1.0
     gravity_compensation: bool = True  # Eq. 14-15
     com_virtual_force: bool = True  # Eq. 16-17
     root_virtual_torque: bool = True  # Eq. 16, 18

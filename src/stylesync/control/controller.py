@@ -26,7 +26,7 @@ from stylesync.control.crvc import (
 from stylesync.control.gravity_compensation import gravity_torques
 from stylesync.control.jacobian_transpose import JointFrames
 from stylesync.control.model_compensation import ipm_ankle_moments, lipm_sync_force
-from stylesync.control.pid import IS_BALL, JointPid
+from stylesync.control.pid import IS_BALL, JointPid, stable_gains
 from stylesync.motion.reference import ReferencePose
 from stylesync.sim.backend import CharacterState, JointFeedback, MassProperties, Torques
 from stylesync.sim.character import JOINT_NAMES, JOINTS
@@ -48,7 +48,7 @@ class BalanceController:
         self.cfg = cfg
         self.mass = mass
         self.g = gravity_mps2
-        self.pid = JointPid(cfg, physics_dt_s, mass.joint_min_inertia_kgm2)
+        self.pid = JointPid(cfg, physics_dt_s, mass.joint_axis_inertia_kgm2)
         self.control_dt_s = control_dt_s
         self.bounds = bnd.BoundsMonitor()
         self._ff = np.zeros((len(JOINTS), 3))
@@ -56,6 +56,11 @@ class BalanceController:
         self._prev_ref_pos: np.ndarray | None = None
         self._ref_vel = np.zeros((len(JOINTS), 3))
         self.telemetry = ControlTelemetry(np.zeros(3), np.zeros(3), np.zeros(3))
+        # The root torque acts on the 6 kg pelvis (0.02 kg·m^2): clamp its gains to the explicit-integration
+        # limit like the joint gains (Table 3's Kd = 1000 would be ~90x past it at 600 Hz).
+        kp_root, kd_root = stable_gains(np.array([cfg.root_torque_kp]), np.array([cfg.root_torque_kd]),
+                                        np.full((1, 3), mass.root_link_inertia_kgm2), physics_dt_s)
+        self.root_kp, self.root_kd = float(kp_root[0, 0]), float(kd_root[0, 0])
 
     def update(self, state: CharacterState, ref: ReferencePose) -> None:
         cfg = self.cfg
@@ -88,7 +93,7 @@ class BalanceController:
             self.bounds.report("ds_com", d_c > bnd.ds_com_bound_m(), state.time_s,
                                f"COM {d_c:.3f} m from the support centre > {bnd.ds_com_bound_m():.3f} m (Eq. 24)")
         if np.any(force):
-            ff += stance_force_torques(frames, com, force, w)  # Eq. 17
+            ff += stance_force_torques(frames, state.link_com_world, self.mass.link_mass_kg, force, w)  # Eq. 17
         if cfg.ipm_ankle_compensation:  # Eq. 20
             ff += frames.torque_from_moment(ipm_ankle_moments(ref.com_world, ref.ankle_world, w,
                                                               self.mass.total_kg, self.g))
@@ -112,7 +117,7 @@ class BalanceController:
         tau += self._ff
         if self.cfg.root_virtual_torque:  # Eq. 16 (second line), Eq. 18
             tau_r = root_virtual_torque(ref.root_quat_wxyz, fb.root_quat_wxyz, fb.root_ang_vel_world,
-                                        self.cfg.root_torque_kp, self.cfg.root_torque_kd,
+                                        self.root_kp, self.root_kd,
                                         self.cfg.root_yaw_gain_scale)
             self.telemetry.root_torque_nm = tau_r
             hips = {s: fb.joint_pos[_HIP_INDEX[s]] for s in ("left", "right")}

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from stylesync import rotations as rot
-from stylesync.control.gravity_compensation import LEG_JOINTS
+from stylesync.control.gravity_compensation import LEG_JOINTS, SUBTREE_MASK
 from stylesync.control.jacobian_transpose import JointFrames
 from stylesync.sim.character import JOINTS, Q_WORLD_MODEL
 
@@ -26,15 +26,25 @@ def com_virtual_force(com_desired, com_vel_desired, com, com_vel, mass_kg: float
     return mass_kg * (kp * (np.asarray(com_desired) - com) + kd * (np.asarray(com_vel_desired) - com_vel))
 
 
-def stance_force_torques(frames: JointFrames, com: np.ndarray, force_world: np.ndarray,
-                         stance_weight: dict[str, float]) -> np.ndarray:
-    """Eq. 17: ``τ_fr = J_r^T f_r`` through each stance leg (foot as base), weighted by its stance share."""
+def stance_force_torques(frames: JointFrames, link_com_world: np.ndarray, link_mass_kg: np.ndarray,
+                         force_world: np.ndarray, stance_weight: dict[str, float]) -> np.ndarray:
+    """Eq. 17: ``τ_fr = J_r^T f_r`` through each stance leg (foot as base), weighted by its stance share.
+
+    J_r is the Jacobian of the whole-body COM with the stance foot fixed: turning a leg joint j moves only the
+    links above it, so its column is ``(M_above / M) ω_j × (c_above - o_j)``.
+    """
     moment = np.zeros((len(JOINTS), 3))
+    m_all = link_mass_kg.sum()
+    weighted = link_mass_kg[:, None] * link_com_world
     for side, w in stance_weight.items():
         if w <= 0:
             continue
         idx = LEG_JOINTS[side]
-        moment[idx] += -w * np.cross(com[None, :] - frames.origin[idx], force_world[None, :])
+        m_sub = SUBTREE_MASK[idx] @ link_mass_kg
+        c_sub = (SUBTREE_MASK[idx] @ weighted) / m_sub[:, None]
+        m_above = m_all - m_sub
+        c_above = (weighted.sum(axis=0)[None, :] - m_sub[:, None] * c_sub) / m_above[:, None]
+        moment[idx] += -w * (m_above / m_all)[:, None] * np.cross(c_above - frames.origin[idx], force_world[None, :])
     return frames.torque_from_moment(moment)
 
 

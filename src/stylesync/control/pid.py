@@ -41,17 +41,21 @@ STABILITY_FRACTION = 0.5
 
 
 def stable_gains(kp: np.ndarray, kd: np.ndarray, inertia_kgm2: np.ndarray, dt_s: float):
+    """Per-axis gains (n_joints, 3) clamped to the explicit-integration limit of the axis inertia (n_joints, 3)."""
     kd_max = STABILITY_FRACTION * 2.0 * inertia_kgm2 / dt_s
     kp_max = STABILITY_FRACTION * inertia_kgm2 / dt_s**2
-    return np.minimum(kp, kp_max), np.minimum(kd, kd_max)
+    return np.minimum(kp[:, None], kp_max), np.minimum(kd[:, None], kd_max)
 
 
 class JointPid:
     def __init__(self, cfg: ControlConfig, dt_s: float, joint_inertia_kgm2: np.ndarray | None = None):
         kp, ki, kd = gain_arrays(cfg)
-        if joint_inertia_kgm2 is not None:
-            kp, kd = stable_gains(kp, kd, joint_inertia_kgm2, dt_s)
         self.kp, self.ki, self.kd = kp[:, None], ki[:, None], kd[:, None]
+        if joint_inertia_kgm2 is not None:
+            self.kp, self.kd = stable_gains(kp, kd, joint_inertia_kgm2, dt_s)
+            # A hinge acts about its axis (model z) only.
+            self.kp[~IS_BALL] = self.kp[~IS_BALL][:, 2:3]
+            self.kd[~IS_BALL] = self.kd[~IS_BALL][:, 2:3]
         self.dt_s = dt_s
         self.integral_limit = cfg.integral_limit_rad_s
         self.integral = np.zeros((len(JOINTS), 3))

@@ -42,7 +42,8 @@ class CharacterState:
 @dataclass(frozen=True)
 class MassProperties:
     link_mass_kg: np.ndarray  # (n_links,)
-    joint_min_inertia_kgm2: np.ndarray  # (n_joints,) smallest principal inertia of each joint's subtree
+    joint_axis_inertia_kgm2: np.ndarray  # (n_joints, 3) effective inertia per child-frame axis at rest
+    root_link_inertia_kgm2: float  # smallest principal inertia of the pelvis link about its COM
 
     @property
     def total_kg(self) -> float:

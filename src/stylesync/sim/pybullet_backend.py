@@ -25,6 +25,7 @@ from stylesync.sim.character import (
     JOINT_NAMES,
     JOINTS,
     LINK_NAMES,
+    LINK_PARENT,
     Q_WORLD_MODEL,
     URDF_GLOBAL_SCALING,
     URDF_PATH_IN_PYBULLET_DATA,
@@ -108,36 +109,43 @@ class PyBulletBackend(PhysicsBackend):
         masses = [c.getDynamicsInfo(self.body, i)[0] for i in self._link_idx]
         base_mass = c.getDynamicsInfo(self.body, -1)[0]
         masses[0] += base_mass  # the 0.1 g dummy base is welded to the pelvis
-        self._mass = MassProperties(np.array(masses), self._rest_joint_inertia())
+        self._mass = MassProperties(np.array(masses), self._rest_joint_inertia(),
+                                    float(min(c.getDynamicsInfo(self.body, self._link_idx[0])[2])))
         self.balls: list[int] = []
 
     def _rest_joint_inertia(self) -> np.ndarray:
-        """Smallest principal moment of inertia [kg·m^2] of each joint's subtree about the joint, rest pose."""
+        """Per-axis effective inertia [kg·m^2] of each joint at rest, in the joint's child frame (n_joints, 3).
+
+        The reduced inertia of the two sides, ``I_c I_p / (I_c + I_p)``: the child subtree about the joint, and the
+        parent link alone about its own COM (the fastest mode when the parent floats, e.g. the 6 kg pelvis).
+        """
         c = self._pb
         self.reset(np.array([0.0, 0.0, 3.0]), rot.IDENTITY_WXYZ)
         links = c.getLinkStates(self.body, self._link_idx, computeForwardKinematics=1)
-        inertia_world = []
+        R_wm = rot.matrix_from_quat(Q_WORLD_MODEL)
+        per_link = []
         for i, ls in zip(self._link_idx, links, strict=True):
             m, _, diag = c.getDynamicsInfo(self.body, i)[:3]
             R = rot.matrix_from_quat(rot.wxyz_from_xyzw(ls[1]))
-            inertia_world.append((m, np.array(ls[0]), R @ np.diag(diag) @ R.T))
+            per_link.append((m, np.array(ls[0]), R @ np.diag(diag) @ R.T))
         names = list(LINK_NAMES)
-        out = np.zeros(len(JOINT_NAMES))
-        from stylesync.sim.character import LINK_PARENT
-
+        out = np.zeros((len(JOINT_NAMES), 3))
         for k, jn in enumerate(JOINT_NAMES):
             origin = np.array(links[names.index(jn)][4])
-            total = np.zeros((3, 3))
+            child = np.zeros((3, 3))
             for li, name in enumerate(names):
                 cur: str | None = name
                 while cur is not None and cur != jn:
                     cur = LINK_PARENT[cur]
                 if cur is None:
                     continue
-                m, com, I = inertia_world[li]
+                m, com, inertia = per_link[li]
                 r = com - origin
-                total += I + m * (np.dot(r, r) * np.eye(3) - np.outer(r, r))
-            out[k] = float(np.linalg.eigvalsh(total)[0])
+                child += inertia + m * (np.dot(r, r) * np.eye(3) - np.outer(r, r))
+            parent = per_link[names.index(LINK_PARENT[jn] or "root")][2]
+            ic = np.diag(R_wm.T @ child @ R_wm)  # model axes = child frame at rest
+            ip = np.diag(R_wm.T @ parent @ R_wm)
+            out[k] = ic * ip / (ic + ip)
         return out
 
     # ------------------------------------------------------------------------------------------------------
