@@ -24,14 +24,19 @@ from stylesync.control.bounds import BoundsMonitor, step_length_bound_m
 from stylesync.motion.balance_strategy import level_root, stance_hip_blend, swing_hip_feedback
 from stylesync.motion.leg_ik import solve_leg
 from stylesync.motion.reference import LipmMap, ReferencePose
-from stylesync.motion.stance_fsm import CharacterStanceFsm, OperatorStanceFsm, Stance, stance_weights, swing_side
+from stylesync.motion.stance_fsm import (
+    CharacterStanceFsm,
+    OperatorStanceFsm,
+    Stance,
+    stance_weights,
+    swing_side,
+)
 from stylesync.motion.style_features import StyleExtractor, StyleFeatures
 from stylesync.processing.body_parameters import link_length
 from stylesync.processing.joint_map import hinge_angle
 from stylesync.processing.operator_processing import OperatorSample
 from stylesync.sim.backend import CharacterState, MassProperties
 from stylesync.sim.character import (
-    ANKLE_HEIGHT_M,
     HIP_HALF_WIDTH_M,
     JOINT_NAMES,
     JOINTS,

@@ -20,7 +20,6 @@ from stylesync.sources.frame import OperatorFrame
 from stylesync.sources.human_model import HumanModel
 from stylesync.sources.sensor_model import SensorModel
 
-
 STAND_CLIP = "stand"  # an operator standing still, for balance checks
 
 

@@ -1,0 +1,68 @@
+"""Figures of a run: COM with footsteps (Fig. 13), stance states (Fig. 11), style features, render strip."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from stylesync.session import SessionResult  # noqa: E402
+
+
+def write_plots(result: SessionResult, out: Path) -> list[Path]:
+    lg = result.log
+    t = lg.array("t")
+    paths = []
+    fig, ax = plt.subplots(figsize=(8, 4))
+    ax.plot(lg.array("com_x"), lg.array("com_y"), label="character COM")
+    s = lg.array("scale")
+    ax.plot(lg.array("op_com_x") * s, lg.array("op_com_y") * s, "--", label="operator COM (scaled)")
+    for side, c in (("l", "tab:blue"), ("r", "tab:red")):
+        z = lg.array(f"a{side}_z")
+        on = z < 0.075
+        ax.scatter(lg.array(f"a{side}_x")[on], lg.array(f"a{side}_y")[on], s=4, c=c, alpha=0.3)
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.axis("equal")
+    ax.legend()
+    ax.set_title("COM trajectory and footsteps")
+    paths.append(out / "com_footsteps.png")
+    fig.savefig(paths[-1], dpi=100)
+    plt.close(fig)
+
+    fig, ax = plt.subplots(figsize=(8, 3))
+    ax.step(t, lg.array("op_state"), where="post", label="operator")
+    ax.step(t, lg.array("char_state") + 0.05, where="post", label="character")
+    ax.set_yticks([0, 1, 2], ["LS", "DS", "RS"])
+    ax.set_xlabel("t [s]")
+    ax.legend()
+    ax.set_title("Stance states")
+    paths.append(out / "stance_states.png")
+    fig.savefig(paths[-1], dpi=100)
+    plt.close(fig)
+
+    fig, axes = plt.subplots(3, 1, figsize=(8, 7), sharex=True)
+    for ax, key, label in zip(axes, ("N_r_y", "T_r", "H"), ("N_r (y)", "T_r [rad]", "H [rad]"), strict=True):
+        ax.plot(t, lg.array(f"op_{key}"), label="operator")
+        ax.plot(t, lg.array(f"ch_{key}"), label="character")
+        ax.set_ylabel(label)
+    axes[0].legend()
+    axes[-1].set_xlabel("t [s]")
+    paths.append(out / "style_features.png")
+    fig.savefig(paths[-1], dpi=100)
+    plt.close(fig)
+    return paths
+
+
+def write_strip(frames: list[tuple[float, np.ndarray]], path: Path) -> Path | None:
+    if not frames:
+        return None
+    import imageio.v3 as iio
+
+    strip = np.concatenate([f for _, f in frames[:8]], axis=1)
+    iio.imwrite(path, strip)
+    return path

@@ -1,0 +1,66 @@
+"""Run metrics written to metrics.json (definitions in docs/metrics.md)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from stylesync.motion.stance_fsm import Stance
+from stylesync.session import STANCE_CODE, SessionResult
+
+_DS = STANCE_CODE[Stance.DS]
+
+
+def touchdowns(states: np.ndarray) -> np.ndarray:
+    """Indices where the state enters DS from a single stance (one step each)."""
+    s = np.asarray(states)
+    return np.where((s[1:] == _DS) & (s[:-1] != _DS))[0] + 1
+
+
+def transition_delays(t: np.ndarray, op: np.ndarray, ch: np.ndarray, window_s: float = 1.0) -> list[float]:
+    """For each operator state change, the time until the character first enters the same state [s].
+
+    A character already in that state (early contact) counts as 0; one that never gets there within
+    ``window_s`` counts as ``window_s``.
+    """
+    delays = []
+    for i in np.where(op[1:] != op[:-1])[0] + 1:
+        target = op[i]
+        if ch[i] == target:
+            delays.append(0.0)
+            continue
+        later = np.where((ch[i:] == target) & (t[i:] <= t[i] + window_s))[0]
+        delays.append(float(t[i + later[0]] - t[i]) if len(later) else window_s)
+    return delays
+
+
+def summarize(result: SessionResult) -> dict:
+    lg = result.log
+    t = lg.array("t")
+    op, ch = lg.array("op_state").astype(int), lg.array("char_state").astype(int)
+    delays = transition_delays(t, op, ch)
+    com = np.stack([lg.array("com_x"), lg.array("com_y")], axis=1)
+    com_d = np.stack([lg.array("com_d_x"), lg.array("com_d_y")], axis=1)
+    com_err = np.linalg.norm(com - com_d, axis=1) if len(t) else np.zeros(1)
+    tick = np.array(result.stage_ms["processing"]) + np.array(result.stage_ms["motion"]) + np.array(
+        result.stage_ms["control_update"]) if result.stage_ms["processing"] else np.zeros(1)
+    return {
+        "fell": result.fell,
+        "fall_time_s": result.fall_time_s,
+        "fall_reason": result.fall_reason,
+        "sim_duration_s": round(result.sim_duration_s, 4),
+        "operator_steps": int(len(touchdowns(op))),
+        "character_steps": int(len(touchdowns(ch))),
+        "realtime_factor": round(result.sim_duration_s / max(result.wall_duration_s, 1e-9), 3),
+        "control_tick_ms": {"p50": float(np.percentile(tick, 50)), "p99": float(np.percentile(tick, 99))},
+        "state_transition_delay_s": {
+            "mean": float(np.mean(delays)) if delays else 0.0,
+            "p95": float(np.percentile(delays, 95)) if delays else 0.0,
+            "max": float(np.max(delays)) if delays else 0.0,
+            "count": len(delays),
+        },
+        "com_error_m": {"mean": float(com_err.mean()), "max": float(com_err.max())},
+        "joint_error_deg": {"mean": float(lg.array("joint_err_deg").mean()) if len(t) else 0.0},
+        "rejected_frames": result.rejected_frames,
+        "dropped_joint_values": result.dropped_joint_values,
+        "bound_violations": result.bound_counts,
+    }

@@ -1,0 +1,38 @@
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from stylesync.processing.floor_filter import FloorFilter
+from stylesync.processing.interpolation import LinearRamp
+from stylesync.processing.one_euro import OneEuroFilter
+
+
+@given(st.floats(-10, 10))
+@settings(max_examples=30)
+def test_one_euro_passes_constant(c):
+    f = OneEuroFilter(1 / 133)
+    out = [f(np.array([c]))[0] for _ in range(50)]
+    assert abs(out[-1] - c) < 1e-9
+
+
+def test_one_euro_reduces_noise():
+    rng = np.random.default_rng(0)
+    x = rng.normal(0, 0.05, 2000)
+    f = OneEuroFilter(1 / 133, min_cutoff_hz=1.0, beta=0.0)
+    y = np.array([f(np.array([v]))[0] for v in x])
+    assert y[100:].std() < 0.3 * x[100:].std()
+
+
+def test_floor_filter_deadband():
+    f = FloorFilter(0.01)
+    f(np.array([0.0]))
+    assert f(np.array([0.009]))[0] == 0.0
+    assert abs(f(np.array([0.03]))[0] - 0.02) < 1e-12
+
+
+def test_interpolation_reaches_reference_in_one_mocap_period():
+    r = LinearRamp(16.0, 133.0)
+    r.push(np.array([0.0]))
+    r.push(np.array([1.0]))
+    vals = [r.step()[0] for _ in range(9)]
+    assert np.all(np.diff(vals) >= 0) and abs(vals[-1] - 1.0) < 1e-12 and vals[0] < 0.2
