@@ -104,7 +104,6 @@ class Session:
                                             "physics": []}
         next_control = 0.0
         next_render = 0.0
-        last_frame_wall = time.perf_counter()
         last_frame_sim = 0.0
         fell, fall_time, fall_reason = False, None, ""
         wall0 = time.perf_counter()
@@ -118,7 +117,7 @@ class Session:
                 for f in frames:
                     self.processing.push(f)
                 if frames:
-                    last_frame_sim, last_frame_wall = t, time.perf_counter()
+                    last_frame_sim = t
                 elif t - last_frame_sim > SILENT_STREAM_TIMEOUT_S and self._source_is_live():
                     raise SourceError(f"operator stream silent for more than {SILENT_STREAM_TIMEOUT_S:.0f} s")
                 sample = self.processing.step(t)
