@@ -16,4 +16,5 @@ def test_round_trips(v):
     assert min(np.abs(q2 - q).max(), np.abs(q2 + q).max()) < 1e-9  # double cover
     r = rot.quat_from_rotvec(rot.rotvec_from_quat(q))
     assert np.allclose(rot.matrix_from_quat(r), rot.matrix_from_quat(q), atol=1e-9)
-    assert np.allclose(rot.rotvec_from_quat(q), rot.rotvec_from_quat(-q))
+    r1, r2 = rot.quat_from_rotvec(rot.rotvec_from_quat(q)), rot.quat_from_rotvec(rot.rotvec_from_quat(-q))
+    assert np.allclose(rot.matrix_from_quat(r1), rot.matrix_from_quat(r2), atol=1e-9)  # q and -q: one rotation
