@@ -2,13 +2,14 @@
 
 import numpy as np
 import pytest
+from conftest import random_pose
 
 from stylesync import rotations as rot
 from stylesync.config import WorldConfig
 from stylesync.control.crvc import stance_force_torques
 from stylesync.control.jacobian_transpose import JointFrames
 from stylesync.sim.backend import make_backend
-from stylesync.sim.character import JOINTS, LINK_NAMES, JointKind
+from stylesync.sim.character import JOINTS, LINK_NAMES, JointKind, chain_to_root
 
 
 @pytest.fixture(scope="module")
@@ -16,17 +17,6 @@ def backend():
     b = make_backend(WorldConfig(gravity_mps2=1e-9), 600.0)
     yield b
     b.close()
-
-
-def _pose(seed):
-    rng = np.random.default_rng(seed)
-    q = np.zeros((len(JOINTS), 4))
-    for k, j in enumerate(JOINTS):
-        if j.kind is JointKind.BALL:
-            q[k] = rot.quat_from_rotvec(rng.normal(0, 0.3, 3))
-        else:
-            q[k, 0] = -0.6 if "knee" in j.name else 0.6
-    return q
 
 
 def _perturbed(q, k, axis, eps):
@@ -49,7 +39,7 @@ def _point_and_foot(backend, root_pos, root_q, q, link):
 def test_forward_chain_matches_finite_differences(backend):
     """A force at a link's COM through the chain from the root (Eq. 14): tau = J^T f."""
     root_pos, root_q = np.array([0.0, 0.0, 2.0]), rot.quat_from_rotvec([0.1, -0.2, 0.3])
-    q = _pose(0)
+    q = random_pose(0)
     f = np.array([3.0, -2.0, 5.0])
     for link in ("left_wrist", "right_ankle", "neck"):
         backend.reset(root_pos, root_q, q)
@@ -57,8 +47,6 @@ def test_forward_chain_matches_finite_differences(backend):
         frames = JointFrames(s)
         i = LINK_NAMES.index(link)
         p = s.link_com_world[i]
-        from stylesync.sim.character import chain_to_root
-
         ids = np.array([k for k, j in enumerate(JOINTS) if j.name in chain_to_root(link)])
         tau = frames.torque_from_moment(frames.moment_of_force(ids, p, f))
         eps = 1e-6
@@ -75,7 +63,7 @@ def test_forward_chain_matches_finite_differences(backend):
 def test_stance_leg_force_matches_finite_differences(backend):
     """Eq. 17: the COM force through a stance leg, the foot held fixed in the world."""
     root_pos, root_q = np.array([0.0, 0.0, 2.0]), rot.IDENTITY_WXYZ
-    q = _pose(1)
+    q = random_pose(1)
     f = np.array([4.0, 1.0, -6.0])
     s, com, foot_p, foot_R = _point_and_foot(backend, root_pos, root_q, q, "left_ankle")
     tau = stance_force_torques(JointFrames(s), s.link_com_world, backend.mass_properties().link_mass_kg, f,

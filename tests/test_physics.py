@@ -1,6 +1,7 @@
 """Physics behaviour with clear numeric bounds."""
 
 import numpy as np
+from conftest import random_pose
 
 from stylesync import rotations as rot
 from stylesync.config import WorldConfig
@@ -8,18 +9,11 @@ from stylesync.control.gravity_compensation import gravity_torques
 from stylesync.control.jacobian_transpose import JointFrames
 from stylesync.control.pid import joint_error
 from stylesync.sim.backend import Torques, make_backend
-from stylesync.sim.character import JOINTS, JointKind
 
 
 def test_gravity_compensation_holds_root_fixed_character_5s():
     b = make_backend(WorldConfig(), 600.0, fixed_root=True)
-    rng = np.random.default_rng(1)
-    q0 = np.zeros((len(JOINTS), 4))
-    for k, j in enumerate(JOINTS):
-        if j.kind is JointKind.BALL:
-            q0[k] = rot.quat_from_rotvec(rng.normal(0, 0.3, 3))
-        else:
-            q0[k, 0] = -0.5 if "knee" in j.name else 0.5
+    q0 = random_pose(1, hinge_rad=0.5)
     b.reset(np.array([0, 0, 1.5]), rot.IDENTITY_WXYZ, q0)
     m = b.mass_properties()
     for i in range(3000):

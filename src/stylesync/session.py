@@ -17,10 +17,13 @@ import numpy as np
 
 from stylesync import rotations as rot
 from stylesync.config import SessionConfig
+from stylesync.control.bounds import BoundsMonitor
 from stylesync.control.controller import BalanceController
+from stylesync.control.pid import joint_error
 from stylesync.errors import SourceError
 from stylesync.motion.pose_optimization import MotionOptimizer
 from stylesync.motion.stance_fsm import Stance
+from stylesync.motion.style_features import ROW_NAMES as _FEATURES
 from stylesync.motion.style_features import StyleExtractor
 from stylesync.processing.operator_processing import OperatorProcessing
 from stylesync.sim.backend import CharacterState, PhysicsBackend, make_backend
@@ -61,7 +64,6 @@ class SessionResult:
     dropped_joint_values: int
     bound_counts: dict[str, int]
     stage_ms: dict[str, list[float]]
-    first_character_frame: np.ndarray | None = None
 
 
 class Session:
@@ -72,9 +74,11 @@ class Session:
         self.backend = backend or make_backend(config.world, config.clocks.physics_hz, gui=config.gui)
         self.mass = self.backend.mass_properties()
         self.processing = OperatorProcessing(config.clocks, config.filters)
-        self.motion = MotionOptimizer(config.motion, config.clocks.control_hz)
+        self.bounds = BoundsMonitor()
+        self.motion = MotionOptimizer(config.motion, config.clocks.control_hz, self.bounds)
         self.controller = BalanceController(config.control, self.mass, config.world.gravity_mps2,
-                                            1.0 / config.clocks.physics_hz, 1.0 / config.clocks.control_hz)
+                                            1.0 / config.clocks.physics_hz, 1.0 / config.clocks.control_hz,
+                                            self.bounds)
         self.char_style = StyleExtractor()
         self.on_tick = on_tick
         self.renders: list[tuple[float, np.ndarray]] = []
@@ -158,11 +162,9 @@ class Session:
                     time.sleep(lag)
         wall = time.perf_counter() - wall0
         sim_t = (step + 1) * dt if not fell else float(fall_time or 0.0)
-        counts = dict(self.controller.bounds.counts)
-        counts["step_length"] = self.motion.bounds.counts["step_length"]
         return SessionResult(tick_log, fell, fall_time, fall_reason, sim_t, wall, step + 1,
                              getattr(self.source, "rejected_frames", 0), self.processing.dropped_joint_values,
-                             counts, stage_ms)
+                             dict(self.bounds.counts), stage_ms)
 
     def _source_is_live(self) -> bool:
         return bool(getattr(self.source, "live", False))
@@ -183,8 +185,6 @@ class Session:
         shank = {s: state.link_quat_wxyz[_LINK[f"{s}_knee"]] for s in ("left", "right")}
         foot = {s: state.link_quat_wxyz[_LINK[f"{s}_ankle"]] for s in ("left", "right")}
         cf = self.char_style(hips, knees, ankles, shank, foot, com, state.root_quat_wxyz)
-        from stylesync.control.pid import joint_error
-
         err = joint_error(state.joint_pos, ref.joint_pos)
         lg.add(
             t=t, tick_ms=tick_ms,
@@ -207,5 +207,3 @@ class Session:
             **{f"ch_{k}": v for k, v in zip(_FEATURES, cf.as_row(), strict=True)},
         )
 
-
-from stylesync.motion.style_features import ROW_NAMES as _FEATURES  # noqa: E402

@@ -28,6 +28,7 @@ from stylesync.control.jacobian_transpose import JointFrames
 from stylesync.control.model_compensation import ipm_ankle_moments, lipm_sync_force
 from stylesync.control.pid import IS_BALL, JointPid, stable_gains
 from stylesync.motion.reference import ReferencePose
+from stylesync.motion.stance_fsm import Stance
 from stylesync.sim.backend import CharacterState, JointFeedback, MassProperties, Torques
 from stylesync.sim.character import JOINT_NAMES, JOINTS
 
@@ -44,13 +45,13 @@ class ControlTelemetry:
 
 class BalanceController:
     def __init__(self, cfg: ControlConfig, mass: MassProperties, gravity_mps2: float, physics_dt_s: float,
-                 control_dt_s: float):
+                 control_dt_s: float, bounds: bnd.BoundsMonitor | None = None):
         self.cfg = cfg
         self.mass = mass
         self.g = gravity_mps2
         self.pid = JointPid(cfg, physics_dt_s, mass.joint_axis_inertia_kgm2)
         self.control_dt_s = control_dt_s
-        self.bounds = bnd.BoundsMonitor()
+        self.bounds = bounds if bounds is not None else bnd.BoundsMonitor()
         self._ff = np.zeros((len(JOINTS), 3))
         self._ref: ReferencePose | None = None
         self._prev_ref_pos: np.ndarray | None = None
@@ -87,7 +88,7 @@ class BalanceController:
             if exceeded and cfg.enforce_bounds:
                 f_lipm *= limit / mag
             force += f_lipm
-        if ref.character_stance.value == "DS":  # Eq. 24
+        if ref.character_stance is Stance.DS:  # Eq. 24
             centre = 0.5 * (ref.ankle_world["left"] + ref.ankle_world["right"])
             d_c = float(np.linalg.norm((ref.com_world - centre)[:2]))
             self.bounds.report("ds_com", d_c > bnd.ds_com_bound_m(), state.time_s,

@@ -14,26 +14,13 @@ import numpy as np
 
 from stylesync.control.jacobian_transpose import JointFrames
 from stylesync.sim.backend import CharacterState
-from stylesync.sim.character import JOINTS, LINK_NAMES, LINK_PARENT
+from stylesync.sim.character import JOINTS, LINK_NAMES, subtree_links
 
 _UP = np.array([0.0, 0.0, 1.0])
 
-
-def _subtree_links(joint_name: str) -> list[int]:
-    out = []
-    for i, name in enumerate(LINK_NAMES):
-        cur: str | None = name
-        while cur is not None:
-            if cur == joint_name:
-                out.append(i)
-                break
-            cur = LINK_PARENT[cur]
-    return out
-
-
 SUBTREE_MASK = np.zeros((len(JOINTS), len(LINK_NAMES)))
 for _j, _spec in enumerate(JOINTS):
-    SUBTREE_MASK[_j, _subtree_links(_spec.name)] = 1.0
+    SUBTREE_MASK[_j, subtree_links(_spec.name)] = 1.0
 LEG_JOINTS = {side: np.array([k for k, j in enumerate(JOINTS) if j.name.startswith(side) and
                               j.name.split("_")[1] in ("hip", "knee", "ankle")]) for side in ("left", "right")}
 ANKLE_JOINT = {side: next(k for k, j in enumerate(JOINTS) if j.name == f"{side}_ankle")

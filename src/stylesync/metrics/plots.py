@@ -13,6 +13,12 @@ import numpy as np  # noqa: E402
 from stylesync.session import SessionResult  # noqa: E402
 
 
+def _save(fig, path: Path) -> Path:
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
+
+
 def write_plots(result: SessionResult, out: Path) -> list[Path]:
     lg = result.log
     t = lg.array("t")
@@ -30,9 +36,7 @@ def write_plots(result: SessionResult, out: Path) -> list[Path]:
     ax.axis("equal")
     ax.legend()
     ax.set_title("COM trajectory and footsteps")
-    paths.append(out / "com_footsteps.png")
-    fig.savefig(paths[-1], dpi=100)
-    plt.close(fig)
+    paths.append(_save(fig, out / "com_footsteps.png"))
 
     fig, ax = plt.subplots(figsize=(8, 3))
     ax.step(t, lg.array("op_state"), where="post", label="operator")
@@ -41,9 +45,7 @@ def write_plots(result: SessionResult, out: Path) -> list[Path]:
     ax.set_xlabel("t [s]")
     ax.legend()
     ax.set_title("Stance states")
-    paths.append(out / "stance_states.png")
-    fig.savefig(paths[-1], dpi=100)
-    plt.close(fig)
+    paths.append(_save(fig, out / "stance_states.png"))
 
     fig, axes = plt.subplots(3, 1, figsize=(8, 7), sharex=True)
     for ax, key, label in zip(axes, ("N_r_y", "T_r", "H"), ("N_r (y)", "T_r [rad]", "H [rad]"), strict=True):
@@ -52,9 +54,7 @@ def write_plots(result: SessionResult, out: Path) -> list[Path]:
         ax.set_ylabel(label)
     axes[0].legend()
     axes[-1].set_xlabel("t [s]")
-    paths.append(out / "style_features.png")
-    fig.savefig(paths[-1], dpi=100)
-    plt.close(fig)
+    paths.append(_save(fig, out / "style_features.png"))
     return paths
 
 

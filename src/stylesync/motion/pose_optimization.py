@@ -44,6 +44,7 @@ from stylesync.sim.character import (
     SHANK_LENGTH_M,
     THIGH_LENGTH_M,
     JointKind,
+    canonical_quat_from_model,
     model_quat_from_canonical,
 )
 
@@ -72,7 +73,7 @@ def _heading_frame_fraction(p_h, al_h, ar_h, al_c, ar_c, scale: float, heading: 
 
 
 class MotionOptimizer:
-    def __init__(self, cfg: MotionConfig, control_hz: float):
+    def __init__(self, cfg: MotionConfig, control_hz: float, bounds: BoundsMonitor | None = None):
         self.cfg = cfg
         self.dt_s = 1.0 / control_hz
         self.op_fsm = OperatorStanceFsm(cfg.stance_height_threshold_m, cfg.stance_hysteresis_m)
@@ -82,7 +83,7 @@ class MotionOptimizer:
         self._held: OperatorSample | None = None
         self._prev_com_h: np.ndarray | None = None
         self._com_vel_h = np.zeros(3)
-        self.bounds = BoundsMonitor()
+        self.bounds = bounds if bounds is not None else BoundsMonitor()
 
     def operator_features(self, s: OperatorSample) -> StyleFeatures:
         hip = {k: s.pos[f"HIP_{v}"] for k, v in _SIDE_UP.items()}
@@ -105,10 +106,11 @@ class MotionOptimizer:
             self._held = sample
 
         # Operator size: leg length by Eq. 1, smoothed; scale = h_C / h_H (Eq. 9).
-        leg = np.mean([link_length(s.pos[f"HIP_{v}"], s.pos[f"KNEE_{v}"]) +
-                       link_length(s.pos[f"KNEE_{v}"], s.pos[f"ANKLE_{v}"]) for v in _SIDE_UP.values()])
-        self._op_leg_m = leg if self._op_leg_m is None else self._op_leg_m + _SCALE_SMOOTHING * (leg - self._op_leg_m)
-        scale = CHAR_LEG_LENGTH_M / self._op_leg_m
+        leg = float(np.mean([link_length(s.pos[f"HIP_{v}"], s.pos[f"KNEE_{v}"]) +
+                             link_length(s.pos[f"KNEE_{v}"], s.pos[f"ANKLE_{v}"]) for v in _SIDE_UP.values()]))
+        op_leg_m = leg if self._op_leg_m is None else self._op_leg_m + _SCALE_SMOOTHING * (leg - self._op_leg_m)
+        self._op_leg_m = op_leg_m
+        scale = CHAR_LEG_LENGTH_M / op_leg_m
 
         heading = features.H
         q_root_d = level_root(heading)
@@ -153,18 +155,18 @@ class MotionOptimizer:
         for side, sign in (("left", 1.0), ("right", -1.0)):
             hip_w = pelvis_d + R_root_d @ np.array([0.0, sign * HIP_HALF_WIDTH_M, 0.0])
             N = features.N_l if side == "left" else features.N_r
+            other = "left" if side == "right" else "right"
             if side == sw:
                 target = pelvis_d + scale * (a_h[side] - p_h)
                 target[2] = min(max(target[2], ankle_c_z), ankle_c_z + cfg.max_swing_foot_lift_m)
-                st = "left" if side == "right" else "right"
-                bound = step_length_bound_m(CHAR_LEG_LENGTH_M, self._op_leg_m)  # Eq. 28
-                step = target[:2] - a_c[st][:2]
+                bound = step_length_bound_m(CHAR_LEG_LENGTH_M, op_leg_m)  # Eq. 28
+                step = target[:2] - a_c[other][:2]
                 dist = float(np.linalg.norm(step))
                 step_exceeded = dist > bound
                 self.bounds.report("step_length", step_exceeded, state.time_s,
                                    f"step {dist:.2f} m > bound {bound:.2f} m (Eq. 28)")
                 if step_exceeded:
-                    target[:2] = a_c[st][:2] + step * (bound / dist)
+                    target[:2] = a_c[other][:2] + step * (bound / dist)
                 foot_yaw = rot.yaw_from_quat(s.quat[f"ANKLE_{_SIDE_UP[side]}"])
             else:
                 target = a_c[side]
@@ -172,12 +174,11 @@ class MotionOptimizer:
             ik = solve_leg(hip_w, target, THIGH_LENGTH_M, SHANK_LENGTH_M, N)
             q_thigh = ik.thigh_quat_wxyz
             if side == sw:
-                st = "left" if side == "right" else "right"
-                q_thigh = swing_hip_feedback(q_thigh, com_d - a_c[st], com_c - a_c[st], com_vel_d,
+                q_thigh = swing_hip_feedback(q_thigh, com_d - a_c[other], com_c - a_c[other], com_vel_d,
                                              mass.com_velocity(state), cfg.swing_hip_cd, cfg.swing_hip_cv, heading)
             q_hip = rot.multiply(rot.conjugate(q_root_d), q_thigh)
             if weights[side] > 0 and ch_state is not Stance.DS:
-                q_hip_cur = _canonical_local(q_cur[JOINT_NAMES.index(f"{side}_hip")])
+                q_hip_cur = canonical_quat_from_model(q_cur[JOINT_NAMES.index(f"{side}_hip")])
                 q_hip = stance_hip_blend(q_hip, q_hip_cur, cfg.stance_hip_weight_w0)  # Eq. 11
             local[f"{side}_hip"] = q_hip
             knee_angle[f"{side}_knee"] = ik.knee_angle_rad
@@ -223,8 +224,3 @@ class MotionOptimizer:
         t = float((com[:2] - ankles["left"][:2]) @ d) / n2
         return 1.0 - min(max(t, 0.0), 1.0)
 
-
-def _canonical_local(q_model: np.ndarray) -> np.ndarray:
-    from stylesync.sim.character import canonical_quat_from_model
-
-    return canonical_quat_from_model(q_model)

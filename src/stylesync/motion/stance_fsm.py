@@ -65,6 +65,7 @@ class CharacterStanceFsm:
         self.hold_reference = False
         self._swing_start_s = 0.0
         self._hold_start_s = 0.0
+        self._holding = False
         self._early_latched_for: Stance | None = None
 
     def update(self, op: Stance, contact: dict[str, bool], time_s: float) -> Stance:
@@ -94,8 +95,6 @@ class CharacterStanceFsm:
             return self.state
         self._enter(op, time_s)  # lift-off from DS is the operator's decision: follow at once
         return self.state
-
-    _holding = False
 
     def _enter(self, s: Stance, time_s: float) -> None:
         self._holding = False

@@ -52,9 +52,6 @@ def leg_plane_normal(hip, knee, ankle, fallback: np.ndarray) -> np.ndarray:
 
 
 class StyleExtractor:
-    def __init__(self) -> None:
-        self._n_prev: dict[str, np.ndarray] = {}
-
     def __call__(self, hip: dict[str, np.ndarray], knee: dict[str, np.ndarray], ankle: dict[str, np.ndarray],
                  shank_quat: dict[str, np.ndarray], foot_quat: dict[str, np.ndarray], com: np.ndarray,
                  pelvis_quat: np.ndarray) -> StyleFeatures:
@@ -64,7 +61,6 @@ class StyleExtractor:
             q_ankle = rot.multiply(rot.conjugate(shank_quat[s]), foot_quat[s])
             T[s] = rot.twist_angle(q_ankle, _SHANK_AXIS)
             N[s] = leg_plane_normal(hip[s], knee[s], ankle[s], left_axis)
-            self._n_prev[s] = N[s]
             P[s] = np.asarray(ankle[s]) - np.asarray(com)
         return StyleFeatures(T["left"], T["right"], N["left"], N["right"], P["left"], P["right"],
                              rot.yaw_from_quat(pelvis_quat))

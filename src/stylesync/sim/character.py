@@ -83,6 +83,18 @@ FOOT_WIDTH_M = 0.36 * URDF_GLOBAL_SCALING  # box x-extent 0.177, z-extent 0.09 (
 FOOT_CENTER_AHEAD_OF_ANKLE_M = 0.18 * URDF_GLOBAL_SCALING
 
 
+def subtree_links(joint: str) -> list[int]:
+    """Indices (in LINK_NAMES) of the links moved by ``joint``: its child link and everything below it."""
+    out = []
+    for i, name in enumerate(LINK_NAMES):
+        cur: str | None = name
+        while cur is not None and cur != joint:
+            cur = LINK_PARENT[cur]
+        if cur is not None:
+            out.append(i)
+    return out
+
+
 def chain_to_root(link: str) -> list[str]:
     """Joint names from ``link`` up to (not including) the pelvis, child first."""
     chain: list[str] = []

@@ -30,6 +30,7 @@ from stylesync.sim.character import (
     URDF_GLOBAL_SCALING,
     URDF_PATH_IN_PYBULLET_DATA,
     JointKind,
+    subtree_links,
 )
 
 _Q_MODEL_WORLD = rot.conjugate(Q_WORLD_MODEL)
@@ -133,12 +134,7 @@ class PyBulletBackend(PhysicsBackend):
         for k, jn in enumerate(JOINT_NAMES):
             origin = np.array(links[names.index(jn)][4])
             child = np.zeros((3, 3))
-            for li, name in enumerate(names):
-                cur: str | None = name
-                while cur is not None and cur != jn:
-                    cur = LINK_PARENT[cur]
-                if cur is None:
-                    continue
+            for li in subtree_links(jn):
                 m, com, inertia = per_link[li]
                 r = com - origin
                 child += inertia + m * (np.dot(r, r) * np.eye(3) - np.outer(r, r))

@@ -33,6 +33,7 @@ class ClipPerformer:
         self.lead_in_s = lead_in_s
         self.blend_s = min(blend_s, lead_in_s)
         self.leg_ratio = (human.hip_height_m) / CLIP_CHARACTER_LEG_LENGTH_M
+        self._stand_root, self._stand_quats = self._standing()
 
     def _standing(self) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """Neutral standing pose where the clip starts, facing its first heading."""
@@ -44,7 +45,7 @@ class ClipPerformer:
         return np.array([root[0], root[1], self.human.hip_height_m]), {"PELVIS": rot.quat_from_yaw(yaw)}
 
     def frame_at(self, t_s: float) -> OperatorFrame:
-        stand_root, stand_quats = self._standing()
+        stand_root, stand_quats = self._stand_root, self._stand_quats
         if self.clip is None or t_s < self.lead_in_s - self.blend_s:
             return self.human.frame_from_pose(t_s, stand_root, stand_quats)
         pose = self.clip.pose_at(max(0.0, t_s - self.lead_in_s))
@@ -73,8 +74,3 @@ def builtin_operator(
     frames = sensor.sample(performer.frame_at, duration_s)
     return RecordedSource(frames, name=f"builtin:{operator.clip}"), performer
 
-
-def truth_com(performer: ClipPerformer, t_s: float) -> np.ndarray:
-    com = performer.frame_at(t_s).com_world
-    assert com is not None
-    return com
