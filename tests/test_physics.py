@@ -18,7 +18,7 @@ def test_gravity_compensation_holds_root_fixed_character_5s():
     m = b.mass_properties()
     for i in range(3000):
         s = b.read_state(i / 600)
-        b.apply_torques(Torques(gravity_torques(s, JointFrames(s), m.link_mass_kg, 9.8, {"left": 0, "right": 0})))
+        b.apply_torques(Torques(gravity_torques(s, JointFrames(s), m.link_mass_kg, 9.8, {"left": 0, "right": 0}, {})))
         b.step()
     err = np.degrees(np.linalg.norm(joint_error(b.read_state(5.0).joint_pos, q0), axis=1))
     b.close()

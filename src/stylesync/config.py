@@ -126,8 +126,8 @@ class ControlConfig:
     # CR-VC, Eq. 16; Table 3 prints two "Kp" columns, the second is read as Kd.
     com_force_kp_npm: float = 50.0  # Table 3, virtual force Kp [N/m]
     com_force_kd_nspm: float = 30.0  # Table 3, virtual force Kd [N·s/m]
-    root_torque_kp: float = 5000.0  # Table 3, virtual torque Kp [N·m/rad]
-    root_torque_kd: float = 1000.0  # Table 3, virtual torque Kd [N·m·s/rad]
+    root_torque_kp: float = 1000.0  # Table 3 gives 5000; see below [N·m/rad]
+    root_torque_kd: float = 100.0  # Table 3 gives 1000; see below [N·m·s/rad]
     # Extra scaling of the root torque about the vertical (heading), which the stance hips also carry.
     root_yaw_gain_scale: float = 1.0
     gravity_compensation: bool = True  # Eq. 14-15

@@ -129,7 +129,7 @@ class Session:
                 state = self.backend.read_state(t)
                 ref = self.motion.update(sample, state, self.mass)
                 c2 = time.perf_counter()
-                self.controller.update(state, ref)
+                self.controller.update(state, ref, self.backend.joint_space_inertia())
                 c3 = time.perf_counter()
                 stage_ms["processing"].append((c1 - c0) * 1e3)
                 stage_ms["motion"].append((c2 - c1) * 1e3)

@@ -19,18 +19,25 @@ from stylesync.config import ControlConfig
 from stylesync.control import bounds as bnd
 from stylesync.control.crvc import (
     com_virtual_force,
-    hip_torques_for_root,
+    root_gain_scale,
     root_virtual_torque,
     stance_force_torques,
+    stance_hip_map,
 )
 from stylesync.control.gravity_compensation import gravity_torques
 from stylesync.control.jacobian_transpose import JointFrames
 from stylesync.control.model_compensation import ipm_ankle_moments, lipm_sync_force
-from stylesync.control.pid import IS_BALL, JointPid, stable_gains
+from stylesync.control.pid import IS_BALL, JointPid
+from stylesync.control.stable_pd import (
+    N_DOFS,
+    flatten_joint_values,
+    implicit_gain,
+    unflatten_joint_values,
+)
 from stylesync.motion.reference import ReferencePose
 from stylesync.motion.stance_fsm import Stance
 from stylesync.sim.backend import CharacterState, JointFeedback, MassProperties, Torques
-from stylesync.sim.character import JOINT_NAMES, JOINTS
+from stylesync.sim.character import JOINT_NAMES, JOINTS, ROOT_DOFS
 
 TORQUE_LIMIT = np.array([j.torque_limit_nm for j in JOINTS])[:, None]
 _HIP_INDEX = {s: JOINT_NAMES.index(f"{s}_hip") for s in ("left", "right")}
@@ -49,7 +56,8 @@ class BalanceController:
         self.cfg = cfg
         self.mass = mass
         self.g = gravity_mps2
-        self.pid = JointPid(cfg, physics_dt_s, mass.joint_axis_inertia_kgm2)
+        self.pid = JointPid(cfg, physics_dt_s)
+        self.physics_dt_s = physics_dt_s
         self.control_dt_s = control_dt_s
         self.bounds = bounds if bounds is not None else bnd.BoundsMonitor()
         self._ff = np.zeros((len(JOINTS), 3))
@@ -57,19 +65,36 @@ class BalanceController:
         self._prev_ref_pos: np.ndarray | None = None
         self._ref_vel = np.zeros((len(JOINTS), 3))
         self.telemetry = ControlTelemetry(np.zeros(3), np.zeros(3), np.zeros(3))
-        # The root torque acts on the 6 kg pelvis (0.02 kg·m^2): clamp its gains to the explicit-integration
-        # limit like the joint gains (Table 3's Kd = 1000 would be ~90x past it at 600 Hz).
-        kp_root, kd_root = stable_gains(np.array([cfg.root_torque_kp]), np.array([cfg.root_torque_kd]),
-                                        np.full((1, 3), mass.root_link_inertia_kgm2), physics_dt_s)
-        self.root_kp, self.root_kd = float(kp_root[0, 0]), float(kd_root[0, 0])
+        self.root_kp, self.root_kd = cfg.root_torque_kp, cfg.root_torque_kd
+        dt = physics_dt_s
+        self._joint_damping = flatten_joint_values(self.pid.kd * dt + self.pid.kp * dt * dt)
+        self._gain = np.eye(N_DOFS - ROOT_DOFS)  # G of stable_pd, joint rows and columns
+        self._root_map = np.zeros((N_DOFS - ROOT_DOFS, 3))  # S: world root torque -> stance-hip DOF torques
 
-    def update(self, state: CharacterState, ref: ReferencePose) -> None:
+    def _prepare_implicit(self, state: CharacterState, ref: ReferencePose, mass_matrix: np.ndarray) -> None:
+        """G = I - D (M + D)^-1 for this tick (stable_pd.py), with the root torque's feedback in D."""
+        dt = self.physics_dt_s
+        d = np.zeros((N_DOFS, N_DOFS))
+        j = np.arange(ROOT_DOFS, N_DOFS)
+        d[j, j] = self._joint_damping
+        s_map = np.zeros((N_DOFS - ROOT_DOFS, 3))
+        if self.cfg.root_virtual_torque:
+            hips = {side: state.joint_pos[_HIP_INDEX[side]] for side in ("left", "right")}
+            s_map = stance_hip_map(state.root_quat_wxyz, hips, ref.stance_weight)
+            # Q_hips = S τ_r(ω_next): the root damping is implicit in the root's angular acceleration (DOFs 3-5).
+            gain = root_gain_scale(self.cfg.root_yaw_gain_scale) * (self.root_kd * dt + self.root_kp * dt * dt)
+            d[ROOT_DOFS:, 3:6] = s_map * gain[None, :]
+        self._root_map = s_map
+        self._gain = implicit_gain(mass_matrix, d)[ROOT_DOFS:, ROOT_DOFS:]
+
+    def update(self, state: CharacterState, ref: ReferencePose, mass_matrix: np.ndarray) -> None:
         cfg = self.cfg
+        self._prepare_implicit(state, ref, mass_matrix)
         frames = JointFrames(state)
         ff = np.zeros((len(JOINTS), 3))
         w = ref.stance_weight
         if cfg.gravity_compensation:  # Eq. 14-15
-            ff += gravity_torques(state, frames, self.mass.link_mass_kg, self.g, w,
+            ff += gravity_torques(state, frames, self.mass.link_mass_kg, self.g, w, ref.ankle_world,
                                   skip_stance_ankle=cfg.ipm_ankle_compensation)
         com = self.mass.com(state)
         force = np.zeros(3)
@@ -114,15 +139,14 @@ class BalanceController:
         ref = self._ref
         if ref is None:
             return Torques.zeros()
-        tau = self.pid(fb.joint_pos, fb.joint_vel, ref.joint_pos, self._ref_vel)  # Eq. 13
-        tau += self._ff
-        if self.cfg.root_virtual_torque:  # Eq. 16 (second line), Eq. 18
-            tau_r = root_virtual_torque(ref.root_quat_wxyz, fb.root_quat_wxyz, fb.root_ang_vel_world,
-                                        self.root_kp, self.root_kd,
-                                        self.cfg.root_yaw_gain_scale)
+        # Eq. 13 feedback r, evaluated implicitly (stable_pd.py): position error predicted one step ahead.
+        r = self.pid(fb.joint_pos, fb.joint_vel, ref.joint_pos, self._ref_vel, predict_dt_s=self.physics_dt_s)
+        r_flat = flatten_joint_values(r)
+        if self.cfg.root_virtual_torque:  # Eq. 16 (second line), Eq. 18: -w τ_r on each stance hip
+            tau_r = root_virtual_torque(ref.root_quat_wxyz, fb.root_quat_wxyz, fb.root_ang_vel_world, self.root_kp,
+                                        self.root_kd, self.cfg.root_yaw_gain_scale, predict_dt_s=self.physics_dt_s)
             self.telemetry.root_torque_nm = tau_r
-            hips = {s: fb.joint_pos[_HIP_INDEX[s]] for s in ("left", "right")}
-            for j, t in hip_torques_for_root(tau_r, fb.root_quat_wxyz, hips, ref.stance_weight).items():
-                tau[j] += t
+            r_flat += self._root_map @ tau_r
+        tau = unflatten_joint_values(self._gain @ r_flat) + self._ff
         tau[~IS_BALL, 1:] = 0.0
         return Torques(np.clip(tau, -TORQUE_LIMIT, TORQUE_LIMIT))

@@ -6,7 +6,10 @@
   gains per unit mass, i.e. acceleration gains [1/s^2], [1/s].
 * Root virtual torque (Eq. 16): ``τ_r = Kp_vt e_q + Kd_vt e_ω`` on the pelvis orientation, realised as internal
   torques on the stance hip(s) (SIMBICON [2]): a hip torque τ acts +τ on the thigh and -τ on the pelvis, so each
-  stance hip receives ``-w τ_r`` (w its stance weight). Eq. 18 then sums the parts.
+  stance hip receives ``-w τ_r`` (w its stance weight). Eq. 18 then sums the parts. Table 3's Kp = 5000,
+  Kd = 1000 ask for torques the feet cannot pass to the ground (a 45 kg body standing on 18 cm feet can resist
+  about 20 N·m before a foot rolls): 1 degree of pelvis tilt already gives 87 N·m, the feet roll and the character
+  falls within a second (measured). Defaults are Kp = 1000, Kd = 100 (SIMBICON's torso range).
 """
 
 from __future__ import annotations
@@ -16,7 +19,7 @@ import numpy as np
 from stylesync import rotations as rot
 from stylesync.control.gravity_compensation import LEG_JOINTS, SUBTREE_MASK
 from stylesync.control.jacobian_transpose import JointFrames
-from stylesync.sim.character import JOINTS, Q_WORLD_MODEL
+from stylesync.sim.character import JOINT_DOF_START, JOINTS, N_JOINT_DOFS, Q_WORLD_MODEL
 
 HIP_JOINT = {side: next(k for k, j in enumerate(JOINTS) if j.name == f"{side}_hip") for side in ("left", "right")}
 
@@ -48,21 +51,32 @@ def stance_force_torques(frames: JointFrames, link_com_world: np.ndarray, link_m
     return frames.torque_from_moment(moment)
 
 
-def root_virtual_torque(q_root_desired, q_root, ang_vel_world, kp: float, kd: float, yaw_scale: float):
-    """Eq. 16 (second line): world-frame PD torque [N·m] on the pelvis orientation."""
+def root_virtual_torque(q_root_desired, q_root, ang_vel_world, kp: float, kd: float, yaw_scale: float,
+                        predict_dt_s: float = 0.0) -> np.ndarray:
+    """Eq. 16 (second line): world-frame PD torque [N·m] on the pelvis orientation. With ``predict_dt_s`` the
+    orientation error is taken one step ahead (the explicit part of the stable PD, stable_pd.py)."""
+    omega = np.asarray(ang_vel_world, dtype=float)
     e = rot.rotvec_from_quat(rot.multiply(q_root_desired, rot.conjugate(q_root)))  # world-frame error
-    scale = np.array([1.0, 1.0, yaw_scale])
-    return scale * (kp * e - kd * np.asarray(ang_vel_world))
+    return root_gain_scale(yaw_scale) * (kp * (e - predict_dt_s * omega) - kd * omega)
 
 
-def hip_torques_for_root(tau_root_world: np.ndarray, q_root: np.ndarray, hip_quat_model: dict[str, np.ndarray],
-                         stance_weight: dict[str, float]) -> dict[int, np.ndarray]:
-    """Child-frame (thigh) torques that give the pelvis ``tau_root_world`` through the stance hips."""
-    out: dict[int, np.ndarray] = {}
+def root_gain_scale(yaw_scale: float) -> np.ndarray:
+    """Per-axis scaling of the root gains (world x, y, z): the heading axis may be scaled separately."""
+    return np.array([1.0, 1.0, yaw_scale])
+
+
+def stance_hip_map(q_root: np.ndarray, hip_quat_model: dict[str, np.ndarray],
+                   stance_weight: dict[str, float]) -> np.ndarray:
+    """S (N_JOINT_DOFS, 3): joint-DOF torques that give the pelvis a world torque τ_r through the stance hips.
+
+    Each stance hip gets ``-w R_thigh^T τ_r`` in its child (thigh) frame (a hip torque acts -τ on the pelvis).
+    """
+    s_map = np.zeros((N_JOINT_DOFS, 3))
     q_pelvis_model = rot.multiply(q_root, Q_WORLD_MODEL)
     for side, w in stance_weight.items():
         if w <= 0:
             continue
-        R_thigh = rot.matrix_from_quat(rot.multiply(q_pelvis_model, hip_quat_model[side]))
-        out[HIP_JOINT[side]] = R_thigh.T @ (-w * tau_root_world)
-    return out
+        k = HIP_JOINT[side]
+        r_thigh = rot.matrix_from_quat(rot.multiply(q_pelvis_model, hip_quat_model[side]))
+        s_map[JOINT_DOF_START[k]:JOINT_DOF_START[k] + 3] = -w * r_thigh.T
+    return s_map

@@ -27,34 +27,49 @@ ANKLE_JOINT = {side: next(k for k, j in enumerate(JOINTS) if j.name == f"{side}_
                for side in ("left", "right")}
 
 
+def support_point(com_world: np.ndarray, ankle_world: dict[str, np.ndarray],
+                  stance_weight: dict[str, float]) -> dict[str, np.ndarray]:
+    """Centre of pressure assumed under each stance foot [m]: its ankle shifted by the COM's horizontal offset
+    from the weighted ankles, so that the feet's vertical reactions (w_s m g each) balance the COM exactly. In
+    single stance that is the point under the COM; in double stance each reaction stays under its own foot, so
+    the legs do not squeeze each other sideways."""
+    stance = {s: w for s, w in stance_weight.items() if w > 0}
+    if not stance:
+        return {}
+    weighted = sum(w * ankle_world[s] for s, w in stance.items()) / sum(stance.values())
+    delta = np.asarray(com_world, dtype=float) - weighted
+    delta[2] = 0.0
+    return {s: ankle_world[s] + delta for s in stance}
+
+
 def gravity_torques(
     state: CharacterState,
     frames: JointFrames,
     link_mass_kg: np.ndarray,
     gravity_mps2: float,
     stance_weight: dict[str, float],
+    ankle_world: dict[str, np.ndarray],
     skip_stance_ankle: bool = False,
 ) -> np.ndarray:
     """Eq. 14-15 with stance-leg support. Returns the (n_joints, 3) torque layout [N·m].
 
-    ``skip_stance_ankle`` leaves the stance ankles' reverse (weight-bearing) part to the IPM ankle torque (Eq. 20).
+    Every joint holds the weight of its subtree (Eq. 14-15). A stance leg s also receives the ground's vertical
+    reaction ``F_s = w_s m g ẑ`` at its support point p_s (:func:`support_point`); the static balance of the leg
+    below joint j then gives ``τ_j = (c_sub - o_j) × m_sub g ẑ - (p_s - o_j) × F_s``. In single stance this is
+    the "reverse" chain of GENBICON [3] (the leg carries everything above it).
+    ``skip_stance_ankle`` leaves the stance ankles' reaction part to the IPM ankle torque (Eq. 20).
     """
     m = link_mass_kg
+    g_up = gravity_mps2 * _UP
     weighted = m[:, None] * state.link_com_world  # (n_links, 3)
     m_sub = SUBTREE_MASK @ m  # (n_joints,)
     c_sub = (SUBTREE_MASK @ weighted) / m_sub[:, None]
-    m_all = m.sum()
-    c_all = weighted.sum(axis=0) / m_all
-    fwd = np.cross(c_sub - frames.origin, (m_sub * gravity_mps2)[:, None] * _UP)  # (n_joints, 3)
-    moment = fwd.copy()
-    for side, w in stance_weight.items():
-        if w <= 0:
-            continue
+    moment = np.cross(c_sub - frames.origin, m_sub[:, None] * g_up)  # (n_joints, 3)
+    com = weighted.sum(axis=0) / m.sum()
+    for side, p in support_point(com, ankle_world, stance_weight).items():
         idx = LEG_JOINTS[side]
-        m_above = m_all - m_sub[idx]
-        c_above = (m_all * c_all - m_sub[idx, None] * c_sub[idx]) / m_above[:, None]
-        rev = -np.cross(c_above - frames.origin[idx], (m_above * gravity_mps2)[:, None] * _UP)
         if skip_stance_ankle:
-            rev[idx == ANKLE_JOINT[side]] = 0.0
-        moment[idx] = (1.0 - w) * fwd[idx] + w * rev
+            idx = idx[idx != ANKLE_JOINT[side]]
+        reaction = stance_weight[side] * m.sum() * g_up
+        moment[idx] -= np.cross(p[None, :] - frames.origin[idx], reaction[None, :])
     return frames.torque_from_moment(moment)

@@ -14,21 +14,25 @@ from __future__ import annotations
 
 import numpy as np
 
-from stylesync.control.gravity_compensation import ANKLE_JOINT
+from stylesync.control.gravity_compensation import ANKLE_JOINT, support_point
 from stylesync.sim.character import JOINTS
 
 
 def ipm_ankle_moments(com_desired: np.ndarray, ankle_pos: dict[str, np.ndarray], stance_weight: dict[str, float],
                       mass_kg: float, gravity_mps2: float) -> np.ndarray:
-    """Eq. 20 as world moments on the stance ankle joints, (n_joints, 3) [N·m]."""
+    """Eq. 20 as world moments on the stance ankle joints, (n_joints, 3) [N·m].
+
+    d_C is taken from each foot's support point (gravity_compensation.support_point) rather than from each ankle:
+    identical in single stance; in double stance it keeps the two ankles from pushing the body sideways against
+    each other (the paper's single-ankle form would put ±m g w/2 lateral torques on feet that already carry
+    their share directly below them).
+    """
     moment = np.zeros((len(JOINTS), 3))
-    weight = np.array([0.0, 0.0, mass_kg * gravity_mps2])
-    for side, w in stance_weight.items():
-        if w <= 0:
-            continue
-        d = np.asarray(com_desired, dtype=float) - ankle_pos[side]
+    for side, p in support_point(com_desired, ankle_pos, stance_weight).items():
+        weight = np.array([0.0, 0.0, stance_weight[side] * mass_kg * gravity_mps2])
+        d = p - ankle_pos[side]
         d[2] = 0.0  # horizontal distance d_C only (Eq. 20)
-        moment[ANKLE_JOINT[side]] = -w * np.cross(d, weight)
+        moment[ANKLE_JOINT[side]] = -np.cross(d, weight)
     return moment
 
 

@@ -13,7 +13,19 @@ import numpy as np
 
 from stylesync import rotations as rot
 
-_REACH_MARGIN = 0.999  # keep the knee from locking straight
+# Near full extension the knee angle is ill-conditioned (d(reach)/d(angle) -> 0: 1 cm of pelvis noise would swing
+# the knee by 0.25 rad). Reaches beyond SOFT_REACH_START of the leg length are compressed smoothly towards
+# MAX_REACH (knee about 0.2 rad), which keeps the reference smooth and the knee off its lock.
+SOFT_REACH_START = 0.97
+MAX_REACH = 0.995
+
+
+def soft_reach(dist_m: float, leg_m: float) -> float:
+    """Hip-ankle distance actually reached [m]: identity up to SOFT_REACH_START·leg, then tanh-compressed."""
+    d0, d1 = SOFT_REACH_START * leg_m, MAX_REACH * leg_m
+    if dist_m <= d0:
+        return dist_m
+    return d0 + (d1 - d0) * float(np.tanh((dist_m - d0) / (d1 - d0)))
 
 
 @dataclass(frozen=True)
@@ -36,9 +48,9 @@ def solve_leg(hip: np.ndarray, ankle_target: np.ndarray, thigh_m: float, shank_m
     hip = np.asarray(hip, dtype=float)
     d = np.asarray(ankle_target, dtype=float) - hip
     dist = float(np.linalg.norm(d))
-    lo, hi = abs(thigh_m - shank_m) + 1e-4, (thigh_m + shank_m) * _REACH_MARGIN
+    lo = abs(thigh_m - shank_m) + 1e-4
     u = d / dist if dist > 1e-9 else np.array([0.0, 0.0, -1.0])
-    dist = min(max(dist, lo), hi)
+    dist = max(soft_reach(dist, thigh_m + shank_m), lo)
     n = np.asarray(plane_normal, dtype=float)
     n = n - np.dot(n, u) * u
     if np.linalg.norm(n) < 1e-6:

@@ -37,6 +37,7 @@ from stylesync.processing.joint_map import hinge_angle
 from stylesync.processing.operator_processing import OperatorSample
 from stylesync.sim.backend import CharacterState, MassProperties
 from stylesync.sim.character import (
+    ANKLE_HEIGHT_M,
     HIP_HALF_WIDTH_M,
     JOINT_NAMES,
     JOINTS,
@@ -117,6 +118,9 @@ class MotionOptimizer:
         R_root_d = rot.matrix_from_quat(q_root_d)
         a_h = {k: s.pos[f"ANKLE_{v}"] for k, v in _SIDE_UP.items()}
         a_c = {k: state.link_origin_world[_LINK[f"{k}_ankle"]].copy() for k in _SIDE_UP}
+        # Planted feet are flat on the (level) ground: their ankle height is the model's, not the measured one,
+        # which rises when a foot rolls and would feed back into the pelvis height of Eq. 9.
+        a_plant = {k: np.array([v[0], v[1], ANKLE_HEIGHT_M]) for k, v in a_c.items()}
         p_h = s.pos["PELVIS"]
         com_h = s.com_world
         com_c = mass.com(state)
@@ -128,12 +132,12 @@ class MotionOptimizer:
             com_xy = _heading_frame_fraction(com_h, a_h["left"], a_h["right"], a_c["left"], a_c["right"],
                                              scale, heading)
             ankle_h_z = 0.5 * (a_h["left"][2] + a_h["right"][2])
-            ankle_c_z = 0.5 * (a_c["left"][2] + a_c["right"][2])
+            ankle_c_z = ANKLE_HEIGHT_M
         else:
             st = "left" if ch_state is Stance.LS else "right"
             pelvis_xy = a_c[st] + scale * (p_h - a_h[st])
             com_xy = a_c[st] + scale * (com_h - a_h[st])
-            ankle_h_z, ankle_c_z = a_h[st][2], a_c[st][2]
+            ankle_h_z, ankle_c_z = a_h[st][2], ANKLE_HEIGHT_M
         pelvis_d = np.array([pelvis_xy[0], pelvis_xy[1], ankle_c_z + scale * (p_h[2] - ankle_h_z)])  # Eq. 9
         # The operator's COM height reflects his own mass distribution, not the character's: the vertical is left
         # to the pelvis height (Eq. 9) through the leg IK, and the COM target keeps the character's own height.
@@ -169,7 +173,7 @@ class MotionOptimizer:
                     target[:2] = a_c[other][:2] + step * (bound / dist)
                 foot_yaw = rot.yaw_from_quat(s.quat[f"ANKLE_{_SIDE_UP[side]}"])
             else:
-                target = a_c[side]
+                target = a_plant[side]
                 foot_yaw = rot.yaw_from_quat(state.link_quat_wxyz[_LINK[f"{side}_ankle"]])
             ik = solve_leg(hip_w, target, THIGH_LENGTH_M, SHANK_LENGTH_M, N)
             q_thigh = ik.thigh_quat_wxyz

@@ -42,8 +42,6 @@ class CharacterState:
 @dataclass(frozen=True)
 class MassProperties:
     link_mass_kg: np.ndarray  # (n_links,)
-    joint_axis_inertia_kgm2: np.ndarray  # (n_joints, 3) effective inertia per child-frame axis at rest
-    root_link_inertia_kgm2: float  # smallest principal inertia of the pelvis link about its COM
 
     @property
     def total_kg(self) -> float:
@@ -98,6 +96,11 @@ class PhysicsBackend(ABC):
     @abstractmethod
     def apply_torques(self, torques: Torques) -> None:
         """Torques act during the next :meth:`step` only."""
+
+    @abstractmethod
+    def joint_space_inertia(self) -> np.ndarray:
+        """Mass matrix M(q) of the floating character at the current state, (ROOT_DOFS + N_JOINT_DOFS) squared,
+        in the layout of ``sim.character`` (root linear and angular velocity, then the joint DOFs) [kg, kg·m^2]."""
 
     @abstractmethod
     def step(self) -> None: ...

@@ -57,6 +57,13 @@ JOINTS: tuple[JointSpec, ...] = (
     JointSpec("left_elbow", JointKind.HINGE, "left_shoulder", 60.0),
 )
 JOINT_NAMES: tuple[str, ...] = tuple(j.name for j in JOINTS)
+
+# Generalised velocity layout used for the joint-space inertia: the floating root (linear, then angular velocity,
+# world frame) and then each joint's DOFs in JOINTS order (ball: 3 child-frame axes, hinge: 1).
+ROOT_DOFS = 6
+JOINT_DOF_COUNT: tuple[int, ...] = tuple(3 if j.kind is JointKind.BALL else 1 for j in JOINTS)
+JOINT_DOF_START: tuple[int, ...] = tuple(int(x) for x in np.cumsum((0,) + JOINT_DOF_COUNT[:-1]))
+N_JOINT_DOFS = int(sum(JOINT_DOF_COUNT))
 JOINT_BY_NAME: dict[str, JointSpec] = {j.name: j for j in JOINTS}
 
 # All rigid links with mass, in URDF order ("root" is the pelvis; wrists are fixed hands).

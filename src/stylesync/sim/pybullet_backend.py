@@ -22,15 +22,16 @@ from stylesync.errors import SimulationError
 from stylesync.sim.backend import CharacterState, JointFeedback, MassProperties, PhysicsBackend, Torques
 from stylesync.sim.character import (
     FOOT_LINKS,
+    JOINT_DOF_COUNT,
+    JOINT_DOF_START,
     JOINT_NAMES,
     JOINTS,
     LINK_NAMES,
-    LINK_PARENT,
     Q_WORLD_MODEL,
+    ROOT_DOFS,
     URDF_GLOBAL_SCALING,
     URDF_PATH_IN_PYBULLET_DATA,
     JointKind,
-    subtree_links,
 )
 
 _Q_MODEL_WORLD = rot.conjugate(Q_WORLD_MODEL)
@@ -110,39 +111,24 @@ class PyBulletBackend(PhysicsBackend):
         masses = [c.getDynamicsInfo(self.body, i)[0] for i in self._link_idx]
         base_mass = c.getDynamicsInfo(self.body, -1)[0]
         masses[0] += base_mass  # the 0.1 g dummy base is welded to the pelvis
-        self._mass = MassProperties(np.array(masses), self._rest_joint_inertia(),
-                                    float(min(c.getDynamicsInfo(self.body, self._link_idx[0])[2])))
+        self._mass = MassProperties(np.array(masses))
         self.balls: list[int] = []
+        self._dof_map = self._pybullet_dof_map()
 
-    def _rest_joint_inertia(self) -> np.ndarray:
-        """Per-axis effective inertia [kg·m^2] of each joint at rest, in the joint's child frame (n_joints, 3).
-
-        The reduced inertia of the two sides, ``I_c I_p / (I_c + I_p)``: the child subtree about the joint, and the
-        parent link alone about its own COM (the fastest mode when the parent floats, e.g. the 6 kg pelvis).
-        """
+    def _pybullet_dof_map(self) -> np.ndarray:
+        """Indices into PyBullet's padded generalised velocity (flags=1: root 6 + 1 pad, ball joints 3 + 1 pad,
+        hinges 1, fixed 0) of our layout's DOFs (root 6, then JOINTS order)."""
         c = self._pb
-        self.reset(np.array([0.0, 0.0, 3.0]), rot.IDENTITY_WXYZ)
-        links = c.getLinkStates(self.body, self._link_idx, computeForwardKinematics=1)
-        R_wm = rot.matrix_from_quat(Q_WORLD_MODEL)
-        per_link = []
-        for i, ls in zip(self._link_idx, links, strict=True):
-            m, _, diag = c.getDynamicsInfo(self.body, i)[:3]
-            R = rot.matrix_from_quat(rot.wxyz_from_xyzw(ls[1]))
-            per_link.append((m, np.array(ls[0]), R @ np.diag(diag) @ R.T))
-        names = list(LINK_NAMES)
-        out = np.zeros((len(JOINT_NAMES), 3))
-        for k, jn in enumerate(JOINT_NAMES):
-            origin = np.array(links[names.index(jn)][4])
-            child = np.zeros((3, 3))
-            for li in subtree_links(jn):
-                m, com, inertia = per_link[li]
-                r = com - origin
-                child += inertia + m * (np.dot(r, r) * np.eye(3) - np.outer(r, r))
-            parent = per_link[names.index(LINK_PARENT[jn] or "root")][2]
-            ic = np.diag(R_wm.T @ child @ R_wm)  # model axes = child frame at rest
-            ip = np.diag(R_wm.T @ parent @ R_wm)
-            out[k] = ic * ip / (ic + ip)
-        return out
+        start, offset = {}, 7
+        for j in range(c.getNumJoints(self.body)):
+            start[j] = offset
+            kind = c.getJointInfo(self.body, j)[2]
+            offset += {pb.JOINT_SPHERICAL: 4, pb.JOINT_REVOLUTE: 1, pb.JOINT_PRISMATIC: 1}.get(kind, 0)
+        out = list(range(ROOT_DOFS))
+        for k, j in enumerate(self._joint_idx):
+            out += [start[j] + a for a in range(JOINT_DOF_COUNT[k])]
+        assert len(out) == ROOT_DOFS + JOINT_DOF_START[-1] + JOINT_DOF_COUNT[-1]
+        return np.array(out)
 
     # ------------------------------------------------------------------------------------------------------
     def reset(self, root_pos_world, root_quat_wxyz, joint_pos=None) -> None:
@@ -228,6 +214,15 @@ class PyBulletBackend(PhysicsBackend):
             raise SimulationError("non-finite joint torque requested; refusing to drive the character with it")
         forces = [list(v[k]) if self._is_ball[k] else [float(v[k, 0])] for k in range(len(self._joint_idx))]
         self._pb.setJointMotorControlMultiDofArray(self.body, self._joint_idx, pb.TORQUE_CONTROL, forces=forces)
+
+    def joint_space_inertia(self) -> np.ndarray:
+        c = self._pb
+        pos, orn = c.getBasePositionAndOrientation(self.body)
+        q = [*pos, *orn]
+        for js in c.getJointStatesMultiDof(self.body, range(c.getNumJoints(self.body))):
+            q += js[0]
+        m = np.asarray(c.calculateMassMatrix(self.body, q, flags=1))
+        return m[np.ix_(self._dof_map, self._dof_map)]
 
     def step(self) -> None:
         self._pb.stepSimulation()
