@@ -78,7 +78,7 @@ class Session:
         self.motion = MotionOptimizer(config.motion, config.clocks.control_hz, self.bounds)
         self.controller = BalanceController(config.control, self.mass, config.world.gravity_mps2,
                                             1.0 / config.clocks.physics_hz, 1.0 / config.clocks.control_hz,
-                                            self.bounds)
+                                            self.bounds, config.world.friction)
         self.char_style = StyleExtractor()
         self.on_tick = on_tick
         self.renders: list[tuple[float, np.ndarray]] = []

@@ -21,10 +21,10 @@ from stylesync.control.crvc import (
     com_virtual_force,
     root_gain_scale,
     root_virtual_torque,
-    stance_force_torques,
+    stance_force_moments,
     stance_hip_map,
 )
-from stylesync.control.gravity_compensation import gravity_torques
+from stylesync.control.gravity_compensation import ANKLE_JOINT, gravity_torques
 from stylesync.control.jacobian_transpose import JointFrames
 from stylesync.control.model_compensation import ipm_ankle_moments, lipm_sync_force
 from stylesync.control.pid import IS_BALL, JointPid
@@ -34,11 +34,13 @@ from stylesync.control.stable_pd import (
     implicit_gain,
     unflatten_joint_values,
 )
+from stylesync.control.support import limit_ankle_moment
 from stylesync.motion.reference import ReferencePose
 from stylesync.motion.stance_fsm import Stance
 from stylesync.sim.backend import CharacterState, JointFeedback, MassProperties, Torques
 from stylesync.sim.character import JOINT_NAMES, JOINTS, ROOT_DOFS
 
+CONTACT_FORCE_N = 5.0  # a foot pressing the ground harder than this supports the body
 TORQUE_LIMIT = np.array([j.torque_limit_nm for j in JOINTS])[:, None]
 _HIP_INDEX = {s: JOINT_NAMES.index(f"{s}_hip") for s in ("left", "right")}
 
@@ -50,12 +52,21 @@ class ControlTelemetry:
     root_torque_nm: np.ndarray
 
 
+def supporting_weights(stance_weight: dict[str, float], foot_force_n: dict[str, float]) -> dict[str, float]:
+    """The stance weights of the feet that actually touch the ground, renormalised. Support torques (gravity
+    reaction, COM force, IPM ankle torque, root torque) sent to a foot in the air would only spin it."""
+    w = {s: v if foot_force_n[f"{s}_ankle"] > CONTACT_FORCE_N else 0.0 for s, v in stance_weight.items()}
+    total = sum(w.values())
+    return {s: v / total for s, v in w.items()} if total > 0 else w
+
+
 class BalanceController:
     def __init__(self, cfg: ControlConfig, mass: MassProperties, gravity_mps2: float, physics_dt_s: float,
-                 control_dt_s: float, bounds: bnd.BoundsMonitor | None = None):
+                 control_dt_s: float, bounds: bnd.BoundsMonitor | None = None, friction: float = 0.9):
         self.cfg = cfg
         self.mass = mass
         self.g = gravity_mps2
+        self.friction = friction
         self.pid = JointPid(cfg, physics_dt_s)
         self.physics_dt_s = physics_dt_s
         self.control_dt_s = control_dt_s
@@ -65,13 +76,15 @@ class BalanceController:
         self._prev_ref_pos: np.ndarray | None = None
         self._ref_vel = np.zeros((len(JOINTS), 3))
         self.telemetry = ControlTelemetry(np.zeros(3), np.zeros(3), np.zeros(3))
+        self.saturated_ticks = 0  # control ticks whose virtual force was clamped to Eq. 26's bound
         self.root_kp, self.root_kd = cfg.root_torque_kp, cfg.root_torque_kd
         dt = physics_dt_s
         self._joint_damping = flatten_joint_values(self.pid.kd * dt + self.pid.kp * dt * dt)
         self._gain = np.eye(N_DOFS - ROOT_DOFS)  # G of stable_pd, joint rows and columns
         self._root_map = np.zeros((N_DOFS - ROOT_DOFS, 3))  # S: world root torque -> stance-hip DOF torques
 
-    def _prepare_implicit(self, state: CharacterState, ref: ReferencePose, mass_matrix: np.ndarray) -> None:
+    def _prepare_implicit(self, state: CharacterState, stance_weight: dict[str, float],
+                          mass_matrix: np.ndarray) -> None:
         """G = I - D (M + D)^-1 for this tick (stable_pd.py), with the root torque's feedback in D."""
         dt = self.physics_dt_s
         d = np.zeros((N_DOFS, N_DOFS))
@@ -80,7 +93,7 @@ class BalanceController:
         s_map = np.zeros((N_DOFS - ROOT_DOFS, 3))
         if self.cfg.root_virtual_torque:
             hips = {side: state.joint_pos[_HIP_INDEX[side]] for side in ("left", "right")}
-            s_map = stance_hip_map(state.root_quat_wxyz, hips, ref.stance_weight)
+            s_map = stance_hip_map(state.root_quat_wxyz, hips, stance_weight)
             # Q_hips = S τ_r(ω_next): the root damping is implicit in the root's angular acceleration (DOFs 3-5).
             gain = root_gain_scale(self.cfg.root_yaw_gain_scale) * (self.root_kd * dt + self.root_kp * dt * dt)
             d[ROOT_DOFS:, 3:6] = s_map * gain[None, :]
@@ -89,13 +102,14 @@ class BalanceController:
 
     def update(self, state: CharacterState, ref: ReferencePose, mass_matrix: np.ndarray) -> None:
         cfg = self.cfg
-        self._prepare_implicit(state, ref, mass_matrix)
+        w = supporting_weights(ref.stance_weight, state.foot_contact_force_n)
+        foot_yaw = {s: rot.yaw_from_quat(state.link_quat_wxyz[state.link(f"{s}_ankle")]) for s in ("left", "right")}
+        self._prepare_implicit(state, w, mass_matrix)
         frames = JointFrames(state)
         ff = np.zeros((len(JOINTS), 3))
-        w = ref.stance_weight
         if cfg.gravity_compensation:  # Eq. 14-15
             ff += gravity_torques(state, frames, self.mass.link_mass_kg, self.g, w, ref.ankle_world,
-                                  skip_stance_ankle=cfg.ipm_ankle_compensation)
+                                  skip_stance_ankle=cfg.ipm_ankle_compensation, foot_yaw_rad=foot_yaw)
         com = self.mass.com(state)
         force = np.zeros(3)
         if cfg.com_virtual_force:  # Eq. 16 (first line), Eq. 19
@@ -113,17 +127,31 @@ class BalanceController:
             if exceeded and cfg.enforce_bounds:
                 f_lipm *= limit / mag
             force += f_lipm
+        # The whole horizontal virtual force obeys Eq. 26's bound, not only the LIPM part: a stance foot pushes the
+        # COM sideways only by moving its centre of pressure, so a larger force just rolls the foot (the COM
+        # velocity term alone asks for kN when the operator walks off while the character still stands).
+        h_c = max(float(com[2] - min(a[2] for a in ref.ankle_world.values())), 0.1)
+        f_max = bnd.lipm_force_bound_n(self.mass.total_kg, self.g, h_c)
+        f_mag = float(np.linalg.norm(force[:2]))
+        if f_mag > f_max:
+            force[:2] *= f_max / f_mag
+            self.saturated_ticks += 1
         if ref.character_stance is Stance.DS:  # Eq. 24
             centre = 0.5 * (ref.ankle_world["left"] + ref.ankle_world["right"])
             d_c = float(np.linalg.norm((ref.com_world - centre)[:2]))
             self.bounds.report("ds_com", d_c > bnd.ds_com_bound_m(), state.time_s,
                                f"COM {d_c:.3f} m from the support centre > {bnd.ds_com_bound_m():.3f} m (Eq. 24)")
+        moment = np.zeros((len(JOINTS), 3))  # world moments of Eq. 17 and Eq. 20
         if np.any(force):
-            ff += stance_force_torques(frames, state.link_com_world, self.mass.link_mass_kg, force, w)  # Eq. 17
+            moment += stance_force_moments(frames, state.link_com_world, self.mass.link_mass_kg, force, w)  # Eq. 17
         if cfg.ipm_ankle_compensation:  # Eq. 20
-            ff += frames.torque_from_moment(ipm_ankle_moments(ref.com_world, ref.ankle_world, w,
-                                                              self.mass.total_kg, self.g))
-        self._ff = ff
+            moment += ipm_ankle_moments(ref.com_world, ref.ankle_world, w, self.mass.total_kg, self.g, foot_yaw)
+        for side, ws in w.items():  # a stance ankle cannot push harder than its sole allows (support.py)
+            if ws > 0:
+                k = ANKLE_JOINT[side]
+                moment[k] = limit_ankle_moment(moment[k], ref.ankle_world[side], foot_yaw[side],
+                                               ws * self.mass.total_kg * self.g, self.friction)
+        self._ff = ff + frames.torque_from_moment(moment)
         # Reference velocity for the derivative term, from successive references at the control rate.
         if self._prev_ref_pos is not None:
             vel = np.zeros_like(self._ref_vel)

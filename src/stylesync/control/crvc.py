@@ -31,7 +31,15 @@ def com_virtual_force(com_desired, com_vel_desired, com, com_vel, mass_kg: float
 
 def stance_force_torques(frames: JointFrames, link_com_world: np.ndarray, link_mass_kg: np.ndarray,
                          force_world: np.ndarray, stance_weight: dict[str, float]) -> np.ndarray:
-    """Eq. 17: ``τ_fr = J_r^T f_r`` through each stance leg (foot as base), weighted by its stance share.
+    """Eq. 17 in the joint-torque layout (see :func:`stance_force_moments`)."""
+    return frames.torque_from_moment(stance_force_moments(frames, link_com_world, link_mass_kg, force_world,
+                                                          stance_weight))
+
+
+def stance_force_moments(frames: JointFrames, link_com_world: np.ndarray, link_mass_kg: np.ndarray,
+                         force_world: np.ndarray, stance_weight: dict[str, float]) -> np.ndarray:
+    """Eq. 17 as world moments (n_joints, 3): ``τ_fr = J_r^T f_r`` through each stance leg (foot as base),
+    weighted by its stance share.
 
     J_r is the Jacobian of the whole-body COM with the stance foot fixed: turning a leg joint j moves only the
     links above it, so its column is ``(M_above / M) ω_j × (c_above - o_j)``.
@@ -48,7 +56,7 @@ def stance_force_torques(frames: JointFrames, link_com_world: np.ndarray, link_m
         m_above = m_all - m_sub
         c_above = (weighted.sum(axis=0)[None, :] - m_sub[:, None] * c_sub) / m_above[:, None]
         moment[idx] += -w * (m_above / m_all)[:, None] * np.cross(c_above - frames.origin[idx], force_world[None, :])
-    return frames.torque_from_moment(moment)
+    return moment
 
 
 def root_virtual_torque(q_root_desired, q_root, ang_vel_world, kp: float, kd: float, yaw_scale: float,

@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from stylesync.control.jacobian_transpose import JointFrames
+from stylesync.control.support import support_point
 from stylesync.sim.backend import CharacterState
 from stylesync.sim.character import JOINTS, LINK_NAMES, subtree_links
 
@@ -27,21 +28,6 @@ ANKLE_JOINT = {side: next(k for k, j in enumerate(JOINTS) if j.name == f"{side}_
                for side in ("left", "right")}
 
 
-def support_point(com_world: np.ndarray, ankle_world: dict[str, np.ndarray],
-                  stance_weight: dict[str, float]) -> dict[str, np.ndarray]:
-    """Centre of pressure assumed under each stance foot [m]: its ankle shifted by the COM's horizontal offset
-    from the weighted ankles, so that the feet's vertical reactions (w_s m g each) balance the COM exactly. In
-    single stance that is the point under the COM; in double stance each reaction stays under its own foot, so
-    the legs do not squeeze each other sideways."""
-    stance = {s: w for s, w in stance_weight.items() if w > 0}
-    if not stance:
-        return {}
-    weighted = sum(w * ankle_world[s] for s, w in stance.items()) / sum(stance.values())
-    delta = np.asarray(com_world, dtype=float) - weighted
-    delta[2] = 0.0
-    return {s: ankle_world[s] + delta for s in stance}
-
-
 def gravity_torques(
     state: CharacterState,
     frames: JointFrames,
@@ -50,6 +36,7 @@ def gravity_torques(
     stance_weight: dict[str, float],
     ankle_world: dict[str, np.ndarray],
     skip_stance_ankle: bool = False,
+    foot_yaw_rad: dict[str, float] | None = None,
 ) -> np.ndarray:
     """Eq. 14-15 with stance-leg support. Returns the (n_joints, 3) torque layout [N·m].
 
@@ -66,7 +53,7 @@ def gravity_torques(
     c_sub = (SUBTREE_MASK @ weighted) / m_sub[:, None]
     moment = np.cross(c_sub - frames.origin, m_sub[:, None] * g_up)  # (n_joints, 3)
     com = weighted.sum(axis=0) / m.sum()
-    for side, p in support_point(com, ankle_world, stance_weight).items():
+    for side, p in support_point(com, ankle_world, stance_weight, foot_yaw_rad).items():
         idx = LEG_JOINTS[side]
         if skip_stance_ankle:
             idx = idx[idx != ANKLE_JOINT[side]]

@@ -14,21 +14,23 @@ from __future__ import annotations
 
 import numpy as np
 
-from stylesync.control.gravity_compensation import ANKLE_JOINT, support_point
+from stylesync.control.gravity_compensation import ANKLE_JOINT
+from stylesync.control.support import support_point
 from stylesync.sim.character import JOINTS
 
 
 def ipm_ankle_moments(com_desired: np.ndarray, ankle_pos: dict[str, np.ndarray], stance_weight: dict[str, float],
-                      mass_kg: float, gravity_mps2: float) -> np.ndarray:
+                      mass_kg: float, gravity_mps2: float, foot_yaw_rad: dict[str, float] | None = None) -> np.ndarray:
     """Eq. 20 as world moments on the stance ankle joints, (n_joints, 3) [N·m].
 
     d_C is taken from each foot's support point (gravity_compensation.support_point) rather than from each ankle:
     identical in single stance; in double stance it keeps the two ankles from pushing the body sideways against
     each other (the paper's single-ankle form would put ±m g w/2 lateral torques on feet that already carry
-    their share directly below them).
+    their share directly below them). With the feet's headings the point is kept on the sole: a larger ankle
+    torque than the foot can pass to the ground only rolls the foot.
     """
     moment = np.zeros((len(JOINTS), 3))
-    for side, p in support_point(com_desired, ankle_pos, stance_weight).items():
+    for side, p in support_point(com_desired, ankle_pos, stance_weight, foot_yaw_rad).items():
         weight = np.array([0.0, 0.0, stance_weight[side] * mass_kg * gravity_mps2])
         d = p - ankle_pos[side]
         d[2] = 0.0  # horizontal distance d_C only (Eq. 20)

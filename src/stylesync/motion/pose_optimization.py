@@ -50,6 +50,9 @@ from stylesync.sim.character import (
 )
 
 _MIN_AXIS_SPREAD_M = 0.08
+_UP = np.array([0.0, 0.0, 1.0])
+LATE_CONTACT_PRESS_M = 0.02  # a swing foot held for a late contact is aimed this far below the ground [m]
+ANCHOR_BLEND_S = 0.15  # time constant over which a stance change's jump of the retargeting anchor is taken up
 _CONTACT_FORCE_N = 5.0  # a foot with more normal force than this is in contact
 _SCALE_SMOOTHING = 0.02  # per tick, exponential average of the operator's leg length
 _SIDE_UP = {"left": "LEFT", "right": "RIGHT"}
@@ -85,6 +88,9 @@ class MotionOptimizer:
         self._prev_com_h: np.ndarray | None = None
         self._com_vel_h = np.zeros(3)
         self.bounds = bounds if bounds is not None else BoundsMonitor()
+        self._anchor_stance: Stance | None = None
+        self._anchor_offset = np.zeros((2, 2))  # (pelvis, COM) x (x, y) [m]
+        self._last_xy: np.ndarray | None = None
 
     def operator_features(self, s: OperatorSample) -> StyleFeatures:
         hip = {k: s.pos[f"HIP_{v}"] for k, v in _SIDE_UP.items()}
@@ -138,6 +144,16 @@ class MotionOptimizer:
             pelvis_xy = a_c[st] + scale * (p_h - a_h[st])
             com_xy = a_c[st] + scale * (com_h - a_h[st])
             ankle_h_z, ankle_c_z = a_h[st][2], ANKLE_HEIGHT_M
+        # A change of stance changes the anchor of Eq. 10 (the fraction between the feet, or the stance foot); the
+        # operator's and the character's feet are never placed exactly alike, so the targets would jump. The jump
+        # is taken up as an offset that decays with ANCHOR_BLEND_S.
+        if ch_state is not self._anchor_stance and self._last_xy is not None:
+            self._anchor_offset += self._last_xy - np.stack([pelvis_xy[:2], com_xy[:2]])
+        self._anchor_stance = ch_state
+        self._anchor_offset *= np.exp(-self.dt_s / ANCHOR_BLEND_S)
+        pelvis_xy = np.array([*(pelvis_xy[:2] + self._anchor_offset[0]), 0.0])
+        com_xy = np.array([*(com_xy[:2] + self._anchor_offset[1]), 0.0])
+        self._last_xy = np.stack([pelvis_xy[:2], com_xy[:2]])
         pelvis_d = np.array([pelvis_xy[0], pelvis_xy[1], ankle_c_z + scale * (p_h[2] - ankle_h_z)])  # Eq. 9
         # The operator's COM height reflects his own mass distribution, not the character's: the vertical is left
         # to the pelvis height (Eq. 9) through the leg IK, and the COM target keeps the character's own height.
@@ -158,11 +174,23 @@ class MotionOptimizer:
         q_cur = state.joint_pos
         for side, sign in (("left", 1.0), ("right", -1.0)):
             hip_w = pelvis_d + R_root_d @ np.array([0.0, sign * HIP_HALF_WIDTH_M, 0.0])
+            q_root_frame = q_root_d
+            if side == sw:
+                # The swing leg is solved from where its hip actually is (as SIMBICON's world-frame swing hip):
+                # solved from the desired pelvis, a pelvis a little low or tilted would drive the foot into the
+                # ground and lift the body off its stance foot.
+                hip_w = state.link_origin_world[_LINK[f"{side}_hip"]].copy()
+                q_root_frame = state.root_quat_wxyz
             N = features.N_l if side == "left" else features.N_r
             other = "left" if side == "right" else "right"
             if side == sw:
                 target = pelvis_d + scale * (a_h[side] - p_h)
                 target[2] = min(max(target[2], ankle_c_z), ankle_c_z + cfg.max_swing_foot_lift_m)
+                if self.char_fsm.hold_reference:
+                    # Late contact (Sec. 5.1): the operator has landed, the character's foot has not. The held
+                    # reference keeps the foot where the operator put it, horizontally, and lowers it to the
+                    # ground (slightly below, so that it does touch).
+                    target[2] = ANKLE_HEIGHT_M - LATE_CONTACT_PRESS_M
                 bound = step_length_bound_m(CHAR_LEG_LENGTH_M, op_leg_m)  # Eq. 28
                 step = target[:2] - a_c[other][:2]
                 dist = float(np.linalg.norm(step))
@@ -171,23 +199,26 @@ class MotionOptimizer:
                                    f"step {dist:.2f} m > bound {bound:.2f} m (Eq. 28)")
                 if step_exceeded:
                     target[:2] = a_c[other][:2] + step * (bound / dist)
-                foot_yaw = rot.yaw_from_quat(s.quat[f"ANKLE_{_SIDE_UP[side]}"])
+                foot_yaw = rot.twist_angle(s.quat[f"ANKLE_{_SIDE_UP[side]}"], _UP)
             else:
                 target = a_plant[side]
-                foot_yaw = rot.yaw_from_quat(state.link_quat_wxyz[_LINK[f"{side}_ankle"]])
+                foot_yaw = rot.twist_angle(state.link_quat_wxyz[_LINK[f"{side}_ankle"]], _UP)
             ik = solve_leg(hip_w, target, THIGH_LENGTH_M, SHANK_LENGTH_M, N)
             q_thigh = ik.thigh_quat_wxyz
             if side == sw:
                 q_thigh = swing_hip_feedback(q_thigh, com_d - a_c[other], com_c - a_c[other], com_vel_d,
                                              mass.com_velocity(state), cfg.swing_hip_cd, cfg.swing_hip_cv, heading)
-            q_hip = rot.multiply(rot.conjugate(q_root_d), q_thigh)
+            q_hip = rot.multiply(rot.conjugate(q_root_frame), q_thigh)
             if weights[side] > 0 and ch_state is not Stance.DS:
                 q_hip_cur = canonical_quat_from_model(q_cur[JOINT_NAMES.index(f"{side}_hip")])
                 q_hip = stance_hip_blend(q_hip, q_hip_cur, cfg.stance_hip_weight_w0)  # Eq. 11
             local[f"{side}_hip"] = q_hip
             knee_angle[f"{side}_knee"] = ik.knee_angle_rad
             q_foot = rot.quat_from_yaw(foot_yaw)
-            local[f"{side}_ankle"] = rot.multiply(rot.conjugate(ik.shank_quat_wxyz), q_foot)
+            # Feet flat (Sec. 5.3) relative to the shank where it actually is: relative to the IK's shank, any
+            # difference between the two would twist a planted foot against its sole's friction and spin it.
+            q_shank_now = state.link_quat_wxyz[_LINK[f"{side}_knee"]]
+            local[f"{side}_ankle"] = rot.multiply(rot.conjugate(q_shank_now), q_foot)
 
         # Upper body from the joint map; the chest keeps the operator's torso orientation in the world.
         local["chest"] = rot.multiply(rot.conjugate(q_root_d), s.quat["SPINE_CHEST"])
