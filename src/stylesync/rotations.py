@@ -7,6 +7,8 @@ acting on column vectors (``R @ v``). Rotation vectors ("log maps") are axis * a
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -27,17 +29,38 @@ def xyzw_from_wxyz(q_wxyz) -> Array:
     return np.array([q[1], q[2], q[3], q[0]])
 
 
+# Single quaternions and vectors are handled with Python floats (tolist): numpy's per-call overhead on 3- and
+# 4-element arrays dominates the control tick otherwise.
+
+
+def cross(a: Array, b: Array) -> Array:
+    """a × b for 3-vectors, or row-wise for (n, 3) arrays (faster than np.cross on small inputs)."""
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    if a.ndim == 1 and b.ndim == 1:
+        ax, ay, az = a.tolist()
+        bx, by, bz = b.tolist()
+        return np.array([ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx])
+    a, b = np.broadcast_arrays(a, b)
+    out = np.empty(a.shape)
+    out[..., 0] = a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1]
+    out[..., 1] = a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2]
+    out[..., 2] = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    return out
+
+
 def normalize(q: Array) -> Array:
-    n = float(np.linalg.norm(q))
-    if not np.isfinite(n) or n < 1e-12:
+    w, x, y, z = np.asarray(q, dtype=float).tolist()
+    n = math.sqrt(w * w + x * x + y * y + z * z)
+    if not math.isfinite(n) or n < 1e-12:
         return IDENTITY_WXYZ.copy()
-    return q / n
+    return np.array([w / n, x / n, y / n, z / n])
 
 
 def multiply(a: Array, b: Array) -> Array:
     """Hamilton product a ⊗ b (apply b first, then a)."""
-    aw, ax, ay, az = a
-    bw, bx, by, bz = b
+    aw, ax, ay, az = np.asarray(a, dtype=float).tolist()
+    bw, bx, by, bz = np.asarray(b, dtype=float).tolist()
     return np.array(
         [
             aw * bw - ax * bx - ay * by - az * bz,
@@ -54,7 +77,7 @@ def conjugate(q: Array) -> Array:
 
 def matrix_from_quat(q: Array) -> Array:
     """3x3 rotation matrix of a unit quaternion (w, x, y, z)."""
-    w, x, y, z = q
+    w, x, y, z = np.asarray(q, dtype=float).tolist()
     return np.array(
         [
             [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
@@ -85,39 +108,42 @@ def quat_from_matrix(R: Array) -> Array:
 
 
 def rotate(q: Array, v: Array) -> Array:
-    """Rotate vector v [any unit] by quaternion q."""
-    return matrix_from_quat(q) @ np.asarray(v, dtype=float)
+    """Rotate vector v [any unit] by quaternion q: v + 2w (u × v) + 2 u × (u × v), u the vector part."""
+    w, x, y, z = np.asarray(q, dtype=float).tolist()
+    vx, vy, vz = np.asarray(v, dtype=float).tolist()
+    tx, ty, tz = 2 * (y * vz - z * vy), 2 * (z * vx - x * vz), 2 * (x * vy - y * vx)
+    return np.array([vx + w * tx + (y * tz - z * ty), vy + w * ty + (z * tx - x * tz), vz + w * tz + (x * ty - y * tx)])
 
 
 def quat_from_axis_angle(axis: Array, angle_rad: float) -> Array:
-    axis = np.asarray(axis, dtype=float)
-    n = np.linalg.norm(axis)
+    x, y, z = np.asarray(axis, dtype=float).tolist()
+    n = math.sqrt(x * x + y * y + z * z)
     if n < 1e-12:
         return IDENTITY_WXYZ.copy()
-    axis = axis / n
-    h = 0.5 * angle_rad
-    return np.concatenate([[np.cos(h)], np.sin(h) * axis])
+    h = 0.5 * float(angle_rad)
+    k = math.sin(h) / n
+    return np.array([math.cos(h), k * x, k * y, k * z])
 
 
 def quat_from_rotvec(rv: Array) -> Array:
-    rv = np.asarray(rv, dtype=float)
-    angle = float(np.linalg.norm(rv))
+    x, y, z = np.asarray(rv, dtype=float).tolist()
+    angle = math.sqrt(x * x + y * y + z * z)
     if angle < 1e-12:
-        return normalize(np.array([1.0, 0.5 * rv[0], 0.5 * rv[1], 0.5 * rv[2]]))
-    return quat_from_axis_angle(rv / angle, angle)
+        return normalize(np.array([1.0, 0.5 * x, 0.5 * y, 0.5 * z]))
+    k = math.sin(0.5 * angle) / angle
+    return np.array([math.cos(0.5 * angle), k * x, k * y, k * z])
 
 
 def rotvec_from_quat(q: Array) -> Array:
     """Log map: rotation vector [rad] of the shortest rotation equal to q (q and -q give the same)."""
-    q = np.asarray(q, dtype=float)
-    if q[0] < 0:
-        q = -q
-    v = q[1:]
-    s = float(np.linalg.norm(v))
+    w, x, y, z = np.asarray(q, dtype=float).tolist()
+    if w < 0:
+        w, x, y, z = -w, -x, -y, -z
+    s = math.sqrt(x * x + y * y + z * z)
     if s < 1e-12:
-        return 2.0 * v
-    angle = 2.0 * np.arctan2(s, q[0])
-    return v / s * angle
+        return np.array([2.0 * x, 2.0 * y, 2.0 * z])
+    k = 2.0 * math.atan2(s, w) / s
+    return np.array([k * x, k * y, k * z])
 
 
 def slerp(q0: Array, q1: Array, t: float) -> Array:
@@ -129,8 +155,8 @@ def slerp(q0: Array, q1: Array, t: float) -> Array:
 
 def yaw_from_quat(q: Array) -> float:
     """Heading [rad] about world z of the body x axis of q."""
-    fwd = rotate(q, np.array([1.0, 0.0, 0.0]))
-    return float(np.arctan2(fwd[1], fwd[0]))
+    w, x, y, z = np.asarray(q, dtype=float).tolist()
+    return math.atan2(2 * (x * y + w * z), 1 - 2 * (y * y + z * z))
 
 
 def quat_from_yaw(yaw_rad: float) -> Array:
@@ -151,22 +177,26 @@ def swing_twist(q: Array, axis: Array) -> tuple[Array, Array]:
 
 def twist_angle(q: Array, axis: Array) -> float:
     """Signed twist angle [rad] of q about the unit ``axis``."""
-    _, tw = swing_twist(q, axis)
-    if tw[0] < 0:
-        tw = -tw
-    return float(2.0 * np.arctan2(np.dot(tw[1:], axis), tw[0]))
+    w, x, y, z = np.asarray(q, dtype=float).tolist()
+    ax, ay, az = np.asarray(axis, dtype=float).tolist()
+    p = x * ax + y * ay + z * az
+    if abs(w) < 1e-12 and abs(p) < 1e-12:
+        return 0.0
+    if w < 0:
+        w, p = -w, -p
+    return 2.0 * math.atan2(p, w)
 
 
 def rotation_between(a: Array, b: Array) -> Array:
     """Shortest rotation taking direction a onto direction b."""
     a = np.asarray(a, dtype=float) / np.linalg.norm(a)
     b = np.asarray(b, dtype=float) / np.linalg.norm(b)
-    c = np.cross(a, b)
+    c = cross(a, b)
     d = float(np.dot(a, b))
     if d < -1 + 1e-9:
-        ortho = np.cross(a, [1.0, 0.0, 0.0])
+        ortho = cross(a, [1.0, 0.0, 0.0])
         if np.linalg.norm(ortho) < 1e-6:
-            ortho = np.cross(a, [0.0, 1.0, 0.0])
+            ortho = cross(a, [0.0, 1.0, 0.0])
         return quat_from_axis_angle(ortho, np.pi)
     return normalize(np.array([1.0 + d, c[0], c[1], c[2]]))
 

@@ -109,7 +109,7 @@ class BalanceController:
         ff = np.zeros((len(JOINTS), 3))
         if cfg.gravity_compensation:  # Eq. 14-15
             ff += gravity_torques(state, frames, self.mass.link_mass_kg, self.g, w, ref.ankle_world,
-                                  skip_stance_ankle=cfg.ipm_ankle_compensation, foot_yaw_rad=foot_yaw)
+                                  skip_stance_ankle=cfg.ipm_ankle_compensation)
         com = self.mass.com(state)
         force = np.zeros(3)
         if cfg.com_virtual_force:  # Eq. 16 (first line), Eq. 19
@@ -146,8 +146,11 @@ class BalanceController:
             moment += stance_force_moments(frames, state.link_com_world, self.mass.link_mass_kg, force, w)  # Eq. 17
         if cfg.ipm_ankle_compensation:  # Eq. 20
             moment += ipm_ankle_moments(ref.com_world, ref.ankle_world, w, self.mass.total_kg, self.g, foot_yaw)
-        for side, ws in w.items():  # a stance ankle cannot push harder than its sole allows (support.py)
-            if ws > 0:
+        # In single stance the ankle cannot push harder than its sole allows (support.py); in double stance the
+        # two feet share a larger support polygon, and a per-sole clamp there was measured to make the standing
+        # character drift and fall (the ankles' PD and the clamped feedforward then fight).
+        for side, ws in w.items():
+            if ws >= 1.0:
                 k = ANKLE_JOINT[side]
                 moment[k] = limit_ankle_moment(moment[k], ref.ankle_world[side], foot_yaw[side],
                                                ws * self.mass.total_kg * self.g, self.friction)

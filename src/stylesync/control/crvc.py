@@ -55,7 +55,7 @@ def stance_force_moments(frames: JointFrames, link_com_world: np.ndarray, link_m
         c_sub = (SUBTREE_MASK[idx] @ weighted) / m_sub[:, None]
         m_above = m_all - m_sub
         c_above = (weighted.sum(axis=0)[None, :] - m_sub[:, None] * c_sub) / m_above[:, None]
-        moment[idx] += -w * (m_above / m_all)[:, None] * np.cross(c_above - frames.origin[idx], force_world[None, :])
+        moment[idx] += -w * (m_above / m_all)[:, None] * rot.cross(c_above - frames.origin[idx], force_world[None, :])
     return moment
 
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from stylesync import rotations as rot
 from stylesync.control.jacobian_transpose import JointFrames
 from stylesync.control.support import support_point
 from stylesync.sim.backend import CharacterState
@@ -51,12 +52,12 @@ def gravity_torques(
     weighted = m[:, None] * state.link_com_world  # (n_links, 3)
     m_sub = SUBTREE_MASK @ m  # (n_joints,)
     c_sub = (SUBTREE_MASK @ weighted) / m_sub[:, None]
-    moment = np.cross(c_sub - frames.origin, m_sub[:, None] * g_up)  # (n_joints, 3)
+    moment = rot.cross(c_sub - frames.origin, m_sub[:, None] * g_up)  # (n_joints, 3)
     com = weighted.sum(axis=0) / m.sum()
     for side, p in support_point(com, ankle_world, stance_weight, foot_yaw_rad).items():
         idx = LEG_JOINTS[side]
         if skip_stance_ankle:
             idx = idx[idx != ANKLE_JOINT[side]]
         reaction = stance_weight[side] * m.sum() * g_up
-        moment[idx] -= np.cross(p[None, :] - frames.origin[idx], reaction[None, :])
+        moment[idx] -= rot.cross(p[None, :] - frames.origin[idx], reaction[None, :])
     return frames.torque_from_moment(moment)

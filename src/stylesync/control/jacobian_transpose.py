@@ -42,5 +42,5 @@ class JointFrames:
         """(n_joints, 3) moments (p - o_j) × f for the listed joints, zero elsewhere."""
         m = np.zeros((len(JOINTS), 3))
         r = point_world[None, :] - self.origin[joint_ids]
-        m[joint_ids] = np.cross(r, force_world[None, :])
+        m[joint_ids] = rot.cross(r, force_world[None, :])
         return m

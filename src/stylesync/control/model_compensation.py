@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from stylesync import rotations as rot
 from stylesync.control.gravity_compensation import ANKLE_JOINT
 from stylesync.control.support import support_point
 from stylesync.sim.character import JOINTS
@@ -34,7 +35,7 @@ def ipm_ankle_moments(com_desired: np.ndarray, ankle_pos: dict[str, np.ndarray],
         weight = np.array([0.0, 0.0, stance_weight[side] * mass_kg * gravity_mps2])
         d = p - ankle_pos[side]
         d[2] = 0.0  # horizontal distance d_C only (Eq. 20)
-        moment[ANKLE_JOINT[side]] = -np.cross(d, weight)
+        moment[ANKLE_JOINT[side]] = -rot.cross(d, weight)
     return moment
 
 

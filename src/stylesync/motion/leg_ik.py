@@ -40,7 +40,7 @@ class LegIkSolution:
 def _frame(up: np.ndarray, left: np.ndarray) -> np.ndarray:
     left = left - np.dot(left, up) * up
     left /= np.linalg.norm(left)
-    return np.column_stack([np.cross(left, up), left, up])
+    return np.column_stack([rot.cross(left, up), left, up])
 
 
 def solve_leg(hip: np.ndarray, ankle_target: np.ndarray, thigh_m: float, shank_m: float,
@@ -54,9 +54,9 @@ def solve_leg(hip: np.ndarray, ankle_target: np.ndarray, thigh_m: float, shank_m
     n = np.asarray(plane_normal, dtype=float)
     n = n - np.dot(n, u) * u
     if np.linalg.norm(n) < 1e-6:
-        n = np.cross(u, np.array([1.0, 0.0, 0.0]))
+        n = rot.cross(u, np.array([1.0, 0.0, 0.0]))
     n /= np.linalg.norm(n)
-    v = np.cross(u, n)  # in-plane, forward of the hip-ankle line
+    v = rot.cross(u, n)  # in-plane, forward of the hip-ankle line
     cos_a = (thigh_m**2 + dist**2 - shank_m**2) / (2 * thigh_m * dist)
     alpha = float(np.arccos(np.clip(cos_a, -1.0, 1.0)))
     knee = hip + thigh_m * (np.cos(alpha) * u + np.sin(alpha) * v)

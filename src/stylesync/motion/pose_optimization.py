@@ -184,7 +184,10 @@ class MotionOptimizer:
             N = features.N_l if side == "left" else features.N_r
             other = "left" if side == "right" else "right"
             if side == sw:
-                target = pelvis_d + scale * (a_h[side] - p_h)
+                # Where the operator's foot is relative to his pelvis, scaled, from the character's actual pelvis
+                # (horizontally): the foot lands relative to the body that has to be caught.
+                pelvis_now = state.root_pos_world
+                target = np.array([pelvis_now[0], pelvis_now[1], pelvis_d[2]]) + scale * (a_h[side] - p_h)
                 target[2] = min(max(target[2], ankle_c_z), ankle_c_z + cfg.max_swing_foot_lift_m)
                 if self.char_fsm.hold_reference:
                     # Late contact (Sec. 5.1): the operator has landed, the character's foot has not. The held
@@ -206,7 +209,7 @@ class MotionOptimizer:
             ik = solve_leg(hip_w, target, THIGH_LENGTH_M, SHANK_LENGTH_M, N)
             q_thigh = ik.thigh_quat_wxyz
             if side == sw:
-                q_thigh = swing_hip_feedback(q_thigh, com_d - a_c[other], com_c - a_c[other], com_vel_d,
+                q_thigh = swing_hip_feedback(q_thigh, np.zeros(3), com_c - a_c[other], np.zeros(3),
                                              mass.com_velocity(state), cfg.swing_hip_cd, cfg.swing_hip_cv, heading)
             q_hip = rot.multiply(rot.conjugate(q_root_frame), q_thigh)
             if weights[side] > 0 and ch_state is not Stance.DS:
@@ -215,10 +218,13 @@ class MotionOptimizer:
             local[f"{side}_hip"] = q_hip
             knee_angle[f"{side}_knee"] = ik.knee_angle_rad
             q_foot = rot.quat_from_yaw(foot_yaw)
-            # Feet flat (Sec. 5.3) relative to the shank where it actually is: relative to the IK's shank, any
-            # difference between the two would twist a planted foot against its sole's friction and spin it.
-            q_shank_now = state.link_quat_wxyz[_LINK[f"{side}_knee"]]
-            local[f"{side}_ankle"] = rot.multiply(rot.conjugate(q_shank_now), q_foot)
+            # Feet flat (Sec. 5.3) on the IK's shank, which keeps the ankles' stiffness against leaning. The twist
+            # about the shank's long axis is left where it is: a difference between the IK's and the actual
+            # shank twist would otherwise twist a planted foot against its sole's friction and spin it.
+            q_ankle_ik = rot.multiply(rot.conjugate(ik.shank_quat_wxyz), q_foot)
+            swing_ik, _ = rot.swing_twist(q_ankle_ik, _UP)
+            _, twist_now = rot.swing_twist(canonical_quat_from_model(q_cur[JOINT_NAMES.index(f"{side}_ankle")]), _UP)
+            local[f"{side}_ankle"] = rot.multiply(swing_ik, twist_now)
 
         # Upper body from the joint map; the chest keeps the operator's torso orientation in the world.
         local["chest"] = rot.multiply(rot.conjugate(q_root_d), s.quat["SPINE_CHEST"])

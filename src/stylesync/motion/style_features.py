@@ -41,7 +41,7 @@ ROW_NAMES = ["T_l", "T_r", "N_l_x", "N_l_y", "N_l_z", "N_r_x", "N_r_y", "N_r_z",
 def leg_plane_normal(hip, knee, ankle, fallback: np.ndarray) -> np.ndarray:
     a = np.asarray(knee) - np.asarray(hip)
     b = np.asarray(ankle) - np.asarray(knee)
-    n = np.cross(a, b)
+    n = rot.cross(a, b)
     s = np.linalg.norm(n)
     if s < _MIN_PLANE_SINE * np.linalg.norm(a) * np.linalg.norm(b) or s < 1e-9:
         return np.asarray(fallback, dtype=float)
