@@ -8,7 +8,7 @@ import logging
 import sys
 from pathlib import Path
 
-from stylesync.config import OperatorConfig, SessionConfig
+from stylesync.config import ControlConfig, OperatorConfig, SessionConfig
 from stylesync.errors import StylesyncError
 
 
@@ -19,7 +19,8 @@ def _demo(args: argparse.Namespace) -> int:
     from stylesync.sources.builtin_operator import builtin_operator
 
     cfg = SessionConfig(duration_s=args.duration, seed=args.seed, gui=args.gui, realtime=args.realtime,
-                        operator=OperatorConfig(clip=args.clip))
+                        operator=OperatorConfig(clip=args.clip),
+                        control=ControlConfig(lipm_time_sync=not args.no_lipm))
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
@@ -27,6 +28,7 @@ def _demo(args: argparse.Namespace) -> int:
     result = session.run(render_every_s=max(cfg.duration_s / 8, 0.25))
     metrics = summarize(result)
     metrics["clip"] = args.clip
+    metrics["lipm_time_sync"] = not args.no_lipm
     (out / "metrics.json").write_text(json.dumps(metrics, indent=2))
     write_plots(result, out)
     write_strip(session.renders, out / "render_strip.png")
@@ -46,6 +48,7 @@ def main(argv: list[str] | None = None) -> int:
     demo.add_argument("--seed", type=int, default=0)
     demo.add_argument("--gui", action="store_true", help="open the PyBullet window")
     demo.add_argument("--realtime", action="store_true", help="pace to the wall clock")
+    demo.add_argument("--no-lipm", action="store_true", help="switch the LIPM time-sync compensation off (Eq. 21-23)")
     demo.set_defaults(func=_demo)
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")

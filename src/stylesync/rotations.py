@@ -33,7 +33,7 @@ def xyzw_from_wxyz(q_wxyz) -> Array:
 # 4-element arrays dominates the control tick otherwise.
 
 
-def cross(a: Array, b: Array) -> Array:
+def cross(a, b) -> Array:
     """a × b for 3-vectors, or row-wise for (n, 3) arrays (faster than np.cross on small inputs)."""
     a = np.asarray(a, dtype=float)
     b = np.asarray(b, dtype=float)

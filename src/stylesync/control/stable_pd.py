@@ -24,20 +24,19 @@ from stylesync.sim.character import JOINT_DOF_COUNT, JOINT_DOF_START, JOINTS, N_
 N_DOFS = ROOT_DOFS + N_JOINT_DOFS
 
 
+_ROWS = np.array([k for k in range(len(JOINTS)) for _ in range(JOINT_DOF_COUNT[k])])
+_COLS = np.array([a for k in range(len(JOINTS)) for a in range(JOINT_DOF_COUNT[k])])
+assert len(_ROWS) == N_JOINT_DOFS and all(JOINT_DOF_START[k] == int(np.argmax(_ROWS == k)) for k in range(len(JOINTS)))
+
+
 def flatten_joint_values(values: np.ndarray) -> np.ndarray:
     """(n_joints, 3) per-joint values -> (N_JOINT_DOFS,) in the DOF layout (hinges keep column 0)."""
-    out = np.empty(N_JOINT_DOFS)
-    for k in range(len(JOINTS)):
-        s, n = JOINT_DOF_START[k], JOINT_DOF_COUNT[k]
-        out[s:s + n] = values[k, :n]
-    return out
+    return values[_ROWS, _COLS]
 
 
 def unflatten_joint_values(flat: np.ndarray) -> np.ndarray:
     out = np.zeros((len(JOINTS), 3))
-    for k in range(len(JOINTS)):
-        s, n = JOINT_DOF_START[k], JOINT_DOF_COUNT[k]
-        out[k, :n] = flat[s:s + n]
+    out[_ROWS, _COLS] = flat
     return out
 
 

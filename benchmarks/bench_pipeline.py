@@ -1,0 +1,70 @@
+"""Speed of the whole pipeline against physics alone, measured in one run (prints figures; not a test).
+
+    python benchmarks/bench_pipeline.py [--clip stand] [--duration 20]
+
+Physics alone: the same world and character stepped at the physics rate with zero joint torques (the character
+simply falls and lies; contact work is comparable). Whole pipeline: source -> processing -> motion -> control ->
+physics, headless, as fast as possible. Both are timed in this process, one after the other, so their ratio is
+meaningful on a noisy machine even when the absolute figures are not.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+from stylesync.config import OperatorConfig, SessionConfig
+from stylesync.session import Session
+from stylesync.sim.backend import Torques, make_backend
+from stylesync.sources.builtin_operator import builtin_operator
+
+
+def physics_only_rtf(cfg: SessionConfig, sim_s: float) -> float:
+    backend = make_backend(cfg.world, cfg.clocks.physics_hz)
+    backend.reset(np.array([0.0, 0.0, 0.9]), np.array([1.0, 0.0, 0.0, 0.0]))
+    n = int(sim_s * cfg.clocks.physics_hz)
+    zero = Torques.zeros()
+    t0 = time.perf_counter()
+    for _ in range(n):
+        backend.apply_torques(zero)
+        backend.step()
+    wall = time.perf_counter() - t0
+    backend.close()
+    return sim_s / wall
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--clip", default="stand")
+    ap.add_argument("--duration", type=float, default=20.0)
+    ap.add_argument("--seed", type=int, default=0)
+    args = ap.parse_args()
+    cfg = SessionConfig(duration_s=args.duration, seed=args.seed, operator=OperatorConfig(clip=args.clip))
+    phys = physics_only_rtf(cfg, args.duration)
+    source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
+    result = Session(cfg, source).run()
+    rtf = result.sim_duration_s / result.wall_duration_s
+    ticks = len(result.stage_ms["motion"])
+    steps = len(result.stage_ms["physics"])
+    print(f"clip {args.clip}, simulated {result.sim_duration_s:.2f} s"
+          f"{' (fell at %.2f s)' % result.fall_time_s if result.fell else ''}, {ticks} control ticks, {steps} physics steps")
+    print(f"realtime factor, physics alone:  {phys:6.2f}x")
+    print(f"realtime factor, whole pipeline: {rtf:6.2f}x   (ratio {rtf / phys:.2f} of physics alone)")
+    print("time per control tick [ms], mean / p99:")
+    per_tick = {k: np.asarray(v) for k, v in result.stage_ms.items()}
+    steps_per_tick = steps / max(ticks, 1)
+    for name, values in per_tick.items():
+        if values.size == 0:
+            continue
+        scale = steps_per_tick if name in ("torques", "physics") else 1.0  # per-step stages summed over a tick
+        print(f"  {name:15s} {values.mean() * scale:7.3f} / {np.percentile(values, 99) * scale:7.3f}"
+              f"{'   (%.1f physics steps per tick)' % steps_per_tick if scale != 1.0 else ''}")
+    tick_total = result.log.array("tick_ms")
+    print(f"  {'control tick':15s} {tick_total.mean():7.3f} / {np.percentile(tick_total, 99):7.3f}"
+          "   (processing + motion + control update)")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,133 @@
+"""The balance controller's building blocks, each against a known answer, and the free character standing."""
+
+import numpy as np
+import pytest
+from conftest import random_pose
+
+from stylesync import rotations as rot
+from stylesync.config import ControlConfig, OperatorConfig, SessionConfig, WorldConfig
+from stylesync.control.gravity_compensation import LEG_JOINTS, gravity_torques
+from stylesync.control.jacobian_transpose import JointFrames
+from stylesync.control.pid import joint_error
+from stylesync.control.stable_pd import (
+    flatten_joint_values,
+    implicit_gain,
+    unflatten_joint_values,
+)
+from stylesync.control.support import limit_ankle_moment, support_point
+from stylesync.session import Session
+from stylesync.sim.backend import make_backend
+from stylesync.sim.character import N_JOINT_DOFS, ROOT_DOFS, STANDING_ROOT_HEIGHT_M
+from stylesync.sources.builtin_operator import builtin_operator
+
+
+def test_implicit_gain_matches_the_scalar_stable_pd():
+    # One DOF of inertia m: the implicit PD force is r m / (m + kd dt + kp dt^2).
+    m, kp, kd, dt = 0.002, 60.0, 2.0, 1 / 600
+    d = kd * dt + kp * dt * dt
+    g = implicit_gain(np.array([[m]]), np.array([[d]]))
+    assert g[0, 0] == pytest.approx(m / (m + d), rel=1e-12)
+
+
+def test_flatten_round_trip():
+    values = np.random.default_rng(0).normal(size=(12, 3))
+    back = unflatten_joint_values(flatten_joint_values(values))
+    assert flatten_joint_values(back) == pytest.approx(flatten_joint_values(values))
+    assert len(flatten_joint_values(values)) == N_JOINT_DOFS
+
+
+def test_mass_matrix_gives_the_kinetic_energy():
+    b = make_backend(WorldConfig(), 600.0)
+    b.reset(np.array([0.0, 0.0, 2.0]), rot.quat_from_rotvec(np.array([0.3, 0.5, 0.2])), random_pose(3))
+    c = b._pb  # type: ignore[attr-defined]
+    v, w = np.array([0.1, 0.2, -0.3]), np.array([0.3, -0.2, 0.7])
+    c.resetBaseVelocity(b.body, v.tolist(), w.tolist())  # type: ignore[attr-defined]
+    m = b.joint_space_inertia()
+    s = b.read_state(0.0)
+    mass = b.mass_properties().link_mass_kg
+    ke_links = 0.0
+    for i in range(len(mass)):
+        ls = c.getLinkState(b.body, b._link_idx[i], computeLinkVelocity=1)  # type: ignore[attr-defined]
+        inertia = np.diag(c.getDynamicsInfo(b.body, b._link_idx[i])[2])  # type: ignore[attr-defined]
+        r = rot.matrix_from_quat(rot.wxyz_from_xyzw(ls[1]))
+        ke_links += 0.5 * mass[i] * np.dot(ls[6], ls[6]) + 0.5 * np.asarray(ls[7]) @ r @ inertia @ r.T @ ls[7]
+    qd = np.zeros(ROOT_DOFS + N_JOINT_DOFS)
+    qd[:3], qd[3:6] = v, w
+    b.close()
+    assert not s.joint_vel.any()  # joints at rest: the energy is the root motion only
+    assert 0.5 * qd @ m @ qd == pytest.approx(ke_links, rel=2e-3)
+
+
+def test_symmetric_double_stance_needs_no_sideways_hip_or_ankle_torque():
+    b = make_backend(WorldConfig(), 600.0)
+    b.reset(np.array([0.0, 0.0, STANDING_ROOT_HEIGHT_M]), rot.IDENTITY_WXYZ)
+    s = b.read_state(0.0)
+    mass = b.mass_properties().link_mass_kg
+    ankles = {side: s.link_origin_world[s.link(f"{side}_ankle")] for side in ("left", "right")}
+    tau = gravity_torques(s, JointFrames(s), mass, 9.8, {"left": 0.5, "right": 0.5}, ankles)
+    b.close()
+    for side in ("left", "right"):
+        hip, _, ankle = LEG_JOINTS[side]
+        # model x is the lateral (roll) axis of hips and ankles at rest
+        assert abs(tau[hip, 0]) < 0.5 and abs(tau[ankle, 0]) < 0.5
+
+
+def test_support_points_balance_the_com():
+    ankles = {"left": np.array([0.0, 0.1, 0.07]), "right": np.array([0.2, -0.1, 0.07])}
+    w = {"left": 0.3, "right": 0.7}
+    com = np.array([0.18, 0.0, 0.9])
+    p = support_point(com, ankles, w)
+    centre = w["left"] * p["left"] + w["right"] * p["right"]
+    assert centre[:2] == pytest.approx(com[:2])
+
+
+def test_ankle_moment_is_limited_to_the_sole():
+    ankle = np.array([0.0, 0.0, 0.07])
+    f = 441.0
+    small = np.array([-2.0, 5.0, 0.0])  # centre of pressure 1.1 cm ahead, 0.5 cm to the left: on the sole
+    assert limit_ankle_moment(small, ankle, 0.0, f, 0.9) == pytest.approx(small)
+    big = np.array([0.0, 100.0, 0.0])  # 23 cm ahead of the ankle: beyond the toes
+    limited = limit_ankle_moment(big, ankle, 0.0, f, 0.9)
+    toe = 0.045 + 0.8 * 0.177 / 2
+    assert limited[1] == pytest.approx(toe * f)
+    twist = limit_ankle_moment(np.array([0.0, 0.0, 50.0]), ankle, 0.0, f, 0.9)
+    assert twist[2] == pytest.approx(0.9 * f * 0.03)
+
+
+def test_table3_gains_stay_stable_on_a_root_fixed_character():
+    # Table 3's gains without the implicit evaluation diverge at 600 Hz on the feet; with it they track.
+    from stylesync.control.pid import JointPid
+    from stylesync.sim.backend import Torques
+
+    b = make_backend(WorldConfig(), 600.0, fixed_root=True)
+    b.reset(np.array([0.0, 0.0, 1.5]), rot.IDENTITY_WXYZ)
+    target = random_pose(5, hinge_rad=0.5)
+    pid = JointPid(ControlConfig(), 1 / 600)
+    dt = 1 / 600
+    d = np.zeros((ROOT_DOFS + N_JOINT_DOFS,) * 2)
+    j = np.arange(ROOT_DOFS, ROOT_DOFS + N_JOINT_DOFS)
+    d[j, j] = flatten_joint_values(pid.kd * dt + pid.kp * dt * dt)
+    for i in range(1200):
+        if i % 4 == 0:
+            g = implicit_gain(b.joint_space_inertia(), d)[ROOT_DOFS:, ROOT_DOFS:]
+        fb = b.read_joint_feedback()
+        r = pid(fb.joint_pos, fb.joint_vel, target, np.zeros((12, 3)), predict_dt_s=dt)
+        b.apply_torques(Torques(unflatten_joint_values(g @ flatten_joint_values(r))))
+        b.step()
+    err = np.degrees(np.linalg.norm(joint_error(b.read_state(2.0).joint_pos, target), axis=1))
+    vel = b.read_state(2.0).joint_vel
+    b.close()
+    assert np.abs(vel).max() < 0.5  # settled, no oscillation
+    assert err.max() < 15.0  # PD without gravity compensation: a steady sag under gravity, bounded
+
+
+def test_free_character_stands_still_with_a_standing_operator():
+    cfg = SessionConfig(duration_s=10.0, operator=OperatorConfig(clip="stand"))
+    source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
+    result = Session(cfg, source).run()
+    assert not result.fell
+    com = np.stack([result.log.array("com_x"), result.log.array("com_y")], axis=1)
+    t = result.log.array("t")
+    settled = com[t >= 1.0]
+    drift = np.linalg.norm(settled - settled[0], axis=1).max()
+    assert drift < 0.02
