@@ -18,6 +18,7 @@ from stylesync import rotations as rot
 from stylesync.config import ControlConfig
 from stylesync.control import bounds as bnd
 from stylesync.control.crvc import (
+    HIP_JOINT,
     com_virtual_force,
     root_gain_scale,
     root_virtual_torque,
@@ -37,12 +38,10 @@ from stylesync.control.stable_pd import (
 from stylesync.control.support import limit_ankle_moment
 from stylesync.motion.reference import ReferencePose
 from stylesync.motion.stance_fsm import Stance
-from stylesync.sim.backend import CharacterState, JointFeedback, MassProperties, Torques
-from stylesync.sim.character import JOINT_NAMES, JOINTS, ROOT_DOFS
+from stylesync.sim.backend import CONTACT_FORCE_N, CharacterState, JointFeedback, MassProperties, Torques
+from stylesync.sim.character import JOINTS, ROOT_DOFS
 
-CONTACT_FORCE_N = 5.0  # a foot pressing the ground harder than this supports the body
 TORQUE_LIMIT = np.array([j.torque_limit_nm for j in JOINTS])[:, None]
-_HIP_INDEX = {s: JOINT_NAMES.index(f"{s}_hip") for s in ("left", "right")}
 
 
 @dataclass
@@ -76,10 +75,12 @@ class BalanceController:
         self._prev_ref_pos: np.ndarray | None = None
         self._ref_vel = np.zeros((len(JOINTS), 3))
         self.telemetry = ControlTelemetry(np.zeros(3), np.zeros(3), np.zeros(3))
-        self.saturated_ticks = 0  # control ticks whose virtual force was clamped to Eq. 26's bound
         self.root_kp, self.root_kd = cfg.root_torque_kp, cfg.root_torque_kd
         dt = physics_dt_s
-        self._joint_damping = flatten_joint_values(self.pid.kd * dt + self.pid.kp * dt * dt)
+        # D of stable_pd.py: the joints' diagonal is constant; the root torque's block is filled per tick.
+        self._damping = np.zeros((N_DOFS, N_DOFS))
+        j = np.arange(ROOT_DOFS, N_DOFS)
+        self._damping[j, j] = flatten_joint_values(self.pid.kd * dt + self.pid.kp * dt * dt)
         self._gain = np.eye(N_DOFS - ROOT_DOFS)  # G of stable_pd, joint rows and columns
         self._root_map = np.zeros((N_DOFS - ROOT_DOFS, 3))  # S: world root torque -> stance-hip DOF torques
 
@@ -87,12 +88,10 @@ class BalanceController:
                           mass_matrix: np.ndarray) -> None:
         """G = I - D (M + D)^-1 for this tick (stable_pd.py), with the root torque's feedback in D."""
         dt = self.physics_dt_s
-        d = np.zeros((N_DOFS, N_DOFS))
-        j = np.arange(ROOT_DOFS, N_DOFS)
-        d[j, j] = self._joint_damping
+        d = self._damping.copy()
         s_map = np.zeros((N_DOFS - ROOT_DOFS, 3))
         if self.cfg.root_virtual_torque:
-            hips = {side: state.joint_pos[_HIP_INDEX[side]] for side in ("left", "right")}
+            hips = {side: state.joint_pos[HIP_JOINT[side]] for side in ("left", "right")}
             s_map = stance_hip_map(state.root_quat_wxyz, hips, stance_weight)
             # Q_hips = S τ_r(ω_next): the root damping is implicit in the root's angular acceleration (DOFs 3-5).
             gain = root_gain_scale(self.cfg.root_yaw_gain_scale) * (self.root_kd * dt + self.root_kp * dt * dt)
@@ -135,7 +134,6 @@ class BalanceController:
         f_mag = float(np.linalg.norm(force[:2]))
         if f_mag > f_max:
             force[:2] *= f_max / f_mag
-            self.saturated_ticks += 1
         if ref.character_stance is Stance.DS:  # Eq. 24
             centre = 0.5 * (ref.ankle_world["left"] + ref.ankle_world["right"])
             d_c = float(np.linalg.norm((ref.com_world - centre)[:2]))

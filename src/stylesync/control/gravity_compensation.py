@@ -37,7 +37,6 @@ def gravity_torques(
     stance_weight: dict[str, float],
     ankle_world: dict[str, np.ndarray],
     skip_stance_ankle: bool = False,
-    foot_yaw_rad: dict[str, float] | None = None,
 ) -> np.ndarray:
     """Eq. 14-15 with stance-leg support. Returns the (n_joints, 3) torque layout [N·m].
 
@@ -54,7 +53,7 @@ def gravity_torques(
     c_sub = (SUBTREE_MASK @ weighted) / m_sub[:, None]
     moment = rot.cross(c_sub - frames.origin, m_sub[:, None] * g_up)  # (n_joints, 3)
     com = weighted.sum(axis=0) / m.sum()
-    for side, p in support_point(com, ankle_world, stance_weight, foot_yaw_rad).items():
+    for side, p in support_point(com, ankle_world, stance_weight).items():
         idx = LEG_JOINTS[side]
         if skip_stance_ankle:
             idx = idx[idx != ANKLE_JOINT[side]]

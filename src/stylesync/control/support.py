@@ -46,8 +46,6 @@ def support_point(com_world: np.ndarray, ankle_world: dict[str, np.ndarray],
     return out
 
 
-
-
 def limit_ankle_moment(moment_world: np.ndarray, ankle_world: np.ndarray, foot_yaw_rad: float,
                        normal_force_n: float, friction: float) -> np.ndarray:
     """The ankle's world moment [N·m] limited to what a foot carrying ``normal_force_n`` can pass to the ground.

@@ -35,7 +35,7 @@ from stylesync.motion.style_features import StyleExtractor, StyleFeatures
 from stylesync.processing.body_parameters import link_length
 from stylesync.processing.joint_map import hinge_angle
 from stylesync.processing.operator_processing import OperatorSample
-from stylesync.sim.backend import CharacterState, MassProperties
+from stylesync.sim.backend import CONTACT_FORCE_N, CharacterState, MassProperties
 from stylesync.sim.character import (
     ANKLE_HEIGHT_M,
     HIP_HALF_WIDTH_M,
@@ -53,7 +53,6 @@ _MIN_AXIS_SPREAD_M = 0.08
 _UP = np.array([0.0, 0.0, 1.0])
 LATE_CONTACT_PRESS_M = 0.02  # a swing foot held for a late contact is aimed this far below the ground [m]
 ANCHOR_BLEND_S = 0.15  # time constant over which a stance change's jump of the retargeting anchor is taken up
-_CONTACT_FORCE_N = 5.0  # a foot with more normal force than this is in contact
 _SCALE_SMOOTHING = 0.02  # per tick, exponential average of the operator's leg length
 _SIDE_UP = {"left": "LEFT", "right": "RIGHT"}
 _LINK = {n: i for i, n in enumerate(LINK_NAMES)}
@@ -104,7 +103,7 @@ class MotionOptimizer:
         cfg = self.cfg
         features = self.operator_features(sample)
         op_state = self.op_fsm.update(sample.pos["ANKLE_LEFT"][2], sample.pos["ANKLE_RIGHT"][2])
-        contact = {side: state.foot_contact_force_n[f"{side}_ankle"] > _CONTACT_FORCE_N for side in ("left", "right")}
+        contact = {side: state.foot_contact_force_n[f"{side}_ankle"] > CONTACT_FORCE_N for side in ("left", "right")}
         ch_state = self.char_fsm.update(op_state, contact, state.time_s)
         if self.char_fsm.hold_reference and self._held is not None:
             s = self._held  # late contact: keep the reference until the character's foot lands
@@ -127,6 +126,7 @@ class MotionOptimizer:
         # Planted feet are flat on the (level) ground: their ankle height is the model's, not the measured one,
         # which rises when a foot rolls and would feed back into the pelvis height of Eq. 9.
         a_plant = {k: np.array([v[0], v[1], ANKLE_HEIGHT_M]) for k, v in a_c.items()}
+        ankle_c_z = ANKLE_HEIGHT_M
         p_h = s.pos["PELVIS"]
         com_h = s.com_world
         com_c = mass.com(state)
@@ -138,12 +138,11 @@ class MotionOptimizer:
             com_xy = _heading_frame_fraction(com_h, a_h["left"], a_h["right"], a_c["left"], a_c["right"],
                                              scale, heading)
             ankle_h_z = 0.5 * (a_h["left"][2] + a_h["right"][2])
-            ankle_c_z = ANKLE_HEIGHT_M
         else:
             st = "left" if ch_state is Stance.LS else "right"
             pelvis_xy = a_c[st] + scale * (p_h - a_h[st])
             com_xy = a_c[st] + scale * (com_h - a_h[st])
-            ankle_h_z, ankle_c_z = a_h[st][2], ANKLE_HEIGHT_M
+            ankle_h_z = a_h[st][2]
         # A change of stance changes the anchor of Eq. 10 (the fraction between the feet, or the stance foot); the
         # operator's and the character's feet are never placed exactly alike, so the targets would jump. The jump
         # is taken up as an offset that decays with ANCHOR_BLEND_S.

@@ -15,6 +15,8 @@ import numpy as np
 from stylesync.config import WorldConfig
 from stylesync.sim.character import JOINT_NAMES, LINK_NAMES
 
+CONTACT_FORCE_N = 5.0  # a foot pressing the ground harder than this is in contact (supports the body) [N]
+
 
 @dataclass
 class CharacterState:
