@@ -1,41 +1,103 @@
-"""Command line: ``stylesync demo``."""
+"""Command line: ``stylesync demo``, ``stylesync run``, ``stylesync measure``."""
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import logging
 import sys
 from pathlib import Path
 
-from stylesync.config import ControlConfig, OperatorConfig, SessionConfig
+from stylesync.config import ClockConfig, ControlConfig, OperatorConfig, SessionConfig
 from stylesync.errors import StylesyncError
 
+_HEADLINE = ("fell", "fall_time_s", "sim_duration_s", "operator_steps", "character_steps", "realtime_factor")
 
-def _demo(args: argparse.Namespace) -> int:
+
+def _run_session(cfg: SessionConfig, source, out: Path, extra: dict) -> int:
     from stylesync.metrics.plots import write_plots, write_strip
     from stylesync.metrics.summary import summarize
     from stylesync.session import Session
+
+    out.mkdir(parents=True, exist_ok=True)
+    session = Session(cfg, source)
+    try:
+        result = session.run(render_every_s=max(cfg.duration_s / 8, 0.25))
+    finally:
+        source.close()
+    metrics = summarize(result) | extra
+    (out / "metrics.json").write_text(json.dumps(metrics, indent=2))
+    write_plots(result, out)
+    write_strip(session.renders, out / "render_strip.png")
+    print(json.dumps({k: metrics[k] for k in _HEADLINE}))
+    print(f"outputs in {out}")
+    return 0
+
+
+def _demo(args: argparse.Namespace) -> int:
     from stylesync.sources.builtin_operator import builtin_operator
 
     cfg = SessionConfig(duration_s=args.duration, seed=args.seed, gui=args.gui, realtime=args.realtime,
                         operator=OperatorConfig(clip=args.clip),
                         control=ControlConfig(lipm_time_sync=not args.no_lipm))
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
     source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
-    session = Session(cfg, source)
-    result = session.run(render_every_s=max(cfg.duration_s / 8, 0.25))
-    metrics = summarize(result)
-    metrics["clip"] = args.clip
-    metrics["lipm_time_sync"] = not args.no_lipm
-    (out / "metrics.json").write_text(json.dumps(metrics, indent=2))
-    write_plots(result, out)
-    write_strip(session.renders, out / "render_strip.png")
-    print(json.dumps({k: metrics[k] for k in ("fell", "fall_time_s", "sim_duration_s", "operator_steps",
-                                              "character_steps", "realtime_factor")}))
-    print(f"outputs in {out}")
+    return _run_session(cfg, source, Path(args.out), {"clip": args.clip, "lipm_time_sync": not args.no_lipm})
+
+
+def _open(args: argparse.Namespace, clocks: ClockConfig, duration_s: float | None):
+    from stylesync.sources.registry import open_source
+
+    return open_source(args.source, clocks=clocks, sensor=args.sensor, seed=args.seed, duration_s=duration_s,
+                       joint_map=args.joint_map, bvh_scale_m=args.bvh_scale, bvh_up_axis=args.bvh_up)
+
+
+def _run(args: argparse.Namespace) -> int:
+    clocks = ClockConfig()
+    opened = _open(args, clocks, args.duration)
+    live = opened.duration_s is None
+    if live and args.duration is None:
+        raise StylesyncError("a live source needs --duration (seconds to run)")
+    duration = args.duration if args.duration is not None else float(opened.duration_s or 0.0)
+    cfg = SessionConfig(duration_s=duration, seed=args.seed, gui=args.gui, realtime=args.realtime or live,
+                        clocks=dataclasses.replace(clocks, mocap_hz=opened.mocap_hz),
+                        control=ControlConfig(lipm_time_sync=not args.no_lipm))
+    return _run_session(cfg, opened.source, Path(args.out), {"source": args.source, "sensor": args.sensor,
+                                                              "lipm_time_sync": not args.no_lipm})
+
+
+def _measure(args: argparse.Namespace) -> int:
+    from stylesync.processing.body_parameters import measure_operator
+
+    opened = _open(args, ClockConfig(), None)
+    frames = opened.source.poll(float("inf")) if opened.duration_s is not None else []
+    if not frames:
+        wait = getattr(opened.source, "wait_first_frame", None)
+        if wait is not None and wait(10.0):
+            frames = opened.source.poll(0.0)
+    opened.source.close()
+    if not frames:
+        raise StylesyncError(f"{args.source}: no operator frame to measure")
+    cloud = None
+    if args.point_cloud:
+        from stylesync.processing.point_cloud_volume import load_point_cloud
+
+        cloud = load_point_cloud(args.point_cloud)
+    table = measure_operator(frames[: max(1, int(len(frames) * 0.1))], args.mass, cloud)
+    print(table.as_text())
     return 0
+
+
+def _add_source_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--source", required=True,
+                   help="bvh:PATH, k4a-json:PATH, deepmimic:NAME|PATH, builtin:NAME, vmc://HOST:PORT, webcam:INDEX, "
+                        "video:PATH, k4a:DEVICE")
+    p.add_argument("--sensor", default="kinect", choices=("kinect", "none"),
+                   help="recorded sources: 16 Hz Kinect-like sensor model, or the frames as recorded")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--joint-map", help="BVH: JSON object canonical joint -> BVH joint name")
+    p.add_argument("--bvh-scale", type=float, help="BVH: file units to metres (default: detected)")
+    p.add_argument("--bvh-up", help="BVH: up axis x|y|z, optionally signed (default: detected)")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -50,6 +112,19 @@ def main(argv: list[str] | None = None) -> int:
     demo.add_argument("--realtime", action="store_true", help="pace to the wall clock")
     demo.add_argument("--no-lipm", action="store_true", help="switch the LIPM time-sync compensation off (Eq. 21-23)")
     demo.set_defaults(func=_demo)
+    run = sub.add_parser("run", help="drive the character from an operator source")
+    _add_source_args(run)
+    run.add_argument("--duration", type=float, help="simulated seconds (default: the recording's length)")
+    run.add_argument("--out", default="out/run", help="output folder")
+    run.add_argument("--gui", action="store_true", help="open the PyBullet window")
+    run.add_argument("--realtime", action="store_true", help="pace to the wall clock (always for live sources)")
+    run.add_argument("--no-lipm", action="store_true", help="switch the LIPM time-sync compensation off")
+    run.set_defaults(func=_run)
+    measure = sub.add_parser("measure", help="print the operator's link table (Sec. 4.2, Table 2)")
+    _add_source_args(measure)
+    measure.add_argument("--mass", type=float, default=75.8, help="operator's total mass [kg]")
+    measure.add_argument("--point-cloud", help="body point cloud (.ply or .npy, metres, world frame)")
+    measure.set_defaults(func=_measure)
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     try:
@@ -57,6 +132,9 @@ def main(argv: list[str] | None = None) -> int:
     except StylesyncError as exc:
         print(f"stylesync: error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print("stylesync: interrupted", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":

@@ -233,3 +233,16 @@ def batch_rotvec(q: Array) -> Array:
     angle = 2.0 * np.arctan2(s, q[:, 0])
     scale = np.where(s > 1e-12, angle / np.maximum(s, 1e-12), 2.0)
     return v * scale[:, None]
+
+
+def batch_matrix_from_quat(q: Array) -> Array:
+    """Rotation matrices of each row, (n, 4) -> (n, 3, 3)."""
+    w, x, y, z = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+    return np.stack(
+        [
+            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], axis=1),
+            np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], axis=1),
+            np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], axis=1),
+        ],
+        axis=1,
+    )

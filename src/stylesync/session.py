@@ -33,6 +33,7 @@ from stylesync.sources.base import OperatorSource
 log = logging.getLogger("stylesync.session")
 FALL_ROOT_HEIGHT_M = 0.5  # a fall: pelvis below this height, or a non-foot link on the ground
 SILENT_STREAM_TIMEOUT_S = 2.0
+FIRST_FRAME_TIMEOUT_S = 10.0
 _LINK = {n: i for i, n in enumerate(LINK_NAMES)}
 STANCE_CODE = {Stance.LS: 0, Stance.DS: 1, Stance.RS: 2}
 
@@ -64,6 +65,7 @@ class SessionResult:
     dropped_joint_values: int
     bound_counts: dict[str, int]
     stage_ms: dict[str, list[float]]
+    input_latency_ms: list[float] = field(default_factory=list)  # live frames: arrival -> first control tick using it
 
 
 class Session:
@@ -85,6 +87,9 @@ class Session:
 
     def _place_character(self) -> None:
         """Stand the character where the operator stands (scaled), facing the operator's heading."""
+        wait = getattr(self.source, "wait_first_frame", None)
+        if wait is not None and not wait(FIRST_FRAME_TIMEOUT_S):
+            raise SourceError(f"no operator frame arrived within {FIRST_FRAME_TIMEOUT_S:.0f} s")
         frames = self.source.poll(0.0)
         if not frames:
             raise SourceError("the operator source delivered no frame at start (t = 0 s)")
@@ -110,6 +115,7 @@ class Session:
         next_render = 0.0
         last_frame_sim = 0.0
         fell, fall_time, fall_reason = False, None, ""
+        latency_ms: list[float] = []
         wall0 = time.perf_counter()
         step = 0
         for step in range(n_steps):
@@ -120,6 +126,8 @@ class Session:
                 frames = self.source.poll(t)
                 for f in frames:
                     self.processing.push(f)
+                    if "arrival_wall_s" in f.extras:
+                        latency_ms.append((c0 - f.extras["arrival_wall_s"]) * 1e3)
                 if frames:
                     last_frame_sim = t
                 elif t - last_frame_sim > SILENT_STREAM_TIMEOUT_S and self._source_is_live():
@@ -164,7 +172,7 @@ class Session:
         sim_t = (step + 1) * dt if not fell else float(fall_time or 0.0)
         return SessionResult(tick_log, fell, fall_time, fall_reason, sim_t, wall, step + 1,
                              getattr(self.source, "rejected_frames", 0), self.processing.dropped_joint_values,
-                             dict(self.bounds.counts), stage_ms)
+                             dict(self.bounds.counts), stage_ms, latency_ms)
 
     def _source_is_live(self) -> bool:
         return bool(getattr(self.source, "live", False))

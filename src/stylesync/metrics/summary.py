@@ -63,4 +63,14 @@ def summarize(result: SessionResult) -> dict:
         "rejected_frames": result.rejected_frames,
         "dropped_joint_values": result.dropped_joint_values,
         "bound_violations": result.bound_counts,
+        "input_latency_ms": _latency(result.input_latency_ms),
     }
+
+
+def _latency(ms: list[float]) -> dict | None:
+    """Live frames: time from a frame's arrival to the first control tick that uses it [ms]."""
+    if not ms:
+        return None
+    a = np.asarray(ms)
+    return {"p50": float(np.percentile(a, 50)), "p95": float(np.percentile(a, 95)), "max": float(a.max()),
+            "count": len(a)}

@@ -2,11 +2,13 @@
 
 Without a body point cloud the link masses come from a published anthropometric table: Winter, *Biomechanics and
 Motor Control of Human Movement*, 4th ed. (2009), Table 4.1 (segment mass fractions and COM locations, after
-Dempster 1955). The micro-cuboid volume method (Eq. 2-5) needs a point cloud and lives in
-``processing/point_cloud_volume.py`` when one is available.
+Dempster 1955). With a body point cloud, masses come from link volumes by the micro-cuboid method (Eq. 2-5,
+``processing/point_cloud_volume.py``).
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -54,3 +56,84 @@ def leg_length_m(pos: dict[str, np.ndarray], ankle_height_m: float) -> float:
     lengths = [link_length(pos[f"HIP_{s}"], pos[f"KNEE_{s}"]) + link_length(pos[f"KNEE_{s}"], pos[f"ANKLE_{s}"])
                for s in ("LEFT", "RIGHT")]
     return float(np.mean(lengths)) + ankle_height_m
+
+
+# Table 2 rows: (row, proximal joint, distal joint, Winter mass fraction of one such link). Winter splits the trunk
+# 0.497 into thorax 0.216 + abdomen 0.139 (our torso, 0.355) and pelvis 0.142.
+TABLE2_ROWS: tuple[tuple[str, str, str, float], ...] = (
+    ("pelvis", "PELVIS", "SPINE_CHEST", 0.142),
+    ("torso", "SPINE_CHEST", "NECK", 0.355),
+    ("head", "NECK", "HEAD", 0.081),
+    ("upper_arm", "SHOULDER_{S}", "ELBOW_{S}", 0.028),
+    ("lower_arm", "ELBOW_{S}", "WRIST_{S}", 0.022),
+    ("upper_leg", "HIP_{S}", "KNEE_{S}", 0.100),
+    ("lower_leg", "KNEE_{S}", "ANKLE_{S}", 0.0465),
+    ("foot", "ANKLE_{S}", "FOOT_{S}", 0.0145),
+)
+
+
+@dataclass
+class LinkTable:
+    """The operator's links as in Table 2's human column: length [m] (Eq. 1) and mass [kg] (Eq. 2)."""
+
+    total_mass_kg: float
+    length_m: dict[str, float]
+    mass_kg: dict[str, float]
+    method: str  # "point cloud (Eq. 2-5)" or "anthropometric table (Winter 2009)"
+    com_world: np.ndarray  # operator COM of the first frame (Eq. 6) [m]
+
+    def as_text(self) -> str:
+        lines = [f"operator links ({self.method}), total mass {self.total_mass_kg:.1f} kg",
+                 f"{'link':<10} {'length [m]':>10} {'mass [kg]':>10} {'mass [%]':>9}"]
+        for name in self.length_m:
+            m = self.mass_kg[name]
+            lines.append(f"{name:<10} {self.length_m[name]:>10.3f} {m:>10.2f} {100 * m / self.total_mass_kg:>9.1f}")
+        lines.append("COM (first frame) [m]: " + " ".join(f"{v:.3f}" for v in self.com_world))
+        return "\n".join(lines)
+
+
+def _link_ends(row: tuple[str, str, str, float], side: str) -> tuple[str, str]:
+    return row[1].format(S=side), row[2].format(S=side)
+
+
+def measure_operator(frames: list, total_mass_kg: float, point_cloud_world: np.ndarray | None = None) -> LinkTable:
+    """Sec. 4.2 on operator frames: link lengths by Eq. 1 (median over the frames, mean of both sides), masses by
+    volume proportion from a point cloud (Eq. 2-5) or from Winter's table, the COM by Eq. 6."""
+    if not (np.isfinite(total_mass_kg) and total_mass_kg > 0):
+        raise ValueError(f"total mass must be > 0 kg, got {total_mass_kg}")
+    length: dict[str, float] = {}
+    for row in TABLE2_ROWS:
+        sides = ("LEFT", "RIGHT") if "{S}" in row[1] else ("",)
+        vals = [link_length(f.pos(a), f.pos(b)) for f in frames for a, b in (_link_ends(row, s) for s in sides)]
+        length[row[0]] = float(np.median(vals))
+    first = frames[0]
+    pos = {n: first.pos(n) for n in first_joint_names()}
+    if point_cloud_world is None:
+        fractions = {row[0]: row[3] for row in TABLE2_ROWS}
+        total = sum(f * (2 if "{S}" in r[1] else 1) for r, f in zip(TABLE2_ROWS, fractions.values(), strict=True))
+        mass = {n: total_mass_kg * f / total for n, f in fractions.items()}
+        method = "anthropometric table (Winter 2009)"
+    else:
+        from stylesync.processing.point_cloud_volume import link_volumes, masses_by_volume
+        from stylesync.rotations import yaw_from_quat
+
+        links = {}
+        for row in TABLE2_ROWS:
+            for s in (("LEFT", "RIGHT") if "{S}" in row[1] else ("",)):
+                a, b = _link_ends(row, s)
+                links[f"{row[0]}{'_' + s.lower() if s else ''}"] = (pos[a], pos[b])
+        vols = link_volumes(point_cloud_world, links, yaw_from_quat(first.quat("PELVIS")))
+        by_link = masses_by_volume(vols, total_mass_kg)
+        mass = {row[0]: (0.5 * (by_link[f"{row[0]}_left"] + by_link[f"{row[0]}_right"]) if "{S}" in row[1]
+                         else by_link[row[0]]) for row in TABLE2_ROWS}
+        method = "point cloud (Eq. 2-5)"
+    return LinkTable(total_mass_kg, length, mass, method, com_from_joints(pos))
+
+
+def first_joint_names() -> tuple[str, ...]:
+    """Joints Eq. 6 and the link table read."""
+    names = {n for seg in WINTER_SEGMENTS for n in seg[1:3]}
+    for row in TABLE2_ROWS:
+        for s in ("LEFT", "RIGHT"):
+            names |= set(_link_ends(row, s))
+    return tuple(sorted(names))

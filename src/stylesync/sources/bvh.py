@@ -1,0 +1,231 @@
+"""BVH files as recorded operators (``bvh:PATH``), parsed with the maintained ``bvhio`` library.
+
+Joints are matched by name to the canonical skeleton (sources/frame.py). Names are compared after dropping a
+namespace prefix (``mixamorig:``), a Biped prefix (``Bip01``), case, spaces and punctuation; each canonical joint has
+a list of candidates tried in order, which covers the MotionBuilder naming (CMU subject 2, Mixamo: ``LeftUpLeg``,
+``LeftLeg``, ``LeftArm`` ...), the 3ds-Max naming (CMU subject 131: ``LeftHip``, ``LeftKnee``, ``LeftShoulder`` for
+the upper arm ...) and Biped (``Bip01 L Thigh`` ...). A JSON object ``{"HIP_LEFT": "MyThigh", ...}`` given as
+``joint_map`` overrides any entry.
+
+Units: unless given, the scale to metres is the one of {m, cm, mm, inch, CMU (0.056444)} that makes the rest-pose
+stature (ankle-to-head joint / 0.87) 1.0-2.3 m. Up axis: unless given, the file axis closest to head-minus-ankles
+in the rest pose. The floor is placed by :func:`place_on_floor`.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from stylesync import rotations as rot
+from stylesync.errors import SourceError
+from stylesync.sources.frame import JOINT_INDEX, N_JOINTS
+from stylesync.sources.skeleton_tracks import (
+    REQUIRED_JOINTS,
+    SEGMENT_DIRECTIONS,
+    TrackPerformer,
+    fill_canonical,
+    place_on_floor,
+    rest_corrections,
+)
+
+_SIDE_CANDIDATES: dict[str, tuple[str, ...]] = {
+    "HIP": ("{side}upleg", "{s}thigh", "{side}upperleg", "{side}thigh", "{side}hip"),
+    "KNEE": ("{side}leg", "{s}calf", "{side}lowerleg", "{side}shin", "{side}knee"),
+    "ANKLE": ("{side}foot", "{s}foot", "{side}ankle"),
+    "FOOT": ("{side}toebase", "{s}toe0", "{side}toes", "{side}toe", "{s}toe"),
+    "SHOULDER": ("{side}arm", "{s}upperarm", "{side}upperarm", "{side}shoulder"),
+    "ELBOW": ("{side}forearm", "{s}forearm", "{side}lowerarm", "{side}elbow"),
+    "WRIST": ("{side}wrist", "{side}hand", "{s}hand"),
+}
+_CENTRE_CANDIDATES: dict[str, tuple[str, ...]] = {
+    "PELVIS": ("hips", "pelvis", "hip", "root"),
+    "SPINE_CHEST": ("spine2", "chest2", "upperchest", "spine1", "chest", "spine"),
+    "NECK": ("neck", "lowerneck", "neck1"),
+    "HEAD": ("head",),
+}
+UNIT_SCALES_M: dict[str, float] = {"m": 1.0, "cm": 0.01, "mm": 0.001, "inch": 0.0254, "cmu": 0.056444}
+STATURE_RANGE_M = (1.0, 2.3)
+
+
+def name_candidates() -> dict[str, tuple[str, ...]]:
+    """Canonical joint -> normalised BVH joint names tried in order."""
+    out = dict(_CENTRE_CANDIDATES)
+    for side, s in (("left", "l"), ("right", "r")):
+        for part, patterns in _SIDE_CANDIDATES.items():
+            out[f"{part}_{side.upper()}"] = tuple(p.format(side=side, s=s) for p in patterns)
+    return out
+
+
+def normalise_name(name: str) -> str:
+    n = name.rsplit(":", 1)[-1].lower()
+    n = re.sub(r"^bip0*1", "", n)
+    return re.sub(r"[^a-z0-9]", "", n)
+
+
+def load_joint_map(path: str | Path) -> dict[str, str]:
+    try:
+        data = json.loads(Path(path).read_text())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise SourceError(f"joint map {path}: cannot read a JSON object ({exc})") from None
+    if not isinstance(data, dict) or not all(isinstance(k, str) and isinstance(v, str) for k, v in data.items()):
+        raise SourceError(f"joint map {path}: expected a JSON object of canonical joint -> BVH joint name")
+    unknown = sorted(set(data) - set(JOINT_INDEX))
+    if unknown:
+        raise SourceError(f"joint map {path}: unknown canonical joints {unknown}; expected names like HIP_LEFT")
+    return data
+
+
+def match_joints(names: list[str], joint_map: dict[str, str] | None = None) -> dict[str, str]:
+    """Canonical joint -> BVH joint name, for the canonical joints found; raises when a required one is missing."""
+    by_norm: dict[str, str] = {}
+    for n in names:
+        by_norm.setdefault(normalise_name(n), n)
+    out: dict[str, str] = {}
+    for canon, cands in name_candidates().items():
+        for c in cands:
+            if c in by_norm:
+                out[canon] = by_norm[c]
+                break
+    for canon, bvh_name in (joint_map or {}).items():
+        if bvh_name not in names:
+            raise SourceError(f"joint map names '{bvh_name}' for {canon}, but the BVH has no such joint")
+        out[canon] = bvh_name
+    missing = [j for j in REQUIRED_JOINTS if j not in out]
+    if missing:
+        raise SourceError(f"unknown skeleton: no BVH joint found for {', '.join(missing)} (joints in file: "
+                          f"{', '.join(names[:40])}); give a joint map (JSON canonical -> BVH name)")
+    return out
+
+
+def _axes_matrix(up_axis: int, up_sign: float) -> np.ndarray:
+    """File axes -> ours (z up), a proper rotation: ours z = file up, ours x, y = the next two file axes."""
+    A = np.zeros((3, 3))
+    A[2, up_axis] = up_sign
+    A[0, (up_axis + 1) % 3] = up_sign
+    A[1, (up_axis + 2) % 3] = 1.0
+    return A
+
+
+def _depth_first(root: Any) -> list[tuple[Any, int]]:
+    """(joint, parent index) in depth-first order, parents before children."""
+    out: list[tuple[Any, int]] = []
+    stack: list[tuple[Any, int]] = [(root, -1)]
+    while stack:
+        joint, parent = stack.pop()
+        out.append((joint, parent))
+        me = len(out) - 1
+        stack.extend((child, me) for child in reversed(joint.Children))
+    return out
+
+
+class BvhRecording:
+    """A BVH file on the canonical skeleton; ``performer`` replays it."""
+
+    def __init__(self, path: str | Path, joint_map: dict[str, str] | None = None, scale_m: float | None = None,
+                 up_axis: str | None = None):
+        import bvhio
+
+        p = Path(path)
+        if not p.is_file():
+            raise SourceError(f"BVH file not found: {p}")
+        try:
+            container = bvhio.readAsBvh(str(p))
+            joints = _depth_first(container.Root)
+            frame_time = float(container.FrameTime)
+            n_frames = int(container.FrameCount)
+        except Exception as exc:  # noqa: BLE001 - any failure of the third-party parser is a bad file
+            raise SourceError(f"BVH file {p} could not be parsed: {type(exc).__name__}: {exc}".splitlines()[0]
+                              ) from None
+        if n_frames < 1 or not np.isfinite(frame_time) or frame_time <= 0:
+            raise SourceError(f"BVH file {p}: needs at least one frame and a frame time > 0 s")
+        names = [j.Name for j, _ in joints]
+        parent_index = [par for _, par in joints]
+        if len(set(names)) != len(names):
+            raise SourceError(f"BVH file {p}: joint names are not unique")
+        try:
+            local_pos = np.array([[[k.Position.x, k.Position.y, k.Position.z] for k in j.Keyframes]
+                                  for j, _ in joints], dtype=float)  # (J, T, 3)
+            local_q = np.array([[[k.Rotation.w, k.Rotation.x, k.Rotation.y, k.Rotation.z] for k in j.Keyframes]
+                                for j, _ in joints], dtype=float)  # (J, T, 4)
+            offsets = np.array([[j.Offset.x, j.Offset.y, j.Offset.z] for j, _ in joints], dtype=float)
+        except (AttributeError, TypeError, ValueError) as exc:
+            raise SourceError(f"BVH file {p}: malformed motion data ({exc})") from None
+        if local_pos.shape[1] != n_frames or local_q.shape[1] != n_frames:
+            raise SourceError(f"BVH file {p}: {n_frames} frames declared, motion data truncated")
+        if not (np.all(np.isfinite(local_pos)) and np.all(np.isfinite(local_q)) and np.all(np.isfinite(offsets))):
+            raise SourceError(f"BVH file {p} contains NaN or infinite values")
+        self.path = p
+        self.joint_names = names
+        self.mapping = match_joints(names, joint_map)
+        idx = {canon: names.index(n) for canon, n in self.mapping.items()}
+
+        # Rest pose (all rotations identity): cumulative offsets, file units and axes.
+        rest = np.zeros((len(names), 3))
+        for j, par in enumerate(parent_index):
+            rest[j] = offsets[j] + (rest[par] if par >= 0 else 0.0)
+        # A segment joint that coincides with the next one (CMU's Spine1 sits on its Neck) gives way to its parent.
+        for seg, (distal, _) in SEGMENT_DIRECTIONS.items():
+            while np.linalg.norm(rest[idx[distal]] - rest[idx[seg]]) < 1e-9 and parent_index[idx[seg]] >= 0:
+                idx[seg] = parent_index[idx[seg]]
+                self.mapping[seg] = names[idx[seg]]
+        ankles = 0.5 * (rest[idx["ANKLE_LEFT"]] + rest[idx["ANKLE_RIGHT"]])
+        up_vec = rest[idx["HEAD"]] - ankles
+        if up_axis is None:
+            ax = int(np.argmax(np.abs(up_vec)))
+            sign = float(np.sign(up_vec[ax]) or 1.0)
+        else:
+            if up_axis.lstrip("+-") not in ("x", "y", "z"):
+                raise SourceError(f"up axis must be x, y or z (optionally signed), got '{up_axis}'")
+            ax, sign = "xyz".index(up_axis.lstrip("+-")), (-1.0 if up_axis.startswith("-") else 1.0)
+        stature_units = float(abs(up_vec[ax])) * 1.15  # rest ankle-to-head-joint, ~87 % of stature
+        if scale_m is None:
+            fits = [s for s in UNIT_SCALES_M.values() if STATURE_RANGE_M[0] <= stature_units * s <= STATURE_RANGE_M[1]]
+            if not fits:
+                raise SourceError(f"BVH file {p}: rest-pose stature {stature_units:.3g} file units fits none of the "
+                                  f"units {sorted(UNIT_SCALES_M)}; give the scale to metres")
+            scale_m = fits[0]
+        if not (np.isfinite(scale_m) and scale_m > 0):
+            raise SourceError(f"BVH scale to metres must be > 0, got {scale_m}")
+        self.scale_m = float(scale_m)
+        self.stature_m = stature_units * self.scale_m
+        A = _axes_matrix(ax, sign)
+        q_axes = rot.quat_from_matrix(A)
+
+        # Forward kinematics over all frames, file axes.
+        T = n_frames
+        world_pos = np.zeros((len(names), T, 3))
+        world_R = np.zeros((len(names), T, 3, 3))
+        world_q = np.zeros((len(names), T, 4))
+        for j, par in enumerate(parent_index):
+            q_l = local_q[j] / np.linalg.norm(local_q[j], axis=1, keepdims=True)
+            if par < 0:
+                world_q[j] = q_l
+                world_pos[j] = local_pos[j]
+            else:
+                world_q[j] = rot.batch_multiply(world_q[par], q_l)
+                world_pos[j] = world_pos[par] + np.einsum("tij,tj->ti", world_R[par], local_pos[j])
+            world_R[j] = rot.batch_matrix_from_quat(world_q[j])
+
+        # Our axes and metres; canonical segment orientations q(t) = (A R_file(t) A^T) ⊗ q_rest.
+        rest_ours = {canon: A @ rest[i] * self.scale_m for canon, i in idx.items()}
+        q_rest = rest_corrections(rest_ours)
+        pos = np.zeros((T, N_JOINTS, 3))
+        quat = np.tile(rot.IDENTITY_WXYZ, (T, N_JOINTS, 1))
+        conf = np.zeros((T, N_JOINTS))
+        qa = np.tile(q_axes, (T, 1))
+        qa_inv = rot.batch_conjugate(qa)
+        for canon, i in idx.items():
+            k = JOINT_INDEX[canon]
+            pos[:, k] = world_pos[i] @ A.T * self.scale_m
+            conf[:, k] = 1.0
+            if canon in q_rest:
+                q_ours = rot.batch_multiply(rot.batch_multiply(qa, world_q[i]), qa_inv)
+                quat[:, k] = rot.batch_multiply(q_ours, np.tile(q_rest[canon], (T, 1)))
+        fill_canonical(pos, quat, conf)
+        place_on_floor(pos)
+        self.performer = TrackPerformer(np.arange(T) * frame_time, pos, quat, conf, name=f"bvh:{p.name}")

@@ -1,0 +1,126 @@
+"""Opening an operator source from a spec string (``stylesync run --source SPEC``).
+
+Specs: ``bvh:PATH``, ``k4a-json:PATH``, ``deepmimic:NAME|PATH`` (pybullet_data clip name, or a clip file),
+``builtin:NAME`` (same as the demo), ``vmc://HOST:PORT``, ``webcam:INDEX``, ``video:PATH``, ``k4a:DEVICE`` (live Azure
+Kinect). Recorded sources pass through the sensor model: ``kinect`` resamples to the mocap rate (16 Hz) with noise,
+jitter and dropouts from the seed; ``none`` passes the recorded frames at their own rate (the processing stage then
+interpolates from that rate). A recorded operator first holds its first pose for ``lead_in_s``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from stylesync.config import ClockConfig, OperatorConfig
+from stylesync.errors import SourceError
+from stylesync.sources.base import OperatorSource, RecordedSource
+from stylesync.sources.frame import OperatorFrame
+from stylesync.sources.sensor_model import SensorModel
+
+SENSORS = ("kinect", "none")
+KINECT_DROPOUT_PROBABILITY = 0.002  # per joint and frame: occasional lost joints, as a depth sensor has
+
+
+@dataclass
+class OpenedSource:
+    source: OperatorSource
+    mocap_hz: float  # rate the processing stage interpolates from [Hz]
+    duration_s: float | None  # length of a recording (with its lead-in) [s]; None for a live stream
+    label: str
+    performer: object | None = None  # noise-free recording, ``frame_at(t)``
+
+
+class _LeadIn:
+    """Holds a performer's first pose for ``lead_in_s`` seconds, then plays it."""
+
+    def __init__(self, performer, lead_in_s: float):
+        self.performer, self.lead_in_s = performer, lead_in_s
+        self.duration_s = performer.duration_s + lead_in_s
+
+    def frame_at(self, t_s: float) -> OperatorFrame:
+        f = self.performer.frame_at(max(0.0, t_s - self.lead_in_s))
+        f.timestamp_s = t_s
+        return f
+
+
+def _recorded(performer, label: str, sensor: str, clocks: ClockConfig, op: OperatorConfig, seed: int,
+              duration_s: float | None) -> OpenedSource:
+    lead = _LeadIn(performer, op.standing_lead_in_s)
+    total = lead.duration_s if duration_s is None else duration_s
+    if sensor == "kinect":
+        model = SensorModel(rate_hz=clocks.mocap_hz, position_noise_m=op.position_noise_m,
+                            orientation_noise_rad=op.orientation_noise_rad, timestamp_jitter_s=op.timestamp_jitter_s,
+                            dropout_probability=KINECT_DROPOUT_PROBABILITY, seed=seed)
+        return OpenedSource(RecordedSource(model.sample(lead.frame_at, total), name=label), clocks.mocap_hz,
+                            lead.duration_s, label, lead)
+    if sensor != "none":
+        raise SourceError(f"unknown sensor model '{sensor}'; expected one of {', '.join(SENSORS)}")
+    rate = getattr(performer, "rate_hz", 0.0) or clocks.mocap_hz
+    n = int(total * rate) + 1
+    frames = [lead.frame_at(k / rate) for k in range(n)]
+    return OpenedSource(RecordedSource(frames, name=label), rate, lead.duration_s, label, lead)
+
+
+def open_source(spec: str, clocks: ClockConfig | None = None, operator: OperatorConfig | None = None,
+                sensor: str = "kinect", seed: int = 0, duration_s: float | None = None,
+                joint_map: str | None = None, bvh_scale_m: float | None = None,
+                bvh_up_axis: str | None = None) -> OpenedSource:
+    clocks = clocks or ClockConfig()
+    op = operator or OperatorConfig()
+    kind, _, arg = spec.partition(":")
+    if kind == "bvh":
+        from stylesync.sources.bvh import BvhRecording, load_joint_map
+
+        jm = load_joint_map(joint_map) if joint_map else None
+        rec = BvhRecording(arg, joint_map=jm, scale_m=bvh_scale_m, up_axis=bvh_up_axis)
+        return _recorded(rec.performer, spec, sensor, clocks, op, seed, duration_s)
+    if kind == "k4a-json":
+        from stylesync.sources.k4abt_json import K4abtRecording
+
+        k4a = K4abtRecording(arg)
+        opened = _recorded(k4a.performer, spec, sensor, clocks, op, seed, duration_s)
+        opened.source.rejected_frames += k4a.rejected_frames
+        return opened
+    if kind in ("deepmimic", "builtin"):
+        from stylesync.sources.builtin_operator import ClipPerformer
+        from stylesync.sources.deepmimic_clip import DeepMimicClip
+        from stylesync.sources.human_model import HumanModel
+
+        is_path = arg.endswith(".txt") or "/" in arg
+        clip = DeepMimicClip.load(arg) if is_path else DeepMimicClip.builtin(arg)
+        human = HumanModel(op.height_m, op.mass_kg)
+        performer = ClipPerformer(clip, human, op.standing_lead_in_s)
+        total = (duration_s if duration_s is not None else
+                 (clip.duration_s if not clip.loop else 12.0) + op.standing_lead_in_s)
+        model = SensorModel(rate_hz=clocks.mocap_hz, position_noise_m=op.position_noise_m,
+                            orientation_noise_rad=op.orientation_noise_rad, timestamp_jitter_s=op.timestamp_jitter_s,
+                            dropout_probability=KINECT_DROPOUT_PROBABILITY if sensor == "kinect" else 0.0, seed=seed)
+        if sensor == "none":
+            model = SensorModel(rate_hz=clocks.mocap_hz, position_noise_m=0.0, orientation_noise_rad=0.0,
+                                timestamp_jitter_s=0.0, seed=seed)
+        elif sensor != "kinect":
+            raise SourceError(f"unknown sensor model '{sensor}'; expected one of {', '.join(SENSORS)}")
+        return OpenedSource(RecordedSource(model.sample(performer.frame_at, total), name=spec), clocks.mocap_hz,
+                            total, spec, performer)
+    if spec.startswith("vmc://"):
+        from stylesync.sources.vmc import DEFAULT_PORT, VmcSource
+
+        host, _, port = spec.removeprefix("vmc://").partition(":")
+        try:
+            port_n = int(port) if port else DEFAULT_PORT
+        except ValueError:
+            raise SourceError(f"VMC port must be a number: '{spec}'") from None
+        return OpenedSource(VmcSource(host or "127.0.0.1", port_n), 60.0, None, spec)
+    if kind in ("webcam", "video"):
+        from stylesync.sources.webcam import MediaPipeSource
+
+        return OpenedSource(MediaPipeSource(arg, is_file=kind == "video"), 30.0, None, spec)
+    if kind == "k4a":
+        from stylesync.sources.azure_kinect import AzureKinectSource
+
+        return OpenedSource(AzureKinectSource(int(arg or 0)), 30.0, None, spec)
+    if kind and Path(spec).suffix.lower() == ".bvh":
+        raise SourceError(f"unknown source '{spec}'; did you mean bvh:{spec}?")
+    raise SourceError(f"unknown source '{spec}'; expected bvh:PATH, k4a-json:PATH, deepmimic:NAME|PATH, "
+                      f"builtin:NAME, vmc://HOST:PORT, webcam:INDEX, video:PATH or k4a:DEVICE")

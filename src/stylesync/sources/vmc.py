@@ -1,0 +1,314 @@
+"""Live operator stream in the VMC protocol (``vmc://HOST:PORT``): OSC over UDP, as VTuber and motion-capture
+tools send it (Virtual Motion Capture, VSeeFace, XR Animator ...).
+
+Messages read: ``/VMC/Ext/Root/Pos`` (name, position xyz, rotation xyzw of the root in the world) and
+``/VMC/Ext/Bone/Pos`` (Unity humanoid bone name, local position xyz, local rotation xyzw relative to the parent
+bone); ``/VMC/Ext/T`` (sender time [s]) closes a frame, and so does a new root message after bones arrived (for
+senders without ``T``). Unity axes are left-handed, y up, z forward, metres; we convert to ours (x forward, y left,
+z up): ``p_ours = (p_z, -p_x, p_y)``, and a quaternion's vector part ``(-q_z, q_x, -q_y)``. Bone rotations are
+taken relative to a normalised avatar's rest pose (identity local rotations in its T-pose, as VRM avatars are);
+the rest pose's segment directions come from the bones' local positions (sources/skeleton_tracks.py).
+
+The socket listens on 127.0.0.1 unless another host is given. Each completed frame is stamped with its arrival
+time (``extras["arrival_wall_s"]``, ``time.perf_counter``) so that the session can measure the latency from
+arrival to the first control tick that uses it. Frames with NaN, missing bones or garbage arguments are rejected,
+counted and logged. :class:`VmcSender` sends operator frames in the same protocol (for tests and for relaying).
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections import deque
+from typing import Any
+
+import numpy as np
+
+from stylesync import rotations as rot
+from stylesync.errors import SourceError
+from stylesync.sources.base import OperatorSource
+from stylesync.sources.frame import JOINT_INDEX, N_JOINTS, OperatorFrame
+from stylesync.sources.skeleton_tracks import fill_canonical, rest_corrections
+
+log = logging.getLogger("stylesync.sources")
+
+# Unity humanoid bone -> parent bone (UpperChest is optional; bones under it fall back to Chest).
+UNITY_PARENT: dict[str, str | None] = {
+    "Hips": None, "Spine": "Hips", "Chest": "Spine", "UpperChest": "Chest", "Neck": "UpperChest", "Head": "Neck",
+    "LeftUpperLeg": "Hips", "LeftLowerLeg": "LeftUpperLeg", "LeftFoot": "LeftLowerLeg", "LeftToes": "LeftFoot",
+    "RightUpperLeg": "Hips", "RightLowerLeg": "RightUpperLeg", "RightFoot": "RightLowerLeg", "RightToes": "RightFoot",
+    "LeftShoulder": "UpperChest", "LeftUpperArm": "LeftShoulder", "LeftLowerArm": "LeftUpperArm",
+    "LeftHand": "LeftLowerArm", "RightShoulder": "UpperChest", "RightUpperArm": "RightShoulder",
+    "RightLowerArm": "RightUpperArm", "RightHand": "RightLowerArm",
+}
+CANONICAL_BONE: dict[str, str] = {
+    "PELVIS": "Hips", "SPINE_CHEST": "Chest", "NECK": "Neck", "HEAD": "Head",
+    "HIP_LEFT": "LeftUpperLeg", "KNEE_LEFT": "LeftLowerLeg", "ANKLE_LEFT": "LeftFoot", "FOOT_LEFT": "LeftToes",
+    "HIP_RIGHT": "RightUpperLeg", "KNEE_RIGHT": "RightLowerLeg", "ANKLE_RIGHT": "RightFoot", "FOOT_RIGHT": "RightToes",
+    "SHOULDER_LEFT": "LeftUpperArm", "ELBOW_LEFT": "LeftLowerArm", "WRIST_LEFT": "LeftHand",
+    "SHOULDER_RIGHT": "RightUpperArm", "ELBOW_RIGHT": "RightLowerArm", "WRIST_RIGHT": "RightHand",
+}
+REQUIRED_BONES = tuple(b for b in CANONICAL_BONE.values() if not b.endswith("Toes"))
+DEFAULT_PORT = 39539  # the VMC protocol's usual performer -> marionette port
+
+
+def ours_from_unity_pos(p) -> np.ndarray:
+    x, y, z = (float(v) for v in p)
+    return np.array([z, -x, y])
+
+
+def unity_from_ours_pos(p) -> np.ndarray:
+    x, y, z = (float(v) for v in p)
+    return np.array([-y, z, x])
+
+
+def ours_from_unity_quat(q_xyzw) -> np.ndarray:
+    """Unity (x, y, z, w), left-handed, to our (w, x, y, z): the reflection flips the rotation's sense."""
+    x, y, z, w = (float(v) for v in q_xyzw)
+    return rot.normalize(np.array([w, -z, x, -y]))
+
+
+def unity_from_ours_quat(q_wxyz) -> np.ndarray:
+    w, x, y, z = (float(v) for v in q_wxyz)
+    return np.array([y, -z, -x, w])
+
+
+def _parent(bone: str, present: set[str]) -> str | None:
+    par = UNITY_PARENT[bone]
+    while par is not None and par not in present:
+        par = UNITY_PARENT[par]
+    return par
+
+
+def frame_from_bones(t_s: float, root_pos: np.ndarray, root_q: np.ndarray,
+                     bones: dict[str, tuple[np.ndarray, np.ndarray]],
+                     q_rest: dict[str, np.ndarray] | None = None) -> tuple[OperatorFrame, dict[str, np.ndarray]]:
+    """Forward kinematics of one VMC frame (our axes) into an operator frame; returns it and the rest corrections
+    (computed from the bones' local positions when not given)."""
+    present = set(bones)
+    missing = [b for b in REQUIRED_BONES if b not in present]
+    if missing:
+        raise SourceError(f"VMC frame lacks bones {', '.join(missing)}")
+    order = [b for b in UNITY_PARENT if b in present]
+    world_p: dict[str, np.ndarray] = {}
+    world_q: dict[str, np.ndarray] = {}
+    rest_p: dict[str, np.ndarray] = {}
+    for b in order:
+        lp, lq = bones[b]
+        par = _parent(b, present)
+        if par is None:
+            world_q[b] = rot.multiply(root_q, lq)
+            world_p[b] = root_pos + rot.rotate(root_q, lp)
+            rest_p[b] = lp.copy()
+        else:
+            world_q[b] = rot.multiply(world_q[par], lq)
+            world_p[b] = world_p[par] + rot.rotate(world_q[par], lp)
+            rest_p[b] = rest_p[par] + lp
+    pos = np.zeros((1, N_JOINTS, 3))
+    quat = np.tile(rot.IDENTITY_WXYZ, (1, N_JOINTS, 1))
+    conf = np.zeros((1, N_JOINTS))
+    rest_canon: dict[str, np.ndarray] = {}
+    for canon, bone in CANONICAL_BONE.items():
+        if bone in present:
+            pos[0, JOINT_INDEX[canon]] = world_p[bone]
+            rest_canon[canon] = rest_p[bone]
+            conf[0, JOINT_INDEX[canon]] = 1.0
+    for side, bone in (("LEFT", "LeftFoot"), ("RIGHT", "RightFoot")):
+        if f"{side.capitalize()}Toes" not in present:  # no toes: a point 12 cm ahead of the ankle, on its sole
+            k = JOINT_INDEX[f"FOOT_{side}"]
+            pos[0, k] = world_p[bone] + rot.rotate(world_q[bone], np.array([0.12, 0.0, -0.06]))
+            rest_canon[f"FOOT_{side}"] = rest_p[bone] + np.array([0.12, 0.0, -0.06])
+            conf[0, k] = 1.0
+    if q_rest is None:
+        q_rest = rest_corrections(rest_canon)
+    for canon, qr in q_rest.items():
+        quat[0, JOINT_INDEX[canon]] = rot.multiply(world_q[CANONICAL_BONE[canon]], qr)
+    fill_canonical(pos, quat, conf)
+    return OperatorFrame(t_s, pos[0], quat[0], conf[0]), q_rest
+
+
+class VmcSource(OperatorSource):
+    """Listens for VMC packets; ``poll`` returns the frames completed since the last call."""
+
+    live = True
+
+    def __init__(self, host: str = "127.0.0.1", port: int = DEFAULT_PORT, max_queue: int = 256):
+        try:
+            from pythonosc.dispatcher import Dispatcher
+            from pythonosc.osc_server import ThreadingOSCUDPServer
+        except ImportError:
+            raise SourceError("the VMC source needs python-osc: pip install 'stylesync[live]'") from None
+        self.host, self.rejected_frames = host, 0
+        self._lock = threading.Lock()
+        self._queue: deque[OperatorFrame] = deque(maxlen=max_queue)
+        self._root: tuple[np.ndarray, np.ndarray] | None = None
+        self._bones: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+        self._q_rest: dict[str, np.ndarray] | None = None
+        self._t0 = time.perf_counter()
+        self.frames_received = 0
+        d = Dispatcher()
+        d.map("/VMC/Ext/Root/Pos", self._on_root)
+        d.map("/VMC/Ext/Bone/Pos", self._on_bone)
+        d.map("/VMC/Ext/T", self._on_time)
+        try:
+            self._server = ThreadingOSCUDPServer((host, port), d)
+        except OSError as exc:
+            raise SourceError(f"cannot listen for VMC on {host}:{port}: {exc.strerror or exc}") from None
+        self.port = int(self._server.server_address[1])
+        self._thread = threading.Thread(target=self._server.serve_forever, name="vmc-listener", daemon=True)
+        self._thread.start()
+
+    def _on_root(self, _addr: str, *args: Any) -> None:
+        if self._bones:
+            self._complete(None)
+        try:
+            p = ours_from_unity_pos(args[1:4])
+            q = ours_from_unity_quat(args[4:8])
+        except (ValueError, TypeError, IndexError):
+            self._reject("malformed /VMC/Ext/Root/Pos")
+            return
+        self._root = (p, q)
+
+    def _on_bone(self, _addr: str, *args: Any) -> None:
+        try:
+            name = str(args[0])
+            p = ours_from_unity_pos(args[1:4])
+            q = ours_from_unity_quat(args[4:8])
+        except (ValueError, TypeError, IndexError):
+            self._reject("malformed /VMC/Ext/Bone/Pos")
+            return
+        if name in UNITY_PARENT:
+            self._bones[name] = (p, q)
+
+    def _on_time(self, _addr: str, *args: Any) -> None:
+        try:
+            t = float(args[0])
+        except (ValueError, TypeError, IndexError):
+            t = None
+        self._complete(t)
+
+    def _complete(self, sender_time_s: float | None) -> None:
+        arrival = time.perf_counter()
+        bones, root = self._bones, self._root
+        self._bones = {}
+        if root is None or not bones:
+            return
+        if not (np.all(np.isfinite(root[0])) and all(np.all(np.isfinite(p)) and np.all(np.isfinite(q))
+                                                     for p, q in bones.values())):
+            self._reject("NaN or infinite values")
+            return
+        try:
+            frame, q_rest = frame_from_bones(arrival - self._t0, root[0], root[1], bones, self._q_rest)
+        except SourceError as exc:
+            self._reject(str(exc))
+            return
+        self._q_rest = q_rest
+        frame.extras["arrival_wall_s"] = arrival
+        if sender_time_s is not None:
+            frame.extras["sender_time_s"] = sender_time_s
+        with self._lock:
+            self._queue.append(frame)
+            self.frames_received += 1
+
+    def _reject(self, why: str) -> None:
+        self.rejected_frames += 1
+        if self.rejected_frames <= 10 or self.rejected_frames % 100 == 0:
+            log.warning("vmc: rejected frame (%s), %d so far", why, self.rejected_frames)
+
+    def poll(self, now_s: float) -> list[OperatorFrame]:
+        with self._lock:
+            frames = list(self._queue)
+            self._queue.clear()
+        return frames
+
+    def wait_first_frame(self, timeout_s: float) -> bool:
+        """Block until a frame has arrived (True) or the timeout passes (False)."""
+        end = time.perf_counter() + timeout_s
+        while time.perf_counter() < end:
+            with self._lock:
+                if self._queue:
+                    return True
+            time.sleep(0.005)
+        return False
+
+    def close(self) -> None:
+        self._server.shutdown()
+        self._server.server_close()
+
+
+class VmcSender:
+    """Sends operator frames as VMC packets (one OSC bundle per frame) to ``host:port``.
+
+    The avatar is a normalised T-pose skeleton whose bones are measured on the first frame (offsets in each
+    segment's canonical frame, limb lengths).
+    """
+
+    def __init__(self, host: str = "127.0.0.1", port: int = DEFAULT_PORT):
+        from pythonosc.udp_client import SimpleUDPClient
+
+        self._client = SimpleUDPClient(host, port)
+        self._rest_local: dict[str, np.ndarray] | None = None
+        self._q_rest: dict[str, np.ndarray] | None = None
+
+    def _rest_from(self, frame: OperatorFrame) -> None:
+        """A T-pose avatar with the frame's bone lengths: legs down, arms out sideways, feet forward."""
+        length = {b: float(np.linalg.norm(frame.pos(c) - frame.pos(p))) for c, p, b in (
+            ("KNEE_LEFT", "HIP_LEFT", "LeftLowerLeg"), ("ANKLE_LEFT", "KNEE_LEFT", "LeftFoot"),
+            ("ELBOW_LEFT", "SHOULDER_LEFT", "LeftLowerArm"), ("WRIST_LEFT", "ELBOW_LEFT", "LeftHand"))}
+        def in_frame(seg: str, a: str, b: str) -> np.ndarray:
+            """b - a in the canonical frame of ``seg`` (its rest pose is the identity)."""
+            return rot.rotate(rot.conjugate(frame.quat(seg)), frame.pos(b) - frame.pos(a))
+
+        chest = in_frame("PELVIS", "PELVIS", "SPINE_CHEST")
+        local = {"Hips": np.zeros(3), "Spine": 0.5 * chest, "Chest": 0.5 * chest,
+                 "Neck": in_frame("SPINE_CHEST", "SPINE_CHEST", "NECK"), "Head": in_frame("NECK", "NECK", "HEAD")}
+        for side, s in (("Left", 1.0), ("Right", -1.0)):
+            S = side.upper()
+            shoulder = in_frame("SPINE_CHEST", "SPINE_CHEST", f"SHOULDER_{S}")
+            local |= {f"{side}UpperLeg": in_frame("PELVIS", "PELVIS", f"HIP_{S}"),
+                      f"{side}LowerLeg": np.array([0, 0, -length["LeftLowerLeg"]]),
+                      f"{side}Foot": np.array([0, 0, -length["LeftFoot"]]),
+                      f"{side}Toes": in_frame(f"ANKLE_{S}", f"ANKLE_{S}", f"FOOT_{S}"),
+                      f"{side}Shoulder": 0.3 * shoulder, f"{side}UpperArm": 0.7 * shoulder,
+                      f"{side}LowerArm": np.array([0, s * length["LeftLowerArm"], 0]),
+                      f"{side}Hand": np.array([0, s * length["LeftHand"], 0])}
+        self._rest_local = local
+        rest_abs: dict[str, np.ndarray] = {}
+        for b in local:
+            par = _parent(b, set(local))
+            rest_abs[b] = local[b] + (rest_abs[par] if par else 0.0)
+        self._q_rest = rest_corrections({c: rest_abs[b] for c, b in CANONICAL_BONE.items()})
+
+    def send(self, frame: OperatorFrame, sender_time_s: float | None = None) -> None:
+        from pythonosc.osc_bundle_builder import IMMEDIATELY, OscBundleBuilder
+        from pythonosc.osc_message_builder import OscMessageBuilder
+
+        if self._rest_local is None:
+            self._rest_from(frame)
+        assert self._rest_local is not None and self._q_rest is not None
+        # World rotation of each bone relative to the T-pose: canonical ⊗ rest⁻¹.
+        world_q = {CANONICAL_BONE[c]: rot.multiply(frame.quat(c), rot.conjugate(qr)) for c, qr in self._q_rest.items()}
+        world_q["Spine"] = world_q["Hips"]
+        world_q["Head"] = world_q["Neck"]
+        for side in ("Left", "Right"):
+            world_q[f"{side}Shoulder"] = world_q["Chest"]
+            world_q[f"{side}Toes"] = world_q[f"{side}Foot"]
+            world_q[f"{side}Hand"] = world_q[f"{side}LowerArm"]
+        bundle = OscBundleBuilder(IMMEDIATELY)
+
+        def msg(addr: str, args: list) -> None:
+            m = OscMessageBuilder(address=addr)
+            for a in args:
+                m.add_arg(a)
+            bundle.add_content(m.build())  # type: ignore[arg-type]
+
+        root_p = frame.pos("PELVIS")
+        msg("/VMC/Ext/Root/Pos", ["root", *unity_from_ours_pos(root_p).tolist(),
+                                  *unity_from_ours_quat(rot.IDENTITY_WXYZ).tolist()])
+        for b, lp in self._rest_local.items():
+            par = _parent(b, set(self._rest_local))
+            lq = world_q[b] if par is None else rot.multiply(rot.conjugate(world_q[par]), world_q[b])
+            msg("/VMC/Ext/Bone/Pos", [b, *unity_from_ours_pos(lp).tolist(), *unity_from_ours_quat(lq).tolist()])
+        msg("/VMC/Ext/T", [float(frame.timestamp_s if sender_time_s is None else sender_time_s)])
+        self._client.send(bundle.build())
