@@ -1,12 +1,14 @@
 """Link volumes from a body point cloud by the micro-cuboid method (Sec. 4.2, Eq. 2-5).
 
 The cloud is seen along the body's sagittal axis (its forward direction): the coronal plane (lateral y, vertical
-z) is cut into square cells of side ``cell_m``; in each cell the thickness of the body is the distance between
-its front-most and back-most points (Eq. 3, t_pc = |pc_f - pc_b|); the cells tile the cloud's extent exactly, the micro cuboid's volume is the cell area times
-that thickness (Eq. 4) and the volumes add up (Eq. 5). The paper uses the sensor's point grid as the cells; a
-regular grid of a chosen size does the same for clouds from any source (PLY scans, synthetic bodies). For a
-link's volume the cloud is first split by link: each point goes to the nearest link axis (the segment between
-the link's two joints, Eq. 1). Link masses are then the total mass shared by volume proportion (Eq. 2).
+z) is cut into square cells of side about ``cell_m`` that tile the cloud's extent exactly; in each cell the
+thickness of the body is the distance between its front-most and back-most points (Eq. 3, t_pc = |pc_f - pc_b|),
+the micro cuboid's volume is the cell area times that thickness (Eq. 4) and the volumes add up (Eq. 5). The paper
+uses the sensor's point grid as the cells; a regular grid does the same for clouds from any source (PLY scans,
+synthetic bodies). The cloud must be dense enough that every cell holds points of both surfaces (about ten points
+per cell face; 3 mm cells need about 1 point per mm^2). For a link's volume the cloud is first split by link: each
+point goes to the nearest link axis (the segment between the link's two joints, Eq. 1). Link masses are then the
+total mass shared by volume proportion (Eq. 2).
 """
 
 from __future__ import annotations
