@@ -1,0 +1,314 @@
+"""Operator inputs: BVH, Azure Kinect JSON, VMC, the source registry, body parameters (Sec. 4.1-4.2)."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from stylesync import rotations as rot
+from stylesync.cli import main as cli_main
+from stylesync.errors import SourceError
+from stylesync.processing.body_parameters import TABLE2_ROWS, com_from_joints, measure_operator
+from stylesync.processing.point_cloud_volume import load_point_cloud, micro_cuboid_volume
+from stylesync.sources.bvh import BvhRecording, load_joint_map
+from stylesync.sources.frame import JOINT_INDEX
+from stylesync.sources.human_model import HumanModel
+from stylesync.sources.k4abt_json import K4abtRecording, write_k4abt_json
+from stylesync.sources.registry import open_source
+from stylesync.sources.skeleton_tracks import SEGMENT_DIRECTIONS
+
+CMU = Path(__file__).resolve().parents[1].parent / "shared" / "mocap" / "cmu"
+needs_cmu = pytest.mark.skipif(not CMU.is_dir(), reason="../shared/mocap/cmu (CMU BVH clips) is not present")
+
+# A small BVH in centimetres, Y up, MotionBuilder names; the rest pose is a T-pose facing +z.
+# (name, parent, offset, end site or None)
+TINY_SKELETON = [
+    ("Hips", None, (0, 0, 0), None),
+    ("LeftUpLeg", "Hips", (10, 0, 0), None), ("LeftLeg", "LeftUpLeg", (0, -42, 0), None),
+    ("LeftFoot", "LeftLeg", (0, -42, 0), None), ("LeftToeBase", "LeftFoot", (0, -5, 14), (0, 0, 4)),
+    ("RightUpLeg", "Hips", (-10, 0, 0), None), ("RightLeg", "RightUpLeg", (0, -42, 0), None),
+    ("RightFoot", "RightLeg", (0, -42, 0), None), ("RightToeBase", "RightFoot", (0, -5, 14), (0, 0, 4)),
+    ("Spine", "Hips", (0, 25, 0), None), ("Neck", "Spine", (0, 25, 0), None), ("Head", "Neck", (0, 15, 0), (0, 10, 0)),
+    ("LeftArm", "Spine", (18, 22, 0), None), ("LeftForeArm", "LeftArm", (28, 0, 0), None),
+    ("LeftHand", "LeftForeArm", (25, 0, 0), (8, 0, 0)),
+    ("RightArm", "Spine", (-18, 22, 0), None), ("RightForeArm", "RightArm", (-28, 0, 0), None),
+    ("RightHand", "RightForeArm", (-25, 0, 0), (-8, 0, 0)),
+]
+_N_CHANNELS = 6 + 3 * (len(TINY_SKELETON) - 1)
+
+
+def _hierarchy(names: dict[str, str]) -> str:
+    def block(name: str, depth: int) -> list[str]:
+        _, parent, off, end = next(j for j in TINY_SKELETON if j[0] == name)
+        pad = "  " * depth
+        head = "ROOT" if parent is None else "JOINT"
+        chans = ("CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation" if parent is None
+                 else "CHANNELS 3 Zrotation Xrotation Yrotation")
+        lines = [f"{pad}{head} {names.get(name, name)}", f"{pad}{{", f"{pad}  OFFSET {off[0]} {off[1]} {off[2]}",
+                 f"{pad}  {chans}"]
+        for child in (j[0] for j in TINY_SKELETON if j[1] == name):
+            lines += block(child, depth + 1)
+        if end is not None:
+            lines += [f"{pad}  End Site", f"{pad}  {{", f"{pad}    OFFSET {end[0]} {end[1]} {end[2]}", f"{pad}  }}"]
+        return lines + [f"{pad}}}"]
+
+    return "HIERARCHY\n" + "\n".join(block("Hips", 0)) + "\n"
+
+
+def _write_tiny(tmp_path: Path, motion: list[list[float]] | None = None, names: dict[str, str] | None = None) -> Path:
+    rows = motion or [[0, 95, 0] + [0.0] * (_N_CHANNELS - 3) for _ in range(3)]
+    p = tmp_path / "tiny.bvh"
+    p.write_text(_hierarchy(names or {}) + f"MOTION\nFrames: {len(rows)}\nFrame Time: 0.0333333\n"
+                 + "\n".join(" ".join(f"{v:g}" for v in r) for r in rows) + "\n")
+    return p
+
+
+def test_tiny_bvh_units_axes_and_rest_pose(tmp_path):
+    rec = BvhRecording(_write_tiny(tmp_path))
+    assert rec.scale_m == pytest.approx(0.01)
+    f = rec.performer.frame_at(0.0)
+    # Y-up file -> z up; the hips 20 cm apart, the head above the pelvis.
+    assert np.linalg.norm(f.pos("HIP_LEFT") - f.pos("HIP_RIGHT")) == pytest.approx(0.20, abs=1e-6)
+    assert f.pos("HEAD")[2] - f.pos("PELVIS")[2] == pytest.approx(0.65, abs=1e-6)
+    # floor: lowest ankle at Winter's ankle height, 0.079 of the 0.84 m hip-to-ankle length
+    assert f.pos("ANKLE_LEFT")[2] == pytest.approx(0.039 / 0.491 * 0.84, abs=1e-3)
+    # rest pose: every canonical segment hangs or stands as in the canonical rest pose, facing the file's +z
+    yaw = rot.yaw_from_quat(f.quat("PELVIS"))
+    facing = f.pos("FOOT_LEFT") - f.pos("ANKLE_LEFT")
+    assert np.arctan2(facing[1], facing[0]) == pytest.approx(yaw, abs=1e-6)
+    for seg, (distal, d0) in SEGMENT_DIRECTIONS.items():
+        if seg.startswith("ANKLE"):
+            continue
+        d = f.pos(distal) - f.pos(seg)
+        assert rot.rotate(f.quat(seg), np.array(d0)) @ d / np.linalg.norm(d) == pytest.approx(1.0, abs=1e-6), seg
+
+
+def test_bvh_rotation_moves_the_segment(tmp_path):
+    motion = [[0, 95, 0] + [0.0] * (_N_CHANNELS - 3) for _ in range(3)]
+    motion[2][6 + 1] = -90.0  # LeftUpLeg Xrotation -90 deg: the thigh swings forward, towards the file's +z
+    rec = BvhRecording(_write_tiny(tmp_path, motion))
+    f0, f2 = rec.performer.frame_at(0.0), rec.performer.frame_at(2 * 0.0333333)
+    knee_rel = f2.pos("KNEE_LEFT") - f2.pos("HIP_LEFT")
+    assert knee_rel[2] == pytest.approx(0.0, abs=1e-6)  # horizontal thigh
+    yaw = rot.yaw_from_quat(f0.quat("PELVIS"))
+    assert knee_rel[:2] @ np.array([np.cos(yaw), np.sin(yaw)]) == pytest.approx(0.42, abs=1e-6)  # forward
+    d = rot.rotate(f2.quat("HIP_LEFT"), np.array([0.0, 0.0, -1.0]))
+    assert d @ knee_rel / 0.42 == pytest.approx(1.0, abs=1e-6)
+
+
+def test_unknown_skeleton_and_custom_joint_map(tmp_path):
+    p = _write_tiny(tmp_path, names={"LeftUpLeg": "Oberschenkel_L"})
+    with pytest.raises(SourceError, match="HIP_LEFT"):
+        BvhRecording(p)
+    jm = tmp_path / "map.json"
+    jm.write_text(json.dumps({"HIP_LEFT": "Oberschenkel_L"}))
+    rec = BvhRecording(p, joint_map=load_joint_map(jm))
+    assert rec.mapping["HIP_LEFT"] == "Oberschenkel_L"
+    jm.write_text(json.dumps({"HIPS": "x"}))
+    with pytest.raises(SourceError, match="unknown canonical"):
+        load_joint_map(jm)
+
+
+@needs_cmu
+@pytest.mark.parametrize("name, upper_arm", [("02_01", "LeftArm"), ("131_01", "LeftShoulder")])
+def test_cmu_namings(name, upper_arm):
+    rec = BvhRecording(CMU / f"{name}.bvh")
+    assert rec.scale_m == pytest.approx(0.056444)
+    assert rec.mapping["SHOULDER_LEFT"] == upper_arm
+    f = rec.performer.frame_at(1.0)
+    leg = np.linalg.norm(f.pos("HIP_LEFT") - f.pos("KNEE_LEFT")) + np.linalg.norm(f.pos("KNEE_LEFT")
+                                                                                  - f.pos("ANKLE_LEFT"))
+    assert 0.7 < leg < 0.95
+    for seg in ("HIP_LEFT", "KNEE_RIGHT", "SHOULDER_LEFT", "ELBOW_RIGHT"):
+        distal, d0 = SEGMENT_DIRECTIONS[seg]
+        d = f.pos(distal) - f.pos(seg)
+        assert rot.rotate(f.quat(seg), np.array(d0)) @ d / np.linalg.norm(d) > 0.999
+
+
+@given(st.binary(max_size=400))
+@settings(max_examples=40, deadline=None)
+def test_bvh_parser_fails_cleanly_on_garbage(tmp_path_factory, data):
+    p = tmp_path_factory.mktemp("b") / "x.bvh"
+    p.write_bytes(data)
+    with pytest.raises(SourceError):
+        BvhRecording(p)
+
+
+@given(st.integers(min_value=0, max_value=2000), st.sampled_from(["nan", "inf", "x", ""]))
+@settings(max_examples=25, deadline=None)
+def test_bvh_truncated_or_non_finite(tmp_path_factory, cut, bad):
+    tmp = tmp_path_factory.mktemp("t")
+    text = _write_tiny(tmp).read_text()
+    p = tmp / "bad.bvh"
+    p.write_text(text[: len(text) - 1 - cut % 200] if bad == "" else text.replace(" 95 ", f" {bad} ", 1))
+    try:
+        rec = BvhRecording(p)
+    except SourceError:
+        return
+    # What parses must be finite.
+    assert np.all(np.isfinite(rec.performer.pos_world))
+
+
+@given(st.recursive(st.none() | st.booleans() | st.floats(allow_nan=True) | st.text(max_size=5),
+                    lambda c: st.lists(c, max_size=4) | st.dictionaries(st.text(max_size=8), c, max_size=4),
+                    max_leaves=30))
+@settings(max_examples=60, deadline=None)
+def test_k4a_json_fails_cleanly(tmp_path_factory, doc):
+    p = tmp_path_factory.mktemp("k") / "x.json"
+    p.write_text(json.dumps({"frames": doc}) if not isinstance(doc, dict) else json.dumps(doc))
+    with pytest.raises(SourceError):
+        K4abtRecording(p)
+
+
+def test_k4a_json_rejects_bad_frames_and_keeps_good_ones(tmp_path):
+    human = HumanModel()
+    frames = [human.frame_from_pose(k / 30, np.array([0.01 * k, 0, 0.93]), {}) for k in range(10)]
+    p = tmp_path / "rec.json"
+    write_k4abt_json(frames, p)
+    doc = json.loads(p.read_text())
+    doc["frames"][3]["bodies"][0]["joint_positions"][5][0] = None  # garbage
+    doc["frames"][5]["timestamp_usec"] = 0  # back in time
+    doc["frames"][7]["bodies"] = []  # lost body
+    del doc["stylesync_orientation"]  # orientations from positions, as for SDK files
+    p.write_text(json.dumps(doc))
+    rec = K4abtRecording(p)
+    assert rec.rejected_frames == 3
+    assert len(rec.performer.times_s) == 7
+
+
+def test_k4a_json_round_trip_is_exact_to_the_micrometre(tmp_path):
+    human = HumanModel()
+    frames = [human.frame_from_pose(k / 30, np.array([0.02 * k, 0.1, 0.93]),
+                                    {"HIP_LEFT": rot.quat_from_axis_angle(np.array([0, 1.0, 0]), -0.02 * k)})
+              for k in range(20)]
+    p = tmp_path / "rec.json"
+    write_k4abt_json(frames, p)
+    back = K4abtRecording(p).performer
+    shift = back.pos_world[0, JOINT_INDEX["PELVIS"]] - frames[0].pos("PELVIS")
+    assert np.allclose(shift[:2], 0.0, atol=1e-5)  # the floor may move z only
+    for k, f in enumerate(frames):
+        assert np.allclose(back.pos_world[k] - shift, f.joint_pos_world, atol=1e-5)
+        assert np.allclose(np.abs(np.sum(back.quat_wxyz[k] * f.joint_quat_wxyz, axis=1)), 1.0, atol=1e-6)
+
+
+@needs_cmu
+def test_k4a_json_from_bvh_replays_to_the_same_character_motion(tmp_path):
+    from stylesync.config import SessionConfig
+    from stylesync.session import Session
+
+    bvh = CMU / "02_01.bvh"
+    rec = BvhRecording(bvh)
+    k4a = tmp_path / "02_01.json"
+    write_k4abt_json(rec.performer.frames(), k4a)
+    roots = []
+    for spec in (f"bvh:{bvh}", f"k4a-json:{k4a}"):
+        opened = open_source(spec, seed=3, duration_s=2.0)
+        result = Session(SessionConfig(duration_s=2.0), opened.source).run()
+        roots.append(np.stack([result.log.array("com_x"), result.log.array("com_y"), result.log.array("com_z")], 1))
+    n = min(len(r) for r in roots)
+    assert n > 200
+    assert np.max(np.linalg.norm(roots[0][:n] - roots[1][:n], axis=1)) < 0.005  # sensor noise is 5 mm
+
+
+def test_vmc_stream_from_another_process_drives_the_character(tmp_path):
+    pytest.importorskip("pythonosc")
+    from stylesync.config import SessionConfig
+    from stylesync.session import Session
+    from stylesync.sources.vmc import VmcSource
+
+    source = VmcSource("127.0.0.1", 0)
+    sender = subprocess.Popen([sys.executable, "-c", f"""
+from stylesync.sources.human_model import HumanModel
+from stylesync.sources.vmc import VmcSender
+import numpy as np
+h = HumanModel(); s = VmcSender('127.0.0.1', {source.port}); t0 = time.perf_counter()
+for k in range(int(5.0 * 60)):
+    s.send(h.frame_from_pose(k / 60, np.array([0.3, -0.2, h.hip_height_m]), {{}}))
+    time.sleep(max(0.0, t0 + (k + 1) / 60 - time.perf_counter()))
+"""])
+    try:
+        result = Session(SessionConfig(duration_s=3.0, realtime=True), source).run()
+    finally:
+        sender.wait(timeout=30)
+    assert not result.fell
+    assert source.frames_received > 120 and source.rejected_frames == 0
+    assert len(result.input_latency_ms) > 100
+    # the character stands where the (scaled) operator stands: COM over the operator's x-y
+    com = np.array([result.log.array("com_x")[-1], result.log.array("com_y")[-1]])
+    assert np.linalg.norm(com - np.array([0.3, -0.2])) < 0.1
+
+
+def test_registry_errors_are_one_line(tmp_path, capsys):
+    with pytest.raises(SourceError, match="unknown source"):
+        open_source("nonsense:1")
+    with pytest.raises(SourceError, match="not found"):
+        open_source(f"bvh:{tmp_path / 'missing.bvh'}")
+    assert cli_main(["run", "--source", f"bvh:{tmp_path / 'missing.bvh'}", "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("stylesync: error:") and "\n" not in err
+    try:
+        import mediapipe  # noqa: F401
+    except ImportError:
+        with pytest.raises(SourceError, match="pip install"):
+            open_source("webcam:0")
+
+
+def _box_points(a, b, c, n, rng):
+    areas = np.array([b * c, b * c, a * c, a * c, a * b, a * b])
+    k = (n * areas / areas.sum()).astype(int)
+    u = rng.random
+    return np.vstack([
+        np.c_[np.zeros(k[0]), u(k[0]) * b, u(k[0]) * c], np.c_[np.full(k[1], a), u(k[1]) * b, u(k[1]) * c],
+        np.c_[u(k[2]) * a, np.zeros(k[2]), u(k[2]) * c], np.c_[u(k[3]) * a, np.full(k[3], b), u(k[3]) * c],
+        np.c_[u(k[4]) * a, u(k[4]) * b, np.zeros(k[4])], np.c_[u(k[5]) * a, u(k[5]) * b, np.full(k[5], c)]])
+
+
+def test_micro_cuboid_volume_of_box_and_cylinder_within_2_percent():
+    rng = np.random.default_rng(0)
+    box = _box_points(0.3, 0.2, 0.5, 600_000, rng)
+    assert micro_cuboid_volume(box) == pytest.approx(0.3 * 0.2 * 0.5, rel=0.02)
+    n = 500_000
+    th, z = rng.random(n) * 2 * np.pi, rng.random(n) * 0.5
+    cyl = np.c_[0.1 * np.cos(th), 0.1 * np.sin(th), z]
+    assert micro_cuboid_volume(cyl) == pytest.approx(np.pi * 0.1**2 * 0.5, rel=0.02)
+    # lying on its side (axis along the sagittal x): rectangle silhouette, circular depth profile
+    cyl_x = np.c_[z, 0.1 * np.cos(th), 0.1 * np.sin(th)]
+    assert micro_cuboid_volume(cyl_x) == pytest.approx(np.pi * 0.1**2 * 0.5, rel=0.02)
+
+
+def test_point_cloud_loader_rejects_bad_files(tmp_path):
+    p = tmp_path / "c.npy"
+    np.save(p, np.array([[0, 0, np.nan]] * 5))
+    with pytest.raises(SourceError, match="NaN"):
+        load_point_cloud(p)
+    (tmp_path / "c.ply").write_text("ply\nformat ascii 1.0\nelement vertex 3\nend_header\n1 2\n")
+    with pytest.raises(SourceError):
+        load_point_cloud(tmp_path / "c.ply")
+
+
+def test_anthropometric_fallback_reproduces_its_table_and_com_lies_between_the_feet():
+    human = HumanModel(1.75, 75.8)
+    f = human.frame_from_pose(0.0, np.array([0.0, 0.0, human.hip_height_m]), {})
+    table = measure_operator([f], 75.8)
+    per_side = {r[0]: r[3] for r in TABLE2_ROWS}
+    total = sum(v * (2 if "{S}" in r[1] else 1) for r, v in zip(TABLE2_ROWS, per_side.values(), strict=True))
+    assert total == pytest.approx(1.0, abs=0.002)  # Winter's fractions sum to one
+    for name, frac in per_side.items():
+        assert table.mass_kg[name] == pytest.approx(75.8 * frac / total, rel=1e-9)
+    assert table.length_m["upper_leg"] == pytest.approx(human.thigh_m, rel=1e-6)
+    com = com_from_joints({n: f.pos(n) for n in JOINT_INDEX})
+    yl, yr = f.pos("ANKLE_LEFT")[1], f.pos("ANKLE_RIGHT")[1]
+    assert min(yl, yr) < com[1] < max(yl, yr) and abs(com[1]) < 1e-9
+    heel_x, toe_x = f.pos("ANKLE_LEFT")[0] - 0.05, f.pos("FOOT_LEFT")[0]
+    assert heel_x < com[0] < toe_x
+
+
+def test_measure_cli_prints_the_link_table(capsys):
+    assert cli_main(["measure", "--source", "deepmimic:walk", "--mass", "70"]) == 0
+    out = capsys.readouterr().out
+    assert "upper_leg" in out and "70.0 kg" in out
