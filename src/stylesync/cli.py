@@ -1,4 +1,4 @@
-"""Command line: ``stylesync demo``, ``stylesync run``, ``stylesync measure``."""
+"""Command line: ``stylesync demo``, ``run``, ``measure``, ``replay``."""
 
 from __future__ import annotations
 
@@ -15,19 +15,51 @@ from stylesync.errors import StylesyncError
 _HEADLINE = ("fell", "fall_time_s", "sim_duration_s", "operator_steps", "character_steps", "realtime_factor")
 
 
-def _run_session(cfg: SessionConfig, source, out: Path, extra: dict) -> int:
+class _Progress:
+    """One status line on stderr: simulated time, realtime factor, falls (at most twice a second)."""
+
+    def __init__(self, duration_s: float):
+        self.duration_s, self._last = duration_s, -1.0
+
+    def __call__(self, sim_s: float, wall_s: float) -> None:
+        if wall_s - self._last < 0.5:
+            return
+        self._last = wall_s
+        done = int(30 * sim_s / self.duration_s)
+        print(f"\r[{'#' * done}{'.' * (30 - done)}] {sim_s:6.2f}/{self.duration_s:.2f} s sim, "
+              f"{sim_s / max(wall_s, 1e-9):4.1f}x real time", end="", file=sys.stderr, flush=True)
+
+    def done(self, fell: bool, fall_time_s: float | None) -> None:
+        status = f"fell at {fall_time_s:.2f} s" if fell and fall_time_s is not None else "no fall"
+        print(f"\r{status:<70}", file=sys.stderr)
+
+
+def _run_session(cfg: SessionConfig, source, out: Path, extra: dict, args: argparse.Namespace) -> int:
+    from stylesync.export.session_file import SessionRecorder
     from stylesync.metrics.plots import write_plots, write_strip
     from stylesync.metrics.summary import summarize
     from stylesync.session import Session
 
     out.mkdir(parents=True, exist_ok=True)
     session = Session(cfg, source)
+    record = Path(args.record) if args.record else out / "session.jsonl"
+    recorder = SessionRecorder(record, cfg, session)
+    session.on_tick = recorder.tick
+    show = args.progress or sys.stderr.isatty()
+    progress = _Progress(cfg.duration_s) if show else None
+    metrics: dict | None = None
     try:
-        result = session.run(render_every_s=max(cfg.duration_s / 8, 0.25))
+        result = session.run(progress=progress, render_every_s=max(cfg.duration_s / 8, 0.25))
+        metrics = summarize(result) | extra
     finally:
         source.close()
-    metrics = summarize(result) | extra
+        recorder.close(metrics)
+    if progress is not None:
+        progress.done(result.fell, result.fall_time_s)
+    metrics["session_file"] = str(record)
     (out / "metrics.json").write_text(json.dumps(metrics, indent=2))
+    if args.export_bvh or args.export_mp4:
+        _export(record, args.export_bvh, args.export_mp4)
     write_plots(result, out)
     write_strip(session.renders, out / "render_strip.png")
     print(json.dumps({k: metrics[k] for k in _HEADLINE}))
@@ -42,7 +74,7 @@ def _demo(args: argparse.Namespace) -> int:
                         operator=OperatorConfig(clip=args.clip),
                         control=ControlConfig(lipm_time_sync=not args.no_lipm))
     source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
-    return _run_session(cfg, source, Path(args.out), {"clip": args.clip, "lipm_time_sync": not args.no_lipm})
+    return _run_session(cfg, source, Path(args.out), {"clip": args.clip, "lipm_time_sync": not args.no_lipm}, args)
 
 
 def _open(args: argparse.Namespace, clocks: ClockConfig, duration_s: float | None):
@@ -63,7 +95,39 @@ def _run(args: argparse.Namespace) -> int:
                         clocks=dataclasses.replace(clocks, mocap_hz=opened.mocap_hz),
                         control=ControlConfig(lipm_time_sync=not args.no_lipm))
     return _run_session(cfg, opened.source, Path(args.out), {"source": args.source, "sensor": args.sensor,
-                                                              "lipm_time_sync": not args.no_lipm})
+                                                              "lipm_time_sync": not args.no_lipm}, args)
+
+
+def _export(record: Path, bvh: str | None, mp4: str | None) -> None:
+    from stylesync.export.replay import export_bvh, export_mp4
+    from stylesync.export.session_file import read_session
+
+    session = read_session(record)
+    if bvh:
+        n = export_bvh(session, bvh)
+        print(f"BVH: {bvh} ({n} frames)")
+    if mp4:
+        n = export_mp4(session, mp4)
+        print(f"MP4: {mp4} ({n} frames)")
+
+
+def _replay(args: argparse.Namespace) -> int:
+    from stylesync.export.session_file import read_session
+
+    session = read_session(args.file)
+    print(json.dumps({"ticks": len(session.ticks), "duration_s": session.ticks[-1]["t"] if session.ticks else 0.0,
+                      "fell": (session.metrics or {}).get("fell")}))
+    if not (args.export_bvh or args.export_mp4):
+        raise StylesyncError("replay: give --export-bvh FILE and/or --export-mp4 FILE")
+    _export(Path(args.file), args.export_bvh, args.export_mp4)
+    return 0
+
+
+def _add_output_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--record", help="session file to write (default: OUT/session.jsonl)")
+    p.add_argument("--export-bvh", help="write the character's motion as BVH")
+    p.add_argument("--export-mp4", help="write an MP4 of the character (software renderer)")
+    p.add_argument("--progress", action="store_true", help="show a progress line (default: when on a terminal)")
 
 
 def _measure(args: argparse.Namespace) -> int:
@@ -111,6 +175,7 @@ def main(argv: list[str] | None = None) -> int:
     demo.add_argument("--gui", action="store_true", help="open the PyBullet window")
     demo.add_argument("--realtime", action="store_true", help="pace to the wall clock")
     demo.add_argument("--no-lipm", action="store_true", help="switch the LIPM time-sync compensation off (Eq. 21-23)")
+    _add_output_args(demo)
     demo.set_defaults(func=_demo)
     run = sub.add_parser("run", help="drive the character from an operator source")
     _add_source_args(run)
@@ -119,12 +184,18 @@ def main(argv: list[str] | None = None) -> int:
     run.add_argument("--gui", action="store_true", help="open the PyBullet window")
     run.add_argument("--realtime", action="store_true", help="pace to the wall clock (always for live sources)")
     run.add_argument("--no-lipm", action="store_true", help="switch the LIPM time-sync compensation off")
+    _add_output_args(run)
     run.set_defaults(func=_run)
     measure = sub.add_parser("measure", help="print the operator's link table (Sec. 4.2, Table 2)")
     _add_source_args(measure)
     measure.add_argument("--mass", type=float, default=75.8, help="operator's total mass [kg]")
     measure.add_argument("--point-cloud", help="body point cloud (.ply or .npy, metres, world frame)")
     measure.set_defaults(func=_measure)
+    replay = sub.add_parser("replay", help="replay a session file (no re-simulation) into BVH and/or MP4")
+    replay.add_argument("file", help="session file (.jsonl) written by run or demo")
+    replay.add_argument("--export-bvh", help="write the character's motion as BVH")
+    replay.add_argument("--export-mp4", help="write an MP4 of the character (software renderer)")
+    replay.set_defaults(func=_replay)
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     try:

@@ -25,7 +25,7 @@ from stylesync.motion.pose_optimization import MotionOptimizer
 from stylesync.motion.stance_fsm import Stance
 from stylesync.motion.style_features import ROW_NAMES as _FEATURES
 from stylesync.motion.style_features import StyleExtractor
-from stylesync.processing.operator_processing import OperatorProcessing
+from stylesync.processing.operator_processing import OperatorProcessing, OperatorSample
 from stylesync.sim.backend import CharacterState, PhysicsBackend, make_backend
 from stylesync.sim.character import LINK_NAMES, STANDING_ROOT_HEIGHT_M
 from stylesync.sources.base import OperatorSource
@@ -84,6 +84,8 @@ class Session:
         self.char_style = StyleExtractor()
         self.on_tick = on_tick
         self.renders: list[tuple[float, np.ndarray]] = []
+        self.last_sample: OperatorSample | None = None  # newest processed operator sample (recorders, viewers)
+        self.last_torques: np.ndarray | None = None  # (n_joints, 3) torques of the last physics step [N·m]
 
     def _place_character(self) -> None:
         """Stand the character where the operator stands (scaled), facing the operator's heading."""
@@ -133,6 +135,7 @@ class Session:
                 elif t - last_frame_sim > SILENT_STREAM_TIMEOUT_S and self._source_is_live():
                     raise SourceError(f"operator stream silent for more than {SILENT_STREAM_TIMEOUT_S:.0f} s")
                 sample = self.processing.step(t)
+                self.last_sample = sample
                 c1 = time.perf_counter()
                 state = self.backend.read_state(t)
                 ref = self.motion.update(sample, state, self.mass)
@@ -158,7 +161,9 @@ class Session:
                     progress(t, time.perf_counter() - wall0)
             p0 = time.perf_counter()
             fb = self.backend.read_joint_feedback()
-            self.backend.apply_torques(self.controller.torques(fb))
+            torques = self.controller.torques(fb)
+            self.last_torques = torques.values
+            self.backend.apply_torques(torques)
             p1 = time.perf_counter()
             self.backend.step()
             p2 = time.perf_counter()

@@ -1,0 +1,1 @@
+"""Session files, replay and export (BVH, MP4)."""

@@ -1,0 +1,146 @@
+"""Session files: an open, line-based record of a run, flushed as it goes.
+
+Format (UTF-8 JSON Lines). The first line is a header ``{"format": "stylesync-session", "version": 1, "config":
+{...}, "joints": [...], "links": [...], "operator_joints": [...], "stance_codes": {...}}``. Then one line per control
+tick: ``t`` [s], ``root_pos_world`` [3], ``root_quat_wxyz`` [4], ``joint_pos`` [n_joints][4] (ball joints wxyz in
+model axes, hinge angle first), ``link_origin_world`` [n_links][3], ``link_quat_wxyz`` [n_links][4] (canonical),
+``torques_nm`` [n_joints][3] (ball: child frame; hinge: first), ``operator_stance`` and ``character_stance``
+(LS/DS/RS), ``operator_features`` [7], ``character_com_world`` [3], ``operator_pos`` [n_operator_joints][3]. The
+last line, when the run ends, is ``{"metrics": {...}}``. Floats are written with Python's shortest exact
+representation, so a replay reads back identical states. Units: m, s, rad, N·m; world frame z up. Lines are
+flushed every 50 ticks, so a run cut short leaves a readable file.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from collections.abc import Iterator
+from pathlib import Path
+from typing import IO, Any
+
+import numpy as np
+
+from stylesync.errors import SourceError
+from stylesync.processing.joint_map import TRACKED_POSITIONS
+from stylesync.sim.character import JOINTS, LINK_NAMES
+
+FORMAT = "stylesync-session"
+VERSION = 1
+FLUSH_EVERY_TICKS = 50
+
+
+class SessionRecorder:
+    """Writes a session file; ``tick`` is the session's ``on_tick`` hook."""
+
+    def __init__(self, path: str | Path, config: Any, session: Any = None):
+        self.path = Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._f: IO[str] = self.path.open("w", encoding="utf-8")
+        self._session = session
+        self._n = 0
+        header = {"format": FORMAT, "version": VERSION,
+                  "config": _config_dict(config),
+                  "joints": [j.name for j in JOINTS], "links": list(LINK_NAMES),
+                  "operator_joints": list(TRACKED_POSITIONS), "stance_codes": {"LS": 0, "DS": 1, "RS": 2}}
+        self._write(header)
+
+    def _write(self, obj: dict) -> None:
+        self._f.write(json.dumps(obj, default=_jsonable) + "\n")
+
+    def tick(self, state: Any, ref: Any) -> None:
+        sess = self._session
+        torques = getattr(sess, "last_torques", None)
+        sample = getattr(sess, "last_sample", None)
+        self._write({
+            "t": state.time_s, "root_pos_world": state.root_pos_world.tolist(),
+            "root_quat_wxyz": state.root_quat_wxyz.tolist(), "joint_pos": state.joint_pos.tolist(),
+            "link_origin_world": state.link_origin_world.tolist(), "link_quat_wxyz": state.link_quat_wxyz.tolist(),
+            "torques_nm": None if torques is None else np.asarray(torques).tolist(),
+            "operator_stance": ref.operator_stance.value, "character_stance": ref.character_stance.value,
+            "operator_features": list(ref.operator_features.as_row()),
+            "character_com_world": sess.mass.com(state).tolist() if sess is not None else None,
+            "operator_pos": None if sample is None else [sample.pos[n].tolist() for n in TRACKED_POSITIONS],
+        })
+        self._n += 1
+        if self._n % FLUSH_EVERY_TICKS == 0:
+            self._f.flush()
+
+    def close(self, metrics: dict | None = None) -> None:
+        if self._f.closed:
+            return
+        if metrics is not None:
+            self._write({"metrics": metrics})
+        self._f.close()
+
+
+def _config_dict(config: Any) -> Any:
+    if dataclasses.is_dataclass(config) and not isinstance(config, type):
+        return dataclasses.asdict(config)
+    return config
+
+
+def _jsonable(o: Any) -> Any:
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    if isinstance(o, np.generic):
+        return o.item()
+    if isinstance(o, Path):
+        return str(o)
+    if hasattr(o, "value"):
+        return o.value
+    raise TypeError(f"not serialisable: {type(o).__name__}")
+
+
+@dataclasses.dataclass
+class SessionFile:
+    header: dict
+    ticks: list[dict]
+    metrics: dict | None
+
+    def array(self, key: str) -> np.ndarray:
+        return np.asarray([t[key] for t in self.ticks], dtype=float)
+
+
+def iter_lines(path: Path) -> Iterator[tuple[int, dict]]:
+    with path.open("r", encoding="utf-8") as f:
+        for k, line in enumerate(f, start=1):
+            if not line.strip():
+                continue
+            try:
+                obj = json.loads(line)
+            except json.JSONDecodeError:
+                raise SourceError(f"session file {path}, line {k}: not JSON (truncated or damaged)") from None
+            if not isinstance(obj, dict):
+                raise SourceError(f"session file {path}, line {k}: expected a JSON object")
+            yield k, obj
+
+
+def read_session(path: str | Path) -> SessionFile:
+    """Read a session file; a run cut short (no metrics line, a truncated last line) keeps its complete ticks."""
+    p = Path(path)
+    if not p.is_file():
+        raise SourceError(f"session file not found: {p}")
+    header: dict | None = None
+    ticks: list[dict] = []
+    metrics = None
+    try:
+        for k, obj in iter_lines(p):
+            if header is None:
+                if obj.get("format") != FORMAT:
+                    raise SourceError(f"{p} is not a stylesync session file (no '{FORMAT}' header)")
+                header = obj
+            elif "metrics" in obj:
+                metrics = obj["metrics"]
+            elif "t" in obj and "root_pos_world" in obj:
+                ticks.append(obj)
+            else:
+                raise SourceError(f"session file {p}, line {k}: neither a tick nor the metrics")
+    except SourceError as exc:
+        if header is None or "not JSON" not in str(exc):
+            raise
+    except UnicodeDecodeError:
+        raise SourceError(f"session file {p} is not UTF-8 text") from None
+    if header is None:
+        raise SourceError(f"session file {p} is empty")
+    return SessionFile(header, ticks, metrics)
