@@ -111,6 +111,28 @@ def _axes_matrix(up_axis: int, up_sign: float) -> np.ndarray:
     return A
 
 
+def _parse_line_or_fail_at_eof(file: Any, line_number: int) -> tuple[int, list[str], tuple[Any, int, int, str]]:
+    """bvhio's line reader, except that the end of the file raises instead of looping forever (bvhio 1.5.4 spins
+    on a truncated file)."""
+    tokens: list[str] = []
+    line = ""
+    while not tokens:
+        line_number += 1
+        line = file.readline()
+        if line == "":
+            raise SyntaxError(f"unexpected end of file at line {line_number}")
+        tokens = line.strip().split()
+    return line_number, tokens, (file, line_number, len(line) - len(line.lstrip()) + len(tokens[0]), line)
+
+
+def _bvhio() -> Any:
+    import bvhio
+    import bvhio.lib.Parser as parser
+
+    parser.parseLine = _parse_line_or_fail_at_eof  # type: ignore[assignment]
+    return bvhio
+
+
 def _depth_first(root: Any) -> list[tuple[Any, int]]:
     """(joint, parent index) in depth-first order, parents before children."""
     out: list[tuple[Any, int]] = []
@@ -128,8 +150,7 @@ class BvhRecording:
 
     def __init__(self, path: str | Path, joint_map: dict[str, str] | None = None, scale_m: float | None = None,
                  up_axis: str | None = None):
-        import bvhio
-
+        bvhio = _bvhio()
         p = Path(path)
         if not p.is_file():
             raise SourceError(f"BVH file not found: {p}")
