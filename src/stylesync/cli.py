@@ -123,11 +123,20 @@ def _replay(args: argparse.Namespace) -> int:
     return 0
 
 
-def _add_output_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--record", help="session file to write (default: OUT/session.jsonl)")
+def _add_export_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--export-bvh", help="write the character's motion as BVH")
     p.add_argument("--export-mp4", help="write an MP4 of the character (software renderer)")
+
+
+def _add_session_args(p: argparse.ArgumentParser, out_default: str, realtime_help: str) -> None:
+    """Options shared by the commands that run a session (demo, run)."""
+    p.add_argument("--out", default=out_default, help="output folder")
+    p.add_argument("--gui", action="store_true", help="open the PyBullet window")
+    p.add_argument("--realtime", action="store_true", help=realtime_help)
+    p.add_argument("--no-lipm", action="store_true", help="switch the LIPM time-sync compensation off (Eq. 21-23)")
+    p.add_argument("--record", help="session file to write (default: OUT/session.jsonl)")
     p.add_argument("--progress", action="store_true", help="show a progress line (default: when on a terminal)")
+    _add_export_args(p)
 
 
 def _measure(args: argparse.Namespace) -> int:
@@ -170,21 +179,13 @@ def main(argv: list[str] | None = None) -> int:
     demo = sub.add_parser("demo", help="run the built-in operator through the whole pipeline, headless")
     demo.add_argument("--clip", default="walk", help="pybullet_data humanoid3d clip, or 'stand'")
     demo.add_argument("--duration", type=float, default=12.0, help="simulated seconds")
-    demo.add_argument("--out", default="out/demo", help="output folder")
     demo.add_argument("--seed", type=int, default=0)
-    demo.add_argument("--gui", action="store_true", help="open the PyBullet window")
-    demo.add_argument("--realtime", action="store_true", help="pace to the wall clock")
-    demo.add_argument("--no-lipm", action="store_true", help="switch the LIPM time-sync compensation off (Eq. 21-23)")
-    _add_output_args(demo)
+    _add_session_args(demo, "out/demo", "pace to the wall clock")
     demo.set_defaults(func=_demo)
     run = sub.add_parser("run", help="drive the character from an operator source")
     _add_source_args(run)
     run.add_argument("--duration", type=float, help="simulated seconds (default: the recording's length)")
-    run.add_argument("--out", default="out/run", help="output folder")
-    run.add_argument("--gui", action="store_true", help="open the PyBullet window")
-    run.add_argument("--realtime", action="store_true", help="pace to the wall clock (always for live sources)")
-    run.add_argument("--no-lipm", action="store_true", help="switch the LIPM time-sync compensation off")
-    _add_output_args(run)
+    _add_session_args(run, "out/run", "pace to the wall clock (always for live sources)")
     run.set_defaults(func=_run)
     measure = sub.add_parser("measure", help="print the operator's link table (Sec. 4.2, Table 2)")
     _add_source_args(measure)
@@ -193,8 +194,7 @@ def main(argv: list[str] | None = None) -> int:
     measure.set_defaults(func=_measure)
     replay = sub.add_parser("replay", help="replay a session file (no re-simulation) into BVH and/or MP4")
     replay.add_argument("file", help="session file (.jsonl) written by run or demo")
-    replay.add_argument("--export-bvh", help="write the character's motion as BVH")
-    replay.add_argument("--export-mp4", help="write an MP4 of the character (software renderer)")
+    _add_export_args(replay)
     replay.set_defaults(func=_replay)
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")

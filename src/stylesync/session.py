@@ -86,6 +86,7 @@ class Session:
         self.renders: list[tuple[float, np.ndarray]] = []
         self.last_sample: OperatorSample | None = None  # newest processed operator sample (recorders, viewers)
         self.last_torques: np.ndarray | None = None  # (n_joints, 3) torques of the last physics step [N·m]
+        self.last_com_world: np.ndarray | None = None  # character COM at the last control tick [m]
 
     def _place_character(self) -> None:
         """Stand the character where the operator stands (scaled), facing the operator's heading."""
@@ -192,6 +193,7 @@ class Session:
 
     def _log(self, lg: TickLog, t: float, sample, state: CharacterState, ref, tick_ms: float) -> None:
         com = self.mass.com(state)
+        self.last_com_world = com
         hips = {s: state.link_origin_world[_LINK[f"{s}_hip"]] for s in ("left", "right")}
         knees = {s: state.link_origin_world[_LINK[f"{s}_knee"]] for s in ("left", "right")}
         ankles = {s: state.link_origin_world[_LINK[f"{s}_ankle"]] for s in ("left", "right")}

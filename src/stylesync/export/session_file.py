@@ -3,7 +3,7 @@
 Format (UTF-8 JSON Lines). The first line is a header ``{"format": "stylesync-session", "version": 1, "config":
 {...}, "joints": [...], "links": [...], "operator_joints": [...], "stance_codes": {...}}``. Then one line per control
 tick: ``t`` [s], ``root_pos_world`` [3], ``root_quat_wxyz`` [4], ``joint_pos`` [n_joints][4] (ball joints wxyz in
-model axes, hinge angle first), ``link_origin_world`` [n_links][3], ``link_quat_wxyz`` [n_links][4] (canonical),
+model axes, hinge angle first; with the root pose they fix every link), ``link_quat_wxyz`` [n_links][4] (canonical),
 ``torques_nm`` [n_joints][3] (ball: child frame; hinge: first), ``operator_stance`` and ``character_stance``
 (LS/DS/RS), ``operator_features`` [7], ``character_com_world`` [3], ``operator_pos`` [n_operator_joints][3]. The
 last line, when the run ends, is ``{"metrics": {...}}``. Floats are written with Python's shortest exact
@@ -55,11 +55,11 @@ class SessionRecorder:
         self._write({
             "t": state.time_s, "root_pos_world": state.root_pos_world.tolist(),
             "root_quat_wxyz": state.root_quat_wxyz.tolist(), "joint_pos": state.joint_pos.tolist(),
-            "link_origin_world": state.link_origin_world.tolist(), "link_quat_wxyz": state.link_quat_wxyz.tolist(),
+            "link_quat_wxyz": state.link_quat_wxyz.tolist(),
             "torques_nm": None if torques is None else np.asarray(torques).tolist(),
             "operator_stance": ref.operator_stance.value, "character_stance": ref.character_stance.value,
             "operator_features": list(ref.operator_features.as_row()),
-            "character_com_world": sess.mass.com(state).tolist() if sess is not None else None,
+            "character_com_world": getattr(sess, "last_com_world", None),
             "operator_pos": None if sample is None else [sample.pos[n].tolist() for n in TRACKED_POSITIONS],
         })
         self._n += 1

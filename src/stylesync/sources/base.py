@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import logging
+import threading
+import time
 from abc import ABC, abstractmethod
+from collections import deque
 
 import numpy as np
 
@@ -61,3 +64,35 @@ class RecordedSource(OperatorSource):
             out.append(self.frames[self._next])
             self._next += 1
         return out
+
+
+class QueuedLiveSource(OperatorSource):
+    """A live stream: a receiving thread ``push``es frames; ``poll`` hands over those that arrived since the last
+    call. Each frame carries its arrival time in ``extras["arrival_wall_s"]`` (``time.perf_counter``)."""
+
+    live = True
+
+    def __init__(self, max_queue: int):
+        self.rejected_frames = 0
+        self._queue: deque[OperatorFrame] = deque(maxlen=max_queue)
+        self._lock = threading.Lock()
+
+    def push(self, frame: OperatorFrame) -> None:
+        with self._lock:
+            self._queue.append(frame)
+
+    def poll(self, now_s: float) -> list[OperatorFrame]:
+        with self._lock:
+            frames = list(self._queue)
+            self._queue.clear()
+        return frames
+
+    def wait_first_frame(self, timeout_s: float) -> bool:
+        """Block until a frame has arrived (True) or the timeout passes (False)."""
+        end = time.perf_counter() + timeout_s
+        while time.perf_counter() < end:
+            with self._lock:
+                if self._queue:
+                    return True
+            time.sleep(0.005)
+        return False

@@ -64,13 +64,7 @@ def builtin_operator(
     clip = None if operator.clip == STAND_CLIP else DeepMimicClip.builtin(operator.clip)
     human = HumanModel(operator.height_m, operator.mass_kg)
     performer = ClipPerformer(clip, human, operator.standing_lead_in_s)
-    sensor = SensorModel(
-        rate_hz=clocks.mocap_hz,
-        position_noise_m=operator.position_noise_m,
-        orientation_noise_rad=operator.orientation_noise_rad,
-        timestamp_jitter_s=operator.timestamp_jitter_s,
-        seed=seed,
-    )
+    sensor = SensorModel.kinect(operator, clocks, seed)
     frames = sensor.sample(performer.frame_at, duration_s)
     return RecordedSource(frames, name=f"builtin:{operator.clip}"), performer
 

@@ -28,7 +28,7 @@ import numpy as np
 from stylesync import rotations as rot
 from stylesync.errors import SourceError
 from stylesync.sources.frame import K4ABT_JOINTS, N_JOINTS, OperatorFrame
-from stylesync.sources.segment_frames import orientations_from_positions
+from stylesync.sources.segment_frames import canonical_quats_from_positions
 from stylesync.sources.skeleton_tracks import TrackPerformer, place_on_floor
 
 log = logging.getLogger("stylesync.sources")
@@ -80,7 +80,7 @@ class K4abtRecording:
             if times and t <= times[-1]:
                 self._reject(p, k, f"timestamp {t:.6f} s not after {times[-1]:.6f} s")
                 continue
-            body_id = body.get("body_id", body_id) if isinstance(body, dict) else body_id
+            body_id = body.get("body_id", body_id)
             times.append(t)
             positions.append(pos @ R_WORLD_CAMERA.T * 1e-3)
             if q is not None:
@@ -90,16 +90,7 @@ class K4abtRecording:
             raise SourceError(f"k4abt JSON {p}: fewer than two usable frames ({self.rejected_frames} rejected)")
         P = np.array(positions)
         place_on_floor(P)
-        if quats:
-            Q = np.array(quats)
-        else:
-            by_joint = orientations_from_positions(P)
-            Q = np.tile(rot.IDENTITY_WXYZ, (len(times), N_JOINTS, 1))
-            for name, q in by_joint.items():
-                Q[:, K4ABT_JOINTS.index(name)] = q
-            for name, src in (("HEAD", "NECK"), ("FOOT_LEFT", "ANKLE_LEFT"), ("FOOT_RIGHT", "ANKLE_RIGHT"),
-                              ("WRIST_LEFT", "ELBOW_LEFT"), ("WRIST_RIGHT", "ELBOW_RIGHT")):
-                Q[:, K4ABT_JOINTS.index(name)] = Q[:, K4ABT_JOINTS.index(src)]
+        Q = np.array(quats) if quats else canonical_quats_from_positions(P)
         self.path = p
         self.performer = TrackPerformer(np.array(times), P, Q, np.ones((len(times), N_JOINTS)),
                                         name=f"k4a-json:{p.name}")

@@ -7,30 +7,25 @@ from __future__ import annotations
 import logging
 import threading
 import time
-from collections import deque
 from collections.abc import Callable
 
 import numpy as np
 
-from stylesync.sources.base import OperatorSource
-from stylesync.sources.frame import JOINT_INDEX, K4ABT_JOINTS, N_JOINTS, OperatorFrame
-from stylesync.sources.segment_frames import orientations_from_positions
+from stylesync.sources.base import QueuedLiveSource
+from stylesync.sources.frame import JOINT_INDEX, N_JOINTS, OperatorFrame
+from stylesync.sources.segment_frames import canonical_quats_from_positions
 from stylesync.sources.skeleton_tracks import WINTER_ANKLE_PER_HIP_TO_ANKLE, fill_canonical
 
 log = logging.getLogger("stylesync.sources")
 
 
-class LivePositionSource(OperatorSource):
+class LivePositionSource(QueuedLiveSource):
     """``read()`` (run on a thread) returns (positions (32, 3) world [m], confidence (32,)) or None at the end."""
 
-    live = True
-
     def __init__(self, read: Callable[[], tuple[np.ndarray, np.ndarray] | None], name: str, max_queue: int = 64):
+        super().__init__(max_queue)
         self.name = name
-        self.rejected_frames = 0
         self._read = read
-        self._queue: deque[OperatorFrame] = deque(maxlen=max_queue)
-        self._lock = threading.Lock()
         self._stop = threading.Event()
         self._lowest_ankle = np.inf
         self._t0 = time.perf_counter()
@@ -53,22 +48,12 @@ class LivePositionSource(OperatorSource):
             self._lowest_ankle = min(self._lowest_ankle, float(ankles.min()))
             leg = float(np.linalg.norm(pos[JOINT_INDEX["HIP_LEFT"]] - pos[JOINT_INDEX["ANKLE_LEFT"]]))
             pos[:, 2] += WINTER_ANKLE_PER_HIP_TO_ANKLE * leg - self._lowest_ankle
-            P = pos[None]
-            Q = np.tile(np.array([1.0, 0.0, 0.0, 0.0]), (1, N_JOINTS, 1))
-            for name, q in orientations_from_positions(P).items():
-                Q[:, K4ABT_JOINTS.index(name)] = q
-            C = conf[None].copy()
+            P, C = pos[None], conf[None].copy()
+            Q = canonical_quats_from_positions(P)
             fill_canonical(P, Q, C)
             frame = OperatorFrame(arrival - self._t0, P[0], Q[0], C[0])
             frame.extras["arrival_wall_s"] = arrival
-            with self._lock:
-                self._queue.append(frame)
-
-    def poll(self, now_s: float) -> list[OperatorFrame]:
-        with self._lock:
-            frames = list(self._queue)
-            self._queue.clear()
-        return frames
+            self.push(frame)
 
     def close(self) -> None:
         self._stop.set()

@@ -49,9 +49,7 @@ def _recorded(performer, label: str, sensor: str, clocks: ClockConfig, op: Opera
     lead = _LeadIn(performer, op.standing_lead_in_s)
     total = lead.duration_s if duration_s is None else duration_s
     if sensor == "kinect":
-        model = SensorModel(rate_hz=clocks.mocap_hz, position_noise_m=op.position_noise_m,
-                            orientation_noise_rad=op.orientation_noise_rad, timestamp_jitter_s=op.timestamp_jitter_s,
-                            dropout_probability=KINECT_DROPOUT_PROBABILITY, seed=seed)
+        model = SensorModel.kinect(op, clocks, seed, KINECT_DROPOUT_PROBABILITY)
         return OpenedSource(RecordedSource(model.sample(lead.frame_at, total), name=label), clocks.mocap_hz,
                             lead.duration_s, label, lead)
     if sensor != "none":
@@ -93,13 +91,12 @@ def open_source(spec: str, clocks: ClockConfig | None = None, operator: Operator
         performer = ClipPerformer(clip, human, op.standing_lead_in_s)
         total = (duration_s if duration_s is not None else
                  (clip.duration_s if not clip.loop else 12.0) + op.standing_lead_in_s)
-        model = SensorModel(rate_hz=clocks.mocap_hz, position_noise_m=op.position_noise_m,
-                            orientation_noise_rad=op.orientation_noise_rad, timestamp_jitter_s=op.timestamp_jitter_s,
-                            dropout_probability=KINECT_DROPOUT_PROBABILITY if sensor == "kinect" else 0.0, seed=seed)
-        if sensor == "none":
+        if sensor == "kinect":
+            model = SensorModel.kinect(op, clocks, seed, KINECT_DROPOUT_PROBABILITY)
+        elif sensor == "none":  # the clip itself, sampled at the mocap rate
             model = SensorModel(rate_hz=clocks.mocap_hz, position_noise_m=0.0, orientation_noise_rad=0.0,
                                 timestamp_jitter_s=0.0, seed=seed)
-        elif sensor != "kinect":
+        else:
             raise SourceError(f"unknown sensor model '{sensor}'; expected one of {', '.join(SENSORS)}")
         return OpenedSource(RecordedSource(model.sample(performer.frame_at, total), name=spec), clocks.mocap_hz,
                             total, spec, performer)

@@ -13,7 +13,8 @@ from __future__ import annotations
 import numpy as np
 
 from stylesync import rotations as rot
-from stylesync.sources.frame import JOINT_INDEX
+from stylesync.sources.frame import JOINT_INDEX, N_JOINTS
+from stylesync.sources.skeleton_tracks import ORIENTATION_FROM
 
 _STRAIGHT_LIMB = 0.15  # |sin| of the middle-joint angle below which a limb counts as straight
 
@@ -68,3 +69,14 @@ def orientations_from_positions(pos: np.ndarray) -> dict[str, np.ndarray]:
         # as pitched toe-down by that angle; only the foot's heading (twist T) is used downstream.
         out[f"ANKLE_{side}"] = _frame_quats_xz(P[f"FOOT_{side}"] - P[f"ANKLE_{side}"], np.broadcast_to(up, a.shape))
     return out
+
+
+def canonical_quats_from_positions(pos: np.ndarray) -> np.ndarray:
+    """Orientations (T, 32, 4) of every canonical joint from positions (T, 32, 3) [m]; joints without a segment
+    take their neighbour's (``ORIENTATION_FROM``)."""
+    quat = np.tile(rot.IDENTITY_WXYZ, (len(pos), N_JOINTS, 1))
+    for name, q in orientations_from_positions(pos).items():
+        quat[:, JOINT_INDEX[name]] = q
+    for joint, src in ORIENTATION_FROM.items():
+        quat[:, JOINT_INDEX[joint]] = quat[:, JOINT_INDEX[src]]
+    return quat

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from stylesync import rotations as rot
+from stylesync.config import ClockConfig, OperatorConfig
 from stylesync.sources.frame import OperatorFrame
 
 
@@ -24,6 +25,14 @@ class SensorModel:
     timestamp_jitter_s: float = 0.004
     dropout_probability: float = 0.0  # per joint and frame
     seed: int = 0
+
+    @classmethod
+    def kinect(cls, operator: OperatorConfig, clocks: ClockConfig, seed: int,
+               dropout_probability: float = 0.0) -> SensorModel:
+        """The Kinect-like sensor of the operator configuration, at the mocap rate."""
+        return cls(rate_hz=clocks.mocap_hz, position_noise_m=operator.position_noise_m,
+                   orientation_noise_rad=operator.orientation_noise_rad,
+                   timestamp_jitter_s=operator.timestamp_jitter_s, dropout_probability=dropout_probability, seed=seed)
 
     def sample(self, pose_at: Callable[[float], OperatorFrame], duration_s: float) -> list[OperatorFrame]:
         """Frames at ``rate_hz`` over ``[0, duration_s]``; ``pose_at(t)`` gives the noise-free frame at t [s]."""

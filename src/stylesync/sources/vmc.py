@@ -20,14 +20,13 @@ from __future__ import annotations
 import logging
 import threading
 import time
-from collections import deque
 from typing import Any
 
 import numpy as np
 
 from stylesync import rotations as rot
 from stylesync.errors import SourceError
-from stylesync.sources.base import OperatorSource
+from stylesync.sources.base import QueuedLiveSource
 from stylesync.sources.frame import JOINT_INDEX, N_JOINTS, OperatorFrame
 from stylesync.sources.skeleton_tracks import fill_canonical, rest_corrections
 
@@ -128,10 +127,8 @@ def frame_from_bones(t_s: float, root_pos: np.ndarray, root_q: np.ndarray,
     return OperatorFrame(t_s, pos[0], quat[0], conf[0]), q_rest
 
 
-class VmcSource(OperatorSource):
+class VmcSource(QueuedLiveSource):
     """Listens for VMC packets; ``poll`` returns the frames completed since the last call."""
-
-    live = True
 
     def __init__(self, host: str = "127.0.0.1", port: int = DEFAULT_PORT, max_queue: int = 256):
         try:
@@ -139,9 +136,8 @@ class VmcSource(OperatorSource):
             from pythonosc.osc_server import ThreadingOSCUDPServer
         except ImportError:
             raise SourceError("the VMC source needs python-osc: pip install 'stylesync[live]'") from None
-        self.host, self.rejected_frames = host, 0
-        self._lock = threading.Lock()
-        self._queue: deque[OperatorFrame] = deque(maxlen=max_queue)
+        super().__init__(max_queue)
+        self.host = host
         self._root: tuple[np.ndarray, np.ndarray] | None = None
         self._bones: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self._q_rest: dict[str, np.ndarray] | None = None
@@ -207,30 +203,13 @@ class VmcSource(OperatorSource):
         frame.extras["arrival_wall_s"] = arrival
         if sender_time_s is not None:
             frame.extras["sender_time_s"] = sender_time_s
-        with self._lock:
-            self._queue.append(frame)
-            self.frames_received += 1
+        self.push(frame)
+        self.frames_received += 1
 
     def _reject(self, why: str) -> None:
         self.rejected_frames += 1
         if self.rejected_frames <= 10 or self.rejected_frames % 100 == 0:
             log.warning("vmc: rejected frame (%s), %d so far", why, self.rejected_frames)
-
-    def poll(self, now_s: float) -> list[OperatorFrame]:
-        with self._lock:
-            frames = list(self._queue)
-            self._queue.clear()
-        return frames
-
-    def wait_first_frame(self, timeout_s: float) -> bool:
-        """Block until a frame has arrived (True) or the timeout passes (False)."""
-        end = time.perf_counter() + timeout_s
-        while time.perf_counter() < end:
-            with self._lock:
-                if self._queue:
-                    return True
-            time.sleep(0.005)
-        return False
 
     def close(self) -> None:
         self._server.shutdown()
