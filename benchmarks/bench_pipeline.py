@@ -49,7 +49,8 @@ def main() -> None:
     ticks = len(result.stage_ms["motion"])
     steps = len(result.stage_ms["physics"])
     print(f"clip {args.clip}, simulated {result.sim_duration_s:.2f} s"
-          f"{' (fell at %.2f s)' % result.fall_time_s if result.fell else ''}, {ticks} control ticks, {steps} physics steps")
+          f"{f' (fell at {result.fall_time_s:.2f} s)' if result.fell else ''}, {ticks} control ticks, "
+          f"{steps} physics steps")
     print(f"realtime factor, physics alone:  {phys:6.2f}x")
     print(f"realtime factor, whole pipeline: {rtf:6.2f}x   (ratio {rtf / phys:.2f} of physics alone)")
     print("time per control tick [ms], mean / p99:")
@@ -60,7 +61,7 @@ def main() -> None:
             continue
         scale = steps_per_tick if name in ("torques", "physics") else 1.0  # per-step stages summed over a tick
         print(f"  {name:15s} {values.mean() * scale:7.3f} / {np.percentile(values, 99) * scale:7.3f}"
-              f"{'   (%.1f physics steps per tick)' % steps_per_tick if scale != 1.0 else ''}")
+              f"{f'   ({steps_per_tick:.1f} physics steps per tick)' if scale != 1.0 else ''}")
     tick_total = result.log.array("tick_ms")
     print(f"  {'control tick':15s} {tick_total.mean():7.3f} / {np.percentile(tick_total, 99):7.3f}"
           "   (processing + motion + control update)")

@@ -45,15 +45,28 @@ def _run_session(cfg: SessionConfig, source, out: Path, extra: dict, args: argpa
     record = Path(args.record) if args.record else out / "session.jsonl"
     recorder = SessionRecorder(record, cfg, session)
     session.on_tick = recorder.tick
+    viewer = None
+    if args.viewer != "none":
+        from stylesync.viewer.attach import chain, open_viewer, session_hook
+
+        viewer = open_viewer(args.viewer, session, args.viewer_host, args.viewer_port, args.viewer_hz)
+        session.on_tick = chain(recorder.tick, session_hook(session, viewer, args.viewer_hz))
+        session.stop_on_fall = False  # watching: a fall is recorded, the run goes on (Reset stands it up)
+        print(f"viewer: {viewer.url}", flush=True)
     show = args.progress or sys.stderr.isatty()
     progress = _Progress(cfg.duration_s) if show else None
     metrics: dict | None = None
     try:
         result = session.run(progress=progress, render_every_s=max(cfg.duration_s / 8, 0.25))
         metrics = summarize(result) | extra
+    except KeyboardInterrupt:
+        session.closed = True
+        raise
     finally:
         source.close()
         recorder.close(metrics)
+        if viewer is not None:
+            _hold_viewer(viewer)
     if progress is not None:
         progress.done(result.fell, result.fall_time_s)
     metrics["session_file"] = str(record)
@@ -67,11 +80,48 @@ def _run_session(cfg: SessionConfig, source, out: Path, extra: dict, args: argpa
     return 0
 
 
+def _hold_viewer(viewer) -> None:
+    """Keep the viewer up after the run until Ctrl-C when a person is at the terminal."""
+    try:
+        if sys.stdin.isatty():
+            import time
+
+            print(f"run finished; the viewer stays at {viewer.url} (Ctrl-C to quit)", file=sys.stderr, flush=True)
+            while True:
+                time.sleep(1.0)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        viewer.close()
+
+
+def _replay_viewer(args: argparse.Namespace, session) -> None:
+    import time
+
+    from stylesync.export.replay import resample_ticks
+    from stylesync.viewer.attach import open_viewer, replay_snapshots
+
+    viewer = open_viewer(args.viewer, None, args.viewer_host, args.viewer_port, args.viewer_hz)
+    print(f"viewer: {viewer.url}", flush=True)
+    ticks = resample_ticks(session, args.viewer_hz)
+    wall0 = time.perf_counter()
+    t0 = ticks[0]["t"] if ticks else 0.0
+    try:
+        for snap in replay_snapshots(ticks, session.header.get("operator_joints", [])):
+            lag = (snap.time_s - t0) / args.speed - (time.perf_counter() - wall0)
+            if lag > 0:
+                time.sleep(lag)
+            viewer.publish(snap)
+        time.sleep(2.0 / args.viewer_hz)
+    finally:
+        _hold_viewer(viewer)
+
+
 def _demo(args: argparse.Namespace) -> int:
     from stylesync.sources.builtin_operator import builtin_operator
 
-    cfg = SessionConfig(duration_s=args.duration, seed=args.seed, gui=args.gui, realtime=args.realtime,
-                        operator=OperatorConfig(clip=args.clip),
+    cfg = SessionConfig(duration_s=args.duration, seed=args.seed, gui=args.gui,
+                        realtime=args.realtime or args.viewer != "none", operator=OperatorConfig(clip=args.clip),
                         control=ControlConfig(lipm_time_sync=not args.no_lipm))
     source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
     return _run_session(cfg, source, Path(args.out), {"clip": args.clip, "lipm_time_sync": not args.no_lipm}, args)
@@ -91,7 +141,8 @@ def _run(args: argparse.Namespace) -> int:
     if live and args.duration is None:
         raise StylesyncError("a live source needs --duration (seconds to run)")
     duration = args.duration if args.duration is not None else float(opened.duration_s or 0.0)
-    cfg = SessionConfig(duration_s=duration, seed=args.seed, gui=args.gui, realtime=args.realtime or live,
+    cfg = SessionConfig(duration_s=duration, seed=args.seed, gui=args.gui,
+                        realtime=args.realtime or live or args.viewer != "none",
                         clocks=dataclasses.replace(clocks, mocap_hz=opened.mocap_hz),
                         control=ControlConfig(lipm_time_sync=not args.no_lipm))
     return _run_session(cfg, opened.source, Path(args.out), {"source": args.source, "sensor": args.sensor,
@@ -117,15 +168,24 @@ def _replay(args: argparse.Namespace) -> int:
     session = read_session(args.file)
     print(json.dumps({"ticks": len(session.ticks), "duration_s": session.ticks[-1]["t"] if session.ticks else 0.0,
                       "fell": (session.metrics or {}).get("fell")}))
-    if not (args.export_bvh or args.export_mp4):
-        raise StylesyncError("replay: give --export-bvh FILE and/or --export-mp4 FILE")
-    _export(Path(args.file), args.export_bvh, args.export_mp4)
+    if not (args.export_bvh or args.export_mp4 or args.viewer != "none"):
+        raise StylesyncError("replay: give --viewer web|gui, --export-bvh FILE and/or --export-mp4 FILE")
+    if args.export_bvh or args.export_mp4:
+        _export(Path(args.file), args.export_bvh, args.export_mp4)
+    if args.viewer != "none":
+        _replay_viewer(args, session)
     return 0
 
 
 def _add_export_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--export-bvh", help="write the character's motion as BVH")
     p.add_argument("--export-mp4", help="write an MP4 of the character (software renderer)")
+    p.add_argument("--viewer", default="none", choices=("none", "web", "gui"),
+                   help="web: browser viewer (prints its address); gui: PyBullet window mirroring the character. "
+                        "A viewer paces the run to the wall clock")
+    p.add_argument("--viewer-host", default="127.0.0.1", help="address the web viewer listens on")
+    p.add_argument("--viewer-port", type=int, help="web viewer port (default: a free one)")
+    p.add_argument("--viewer-hz", type=float, default=20.0, help="viewer drawing rate [Hz]")
 
 
 def _add_session_args(p: argparse.ArgumentParser, out_default: str, realtime_help: str) -> None:
@@ -194,6 +254,7 @@ def main(argv: list[str] | None = None) -> int:
     measure.set_defaults(func=_measure)
     replay = sub.add_parser("replay", help="replay a session file (no re-simulation) into BVH and/or MP4")
     replay.add_argument("file", help="session file (.jsonl) written by run or demo")
+    replay.add_argument("--speed", type=float, default=1.0, help="viewer playback speed (1 = real time)")
     _add_export_args(replay)
     replay.set_defaults(func=_replay)
     args = parser.parse_args(argv)

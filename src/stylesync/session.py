@@ -9,6 +9,7 @@ wall clock (interactive) or runs as fast as possible (offline).
 from __future__ import annotations
 
 import logging
+import queue
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -87,6 +88,31 @@ class Session:
         self.last_sample: OperatorSample | None = None  # newest processed operator sample (recorders, viewers)
         self.last_torques: np.ndarray | None = None  # (n_joints, 3) torques of the last physics step [N·m]
         self.last_com_world: np.ndarray | None = None  # character COM at the last control tick [m]
+        # Interactive use (viewers): callables run in the loop's thread at the next control tick, a pause flag
+        # honoured there, and whether a fall ends the run (it is recorded either way).
+        self.commands: queue.SimpleQueue[Callable[[Session], None]] = queue.SimpleQueue()
+        self.paused = False
+        self.stop_on_fall = True
+        self.closed = False
+
+    def reset_character(self) -> None:
+        """Stand the character up again where the operator now stands (an interactive reset; it is not a force
+        on the character but a new initial state, like the start of a run)."""
+        sample = self.last_sample
+        if sample is None:
+            return
+        yaw = rot.yaw_from_quat(sample.quat["PELVIS"])
+        pelvis = sample.pos["PELVIS"]
+        self.backend.reset(np.array([pelvis[0], pelvis[1], STANDING_ROOT_HEIGHT_M + 0.003]), rot.quat_from_yaw(yaw))
+        self.controller.pid.reset()
+
+    def _service_commands(self) -> None:
+        while True:
+            try:
+                command = self.commands.get_nowait()
+            except queue.Empty:
+                return
+            command(self)
 
     def _place_character(self) -> None:
         """Stand the character where the operator stands (scaled), facing the operator's heading."""
@@ -125,6 +151,13 @@ class Session:
             t = step * dt
             if t + 1e-12 >= next_control:
                 next_control += control_dt
+                self._service_commands()
+                if self.paused:
+                    p0 = time.perf_counter()
+                    while self.paused and not self.closed:
+                        time.sleep(0.02)
+                        self._service_commands()
+                    wall0 += time.perf_counter() - p0  # a pause is neither simulated nor wall time of the run
                 c0 = time.perf_counter()
                 frames = self.source.poll(t)
                 for f in frames:
@@ -149,10 +182,13 @@ class Session:
                 self._log(tick_log, t, sample, state, ref, (c3 - c0) * 1e3)
                 if self.on_tick is not None:
                     self.on_tick(state, ref)
-                fall_reason = self._fall_reason(state)
-                if fall_reason:
-                    fell, fall_time = True, t
-                    log.warning("character fell at t=%.2f s (%s)", t, fall_reason)
+                reason = self._fall_reason(state)
+                if reason and not fell:
+                    fell, fall_time, fall_reason = True, t, reason
+                    log.warning("character fell at t=%.2f s (%s)", t, reason)
+                if fell and self.stop_on_fall:
+                    break
+                if self.closed:
                     break
                 if render_every_s is not None and t >= next_render and hasattr(self.backend, "render_rgb"):
                     next_render += render_every_s
@@ -175,7 +211,7 @@ class Session:
                 if lag > 0:
                     time.sleep(lag)
         wall = time.perf_counter() - wall0
-        sim_t = (step + 1) * dt if not fell else float(fall_time or 0.0)
+        sim_t = (step + 1) * dt if not (fell and self.stop_on_fall) else float(fall_time or 0.0)
         return SessionResult(tick_log, fell, fall_time, fall_reason, sim_t, wall, step + 1,
                              getattr(self.source, "rejected_frames", 0), self.processing.dropped_joint_values,
                              dict(self.bounds.counts), stage_ms, latency_ms)

@@ -4,7 +4,8 @@ Format (UTF-8 JSON Lines). The first line is a header ``{"format": "stylesync-se
 {...}, "joints": [...], "links": [...], "operator_joints": [...], "stance_codes": {...}}``. Then one line per control
 tick: ``t`` [s], ``root_pos_world`` [3], ``root_quat_wxyz`` [4], ``joint_pos`` [n_joints][4] (ball joints wxyz in
 model axes, hinge angle first; with the root pose they fix every link), ``link_quat_wxyz`` [n_links][4] (canonical),
-``torques_nm`` [n_joints][3] (ball: child frame; hinge: first), ``operator_stance`` and ``character_stance``
+``torques_nm`` [n_joints][3] (ball: child frame; hinge: first), ``scale`` (Eq. 9),
+``operator_stance`` and ``character_stance``
 (LS/DS/RS), ``operator_features`` [7], ``character_com_world`` [3], ``operator_pos`` [n_operator_joints][3]. The
 last line, when the run ends, is ``{"metrics": {...}}``. Floats are written with Python's shortest exact
 representation, so a replay reads back identical states. Units: m, s, rad, N·m; world frame z up. Lines are
@@ -57,7 +58,8 @@ class SessionRecorder:
             "root_quat_wxyz": state.root_quat_wxyz.tolist(), "joint_pos": state.joint_pos.tolist(),
             "link_quat_wxyz": state.link_quat_wxyz.tolist(),
             "torques_nm": None if torques is None else np.asarray(torques).tolist(),
-            "operator_stance": ref.operator_stance.value, "character_stance": ref.character_stance.value,
+            "scale": ref.scale, "operator_stance": ref.operator_stance.value,
+            "character_stance": ref.character_stance.value,
             "operator_features": list(ref.operator_features.as_row()),
             "character_com_world": getattr(sess, "last_com_world", None),
             "operator_pos": None if sample is None else [sample.pos[n].tolist() for n in TRACKED_POSITIONS],

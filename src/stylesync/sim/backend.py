@@ -67,6 +67,22 @@ class JointFeedback:
     root_ang_vel_world: np.ndarray  # (3,)
 
 
+@dataclass(frozen=True)
+class LinkShape:
+    """One collision shape of a character link, for drawing.
+
+    ``kind`` is "sphere" (size = radius), "capsule" (size = (length of the cylinder part, radius), axis = local z)
+    or "box" (size = full extents x, y, z) [m]. ``pos_link`` and ``quat_link_wxyz`` place the shape relative to the
+    link's centre of mass, in the link's canonical axes (those of ``CharacterState.link_quat_wxyz``).
+    """
+
+    link: int  # index in LINK_NAMES
+    kind: str
+    size: tuple[float, ...]
+    pos_link: np.ndarray
+    quat_link_wxyz: np.ndarray
+
+
 @dataclass
 class Torques:
     """Joint torques for one physics step: (n_joints, 3) child-frame for ball joints, column 0 for hinges [N·m]."""
@@ -106,6 +122,10 @@ class PhysicsBackend(ABC):
 
     @abstractmethod
     def step(self) -> None: ...
+
+    @abstractmethod
+    def collision_shapes(self) -> list[LinkShape]:
+        """The character's collision shapes (what touches the ground), for viewers."""
 
     @abstractmethod
     def close(self) -> None: ...

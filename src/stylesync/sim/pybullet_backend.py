@@ -19,7 +19,14 @@ from pybullet_utils.bullet_client import BulletClient
 from stylesync import rotations as rot
 from stylesync.config import WorldConfig
 from stylesync.errors import SimulationError
-from stylesync.sim.backend import CharacterState, JointFeedback, MassProperties, PhysicsBackend, Torques
+from stylesync.sim.backend import (
+    CharacterState,
+    JointFeedback,
+    LinkShape,
+    MassProperties,
+    PhysicsBackend,
+    Torques,
+)
 from stylesync.sim.character import (
     FOOT_LINKS,
     JOINT_DOF_COUNT,
@@ -54,6 +61,9 @@ def _quiet_stdout():
         os.dup2(saved[1], 2)
         for fd in (*saved, devnull):
             os.close(fd)
+
+
+_SHAPE_KIND = {pb.GEOM_SPHERE: "sphere", pb.GEOM_CAPSULE: "capsule", pb.GEOM_BOX: "box"}
 
 
 def _canonical_from_link_xyzw(q_xyzw) -> np.ndarray:
@@ -226,6 +236,26 @@ class PyBulletBackend(PhysicsBackend):
 
     def step(self) -> None:
         self._pb.stepSimulation()
+
+    def collision_shapes(self) -> list[LinkShape]:
+        c = self._pb
+        shapes = []
+        for i, link in enumerate(self._link_idx):
+            _, _, _, inertial_pos, inertial_xyzw, *_ = c.getDynamicsInfo(self.body, link)
+            q_inertial = rot.wxyz_from_xyzw(inertial_xyzw)
+            for data in c.getCollisionShapeData(self.body, link):
+                geom, dims, pos, xyzw = data[2], data[3], data[5], data[6]
+                kind = _SHAPE_KIND.get(geom)
+                if kind is None:
+                    continue
+                # link COM frame (PyBullet's inertial frame) -> canonical link axes: the canonical orientation is
+                # the PyBullet one times Q_MODEL_WORLD, so a vector in PyBullet link axes is Q_WORLD_MODEL v.
+                q_rel = rot.multiply(Q_WORLD_MODEL, rot.multiply(q_inertial, rot.wxyz_from_xyzw(xyzw)))
+                p_rel = rot.rotate(rot.multiply(Q_WORLD_MODEL, q_inertial), np.asarray(pos, dtype=float))
+                size = (float(dims[0]),) if kind == "sphere" else (
+                    (float(dims[0]), float(dims[1])) if kind == "capsule" else tuple(float(d) for d in dims[:3]))
+                shapes.append(LinkShape(i, kind, size, p_rel, q_rel))
+        return shapes
 
     def close(self) -> None:
         try:
