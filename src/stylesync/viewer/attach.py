@@ -14,6 +14,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from stylesync import rotations as rot
 from stylesync.config import WorldConfig
 from stylesync.errors import SimulationError
 from stylesync.motion.stance_fsm import Stance
@@ -22,6 +23,8 @@ from stylesync.viewer.snapshot import Snapshot, snapshot_from_state
 
 log = logging.getLogger("stylesync.viewer")
 VIEWER_KINDS = ("none", "web", "gui")
+BALL_SPEED_MPS = 7.0  # a pushed ball's speed [m/s]
+BALL_START_M = 1.5  # a pushed ball starts this far in front of the chest [m]
 
 
 class GuiMirror:
@@ -61,23 +64,43 @@ def open_viewer(kind: str, session=None, host: str = "127.0.0.1", port: int | No
         except SimulationError as exc:
             raise SimulationError(f"--viewer gui needs a display ({exc}); use --viewer web on a headless machine")\
                 from exc
-    from stylesync.viewer.web_viewer import WebViewer
+    from stylesync.viewer.process import ViewerProcess
 
-    shapes_backend = session.backend if session is not None else make_backend(WorldConfig(), 600.0)
-    shapes = shapes_backend.collision_shapes()
     if session is None:
-        shapes_backend.close()
-        return WebViewer(shapes, host, port, draw_hz)
+        backend = make_backend(WorldConfig(), 600.0)
+        shapes = backend.collision_shapes()
+        backend.close()
+        return ViewerProcess(shapes, host, port, draw_hz)
+    return ViewerProcess(session.backend.collision_shapes(), host, port, draw_hz,
+                         on_action=lambda action: apply_action(session, action))
 
-    def pause(on: bool) -> None:
-        session.paused = on
 
-    return WebViewer(shapes, host, port, draw_hz, on_command=session.commands.put, on_pause=pause)
+def apply_action(session, action: str) -> None:
+    """A viewer control's action on a running session (called from any thread)."""
+    if action == "pause":
+        session.paused = True
+    elif action == "resume":
+        session.paused = False
+    elif action == "reset":
+        session.commands.put(lambda s: s.reset_character())
+    elif action == "push":
+        session.commands.put(throw_ball_at_chest)
+    else:
+        log.warning("viewer: unknown action %r ignored", action)
+
+
+def throw_ball_at_chest(session) -> None:
+    """A football thrown at the chest from the front (a scripted disturbance, Sec. 7.4.2)."""
+    state = session.backend.read_state(0.0)
+    chest = state.link_com_world[1]
+    heading = rot.yaw_from_quat(state.root_quat_wxyz)
+    forward = np.array([np.cos(heading), np.sin(heading), 0.0])
+    session.backend.throw_ball(chest + BALL_START_M * forward, -BALL_SPEED_MPS * forward)
 
 
 def session_hook(session, viewer, draw_hz: float) -> Callable:
-    """An ``on_tick`` hook that hands the viewer a snapshot, at most twice per drawn frame (wall clock)."""
-    min_gap = 0.5 / draw_hz
+    """An ``on_tick`` hook that hands the viewer a snapshot, at most once per drawn frame (wall clock)."""
+    min_gap = 1.0 / draw_hz
     last = [-np.inf]
 
     def hook(state, ref) -> None:

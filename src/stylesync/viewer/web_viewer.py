@@ -3,9 +3,9 @@ ground projection, the support polygon, the stance state, the movement bounds of
 operator exceeds them, live plots of the COM and the stance, and controls (pause, reset, push, overlays, camera
 follow).
 
-The viewer never slows the control loop: the loop only hands it a :class:`Snapshot` (``publish``, a reference
-swap), and a thread of its own draws the newest snapshot at ``draw_hz``. Button presses do not touch the engine
-from that thread either: they queue commands that the loop runs at its next control tick (``Session.commands``).
+The viewer runs in a process of its own (process.py) and draws the newest :class:`Snapshot` it has received at
+``draw_hz`` from a thread; the control loop only sends it snapshots. Button presses never touch the engine from
+here: they become named actions that the session's process turns into commands run at its next control tick.
 """
 
 from __future__ import annotations
@@ -16,7 +16,6 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable
-from typing import Any
 
 import numpy as np
 
@@ -36,10 +35,10 @@ from stylesync.viewer.snapshot import (
 log = logging.getLogger("stylesync.viewer")
 PLOT_WINDOW_S = 10.0  # live plots show this much history [s]
 PLOT_EVERY_S = 0.25  # live plots are redrawn at most this often [s]
+TEXT_EVERY_S = 0.25  # status and warning texts are refreshed at most this often [s]
+CAMERA_DEADBAND_M = 0.05  # a following camera moves once the COM has moved this far [m]
 OPERATOR_BESIDE_M = np.array([0.0, 0.9, 0.0])  # operator skeleton beside the character (world, +y) [m]
 CAMERA_OFFSET_M = (2.6, -1.6, 1.4)  # camera position relative to the COM's ground point [m]
-BALL_SPEED_MPS = 7.0  # a pushed ball's speed [m/s]
-BALL_START_M = 1.5  # a pushed ball starts this far in front of the chest [m]
 _CIRCLE = np.stack([np.cos(np.linspace(0, 2 * np.pi, 49)), np.sin(np.linspace(0, 2 * np.pi, 49))], axis=1)
 _STANCE_TEXT = {Stance.LS: "LS (left stance)", Stance.DS: "DS (double stance)", Stance.RS: "RS (right stance)"}
 _BODY_COLOUR = (200, 180, 150)
@@ -52,11 +51,17 @@ def free_port(host: str = "127.0.0.1") -> int:
         return int(s.getsockname()[1])
 
 
-def _capsule_mesh(length_m: float, radius_m: float) -> tuple[np.ndarray, np.ndarray]:
+def _shape_mesh(shape: LinkShape) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices (in the shape's frame) and faces of a collision shape."""
     import trimesh
 
-    mesh = trimesh.creation.capsule(height=length_m, radius=radius_m, count=[12, 12])
-    return np.asarray(mesh.vertices, dtype=np.float32), np.asarray(mesh.faces, dtype=np.uint32)
+    if shape.kind == "sphere":
+        mesh = trimesh.creation.icosphere(subdivisions=2, radius=shape.size[0])
+    elif shape.kind == "box":
+        mesh = trimesh.creation.box(extents=shape.size)
+    else:
+        mesh = trimesh.creation.capsule(height=shape.size[0], radius=shape.size[1], count=[12, 12])
+    return np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces, dtype=np.uint32)
 
 
 def _ring_segments(points_2d: np.ndarray, z_m: float) -> np.ndarray:
@@ -66,12 +71,12 @@ def _ring_segments(points_2d: np.ndarray, z_m: float) -> np.ndarray:
 
 
 class WebViewer:
-    """``publish`` from the loop; ``close`` when done. ``on_command`` receives the callables the controls queue
-    (each takes the session); ``None`` makes the viewer read-only (replay)."""
+    """``publish`` a snapshot; ``close`` when done. ``on_action`` receives the controls' actions by name ("reset",
+    "push", "pause", "resume"); ``None`` makes the viewer read-only (replay). Runs in the viewer's own process
+    (process.py)."""
 
     def __init__(self, shapes: list[LinkShape], host: str = "127.0.0.1", port: int | None = None,
-                 draw_hz: float = 20.0, on_command: Callable[[Callable], None] | None = None,
-                 on_pause: Callable[[bool], None] | None = None):
+                 draw_hz: float = 20.0, on_action: Callable[[str], None] | None = None):
         try:
             import viser
             import viser.uplot as uplot
@@ -83,13 +88,14 @@ class WebViewer:
         self.server = viser.ViserServer(host=host, port=self.port, verbose=False)
         self.shapes = shapes
         self.draw_hz = draw_hz
-        self._on_command = on_command
-        self._on_pause = on_pause
+        self._on_action = on_action
         self._latest: Snapshot | None = None
         self._drawn: Snapshot | None = None
         self._stop = threading.Event()
         self._history: deque[tuple[float, float, float, float]] = deque()
         self._last_plot = 0.0
+        self._last_text = 0.0
+        self._camera_target = np.full(2, np.inf)
         self.frames_drawn = 0
         self._build_scene()
         self._build_gui(uplot)
@@ -102,18 +108,14 @@ class WebViewer:
         sc = self.server.scene
         sc.set_up_direction("+z")
         sc.add_grid("/ground", width=20.0, height=20.0, cell_size=0.5, position=(0.0, 0.0, 0.0))
-        self._body: list[Any] = []
-        for i, sh in enumerate(self.shapes):
-            name = f"/character/shape_{i}"
-            h: Any
-            if sh.kind == "sphere":
-                h = sc.add_icosphere(name, radius=sh.size[0], color=_BODY_COLOUR, subdivisions=2)
-            elif sh.kind == "box":
-                h = sc.add_box(name, color=_BODY_COLOUR, dimensions=np.asarray(sh.size))
-            else:
-                v, f = _capsule_mesh(sh.size[0], sh.size[1])
-                h = sc.add_mesh_simple(name, v, f, color=_BODY_COLOUR)
-            self._body.append(h)
+        # The whole body is one mesh whose vertices are re-posed each frame: one message per frame instead of two
+        # per shape (the per-shape handles cost the loop measurably more).
+        parts = [_shape_mesh(sh) for sh in self.shapes]
+        self._local_vertices = [v for v, _ in parts]
+        offsets = np.cumsum([0] + [len(v) for v in self._local_vertices[:-1]])
+        faces = np.concatenate([f + o for (_, f), o in zip(parts, offsets, strict=True)]).astype(np.uint32)
+        self._body = sc.add_mesh_simple("/character/body", np.concatenate(self._local_vertices), faces,
+                                        color=_BODY_COLOUR)
         self._com = sc.add_icosphere("/overlays/com", radius=0.03, color=(220, 30, 30))
         self._com_ground = sc.add_icosphere("/overlays/com_ground", radius=0.025, color=(220, 30, 30),
                                             scale=(1.0, 1.0, 0.15))
@@ -152,13 +154,14 @@ class WebViewer:
             data=(np.zeros(1), np.zeros(1)), series=(uplot.Series(label="t [s]"),
                                                      uplot.Series(label="stance (0 LS, 1 DS, 2 RS)", stroke="green")),
             title="Character stance", aspect=2.0, scales=linear_x)
-        if self._on_command is None:
+        if self._on_action is None:
             for h in (reset, push):
                 h.disabled = True
         else:
-            reset.on_click(lambda _: self._command(lambda session: session.reset_character()))
-            push.on_click(lambda _: self._command(_throw_ball_at_chest))
-        self._pause.on_update(lambda _: self._on_pause(self._pause.value) if self._on_pause else None)
+            act = self._on_action
+            reset.on_click(lambda _: act("reset"))
+            push.on_click(lambda _: act("push"))
+            self._pause.on_update(lambda _: act("pause" if self._pause.value else "resume"))
 
     def _place_camera(self, client) -> None:
         snap = self._latest
@@ -166,11 +169,6 @@ class WebViewer:
         client.camera.position = (c[0] + CAMERA_OFFSET_M[0], c[1] + CAMERA_OFFSET_M[1], CAMERA_OFFSET_M[2])
         client.camera.look_at = (c[0], c[1] + 0.4, 0.8)
 
-    def _command(self, fn: Callable) -> None:
-        if self._on_command is not None:
-            self._on_command(fn)
-
-    # ---- the loop's side --------------------------------------------------------------------------------------
     def publish(self, snap: Snapshot) -> None:
         self._latest = snap
 
@@ -192,9 +190,9 @@ class WebViewer:
     def _draw(self, snap: Snapshot) -> None:
         show = {k: h.value for k, h in self._show.items()}
         with self.server.atomic():
-            for h, (p, q) in zip(self._body, shape_poses(self.shapes, snap), strict=True):
-                h.position = p
-                h.wxyz = q
+            posed = [v @ rot.matrix_from_quat(q).T + p
+                     for v, (p, q) in zip(self._local_vertices, shape_poses(self.shapes, snap), strict=True)]
+            self._body.vertices = np.concatenate(posed).astype(np.float32)
             com = snap.com_world
             for handle in (self._com, self._com_ground, self._com_line):
                 handle.visible = show["com"]
@@ -228,17 +226,28 @@ class WebViewer:
             self._stance_label.visible = show["stance"]
             self._stance_label.position = (com[0], com[1], 1.9)
             self._draw_balls(snap)
-        self._status.content = (f"**t = {snap.time_s:.2f} s** · character {_STANCE_TEXT[snap.character_stance]} · "
-                                f"operator {snap.operator_stance.name} · balls thrown: {len(snap.balls_world)}"
-                                + (" · **fallen**" if snap.fell else ""))
-        active = [k for k, v in snap.bounds_active.items() if v]
-        self._warning.content = ("⚠️ **operator exceeds the movement bounds: " + ", ".join(active) + "**"
-                                 if active else "")
+        now = time.perf_counter()
+        if now - self._last_text >= TEXT_EVERY_S:
+            self._last_text = now
+            self._texts(snap)
         self._plots(snap)
-        if self._follow.value:
+        target = np.array([com[0], com[1]])
+        if self._follow.value and np.linalg.norm(target - self._camera_target) > CAMERA_DEADBAND_M:
+            self._camera_target = target
             for client in self.server.get_clients().values():
                 client.camera.position = (com[0] + CAMERA_OFFSET_M[0], com[1] + CAMERA_OFFSET_M[1], CAMERA_OFFSET_M[2])
                 client.camera.look_at = (com[0], com[1] + 0.4, 0.8)
+
+    def _texts(self, snap: Snapshot) -> None:
+        status = (f"**t = {snap.time_s:.2f} s** · character {_STANCE_TEXT[snap.character_stance]} · "
+                  f"operator {snap.operator_stance.name} · balls thrown: {len(snap.balls_world)}"
+                  + (" · **fallen**" if snap.fell else ""))
+        active = [k for k, v in snap.bounds_active.items() if v]
+        warning = "⚠️ **operator exceeds the movement bounds: " + ", ".join(active) + "**" if active else ""
+        if status != self._status.content:
+            self._status.content = status
+        if warning != self._warning.content:
+            self._warning.content = warning
 
     def _draw_balls(self, snap: Snapshot) -> None:
         while len(self._balls) < len(snap.balls_world):
@@ -264,12 +273,3 @@ class WebViewer:
         self._stop.set()
         self._thread.join(timeout=2.0)
         self.server.stop()
-
-
-def _throw_ball_at_chest(session) -> None:
-    """A football thrown at the chest from the front (a scripted disturbance, Sec. 7.4.2)."""
-    state = session.backend.read_state(0.0)
-    chest = state.link_com_world[1]
-    heading = rot.yaw_from_quat(state.root_quat_wxyz)
-    forward = np.array([np.cos(heading), np.sin(heading), 0.0])
-    session.backend.throw_ball(chest + BALL_START_M * forward, -BALL_SPEED_MPS * forward)
