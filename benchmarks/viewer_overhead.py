@@ -79,15 +79,16 @@ def main() -> None:
     cfg = SessionConfig(duration_s=args.duration, operator=OperatorConfig(clip=args.clip))
     without, with_ = [], []
     with sync_playwright() as p:
-        launch = [chromium] if browser_cpus is None else ["taskset", "-c", ",".join(map(str, browser_cpus)), chromium]
+        pin = ["taskset", "-c", ",".join(map(str, browser_cpus))] if browser_cpus else []
+        launch = [*pin, chromium]
         browser = p.chromium.launch(executable_path=_wrapper(launch),
                                     args=["--no-sandbox", "--use-gl=swiftshader", "--enable-unsafe-swiftshader"])
         for _ in range(args.repeats):
             without.append(run_once(cfg, False, browser)[0])
             rtf, frames = run_once(cfg, True, browser, browser_cpus)
             with_.append(rtf)
-        launch = [chromium] if browser_cpus is None else ["taskset", "-c", ",".join(map(str, browser_cpus)),
-                                                          chromium]
+            print(f"  without viewer {without[-1]:.2f}x, with viewer and a browser {rtf:.2f}x "
+                  f"({frames} snapshots sent)")
         browser.close()
     a, b = statistics.median(without), statistics.median(with_)
     print(f"clip {args.clip}, {args.duration:.0f} s simulated per run, {args.repeats} runs each, viewer at "
