@@ -22,12 +22,13 @@ from stylesync.control.bounds import BoundsMonitor
 from stylesync.control.controller import BalanceController
 from stylesync.control.pid import joint_error
 from stylesync.errors import SourceError
+from stylesync.metrics.imitation import CHARACTER_LINKS, OPERATOR_JOINTS
 from stylesync.motion.pose_optimization import MotionOptimizer
 from stylesync.motion.stance_fsm import Stance
 from stylesync.motion.style_features import ROW_NAMES as _FEATURES
 from stylesync.motion.style_features import StyleExtractor
 from stylesync.processing.operator_processing import OperatorProcessing, OperatorSample
-from stylesync.sim.backend import CharacterState, PhysicsBackend, make_backend
+from stylesync.sim.backend import CONTACT_FORCE_N, CharacterState, PhysicsBackend, make_backend
 from stylesync.sim.character import LINK_NAMES, STANDING_ROOT_HEIGHT_M
 from stylesync.sources.base import OperatorSource
 
@@ -253,6 +254,10 @@ class Session:
             root_z=state.root_pos_world[2],
             contact_l=state.foot_contact_force_n["left_ankle"], contact_r=state.foot_contact_force_n["right_ankle"],
             joint_err_deg=float(np.degrees(np.linalg.norm(err, axis=1)).mean()),
+            ch_joints=state.link_origin_world[CHARACTER_LINKS].copy(),
+            op_joints=np.array([sample.pos[n] for n in OPERATOR_JOINTS]),
+            foot_contact=(state.foot_contact_force_n["left_ankle"] > CONTACT_FORCE_N,
+                          state.foot_contact_force_n["right_ankle"] > CONTACT_FORCE_N),
             lipm_fx=self.controller.telemetry.lipm_force_n[0], lipm_fy=self.controller.telemetry.lipm_force_n[1],
             **{f"op_{k}": v for k, v in zip(_FEATURES, ref.operator_features.as_row(), strict=True)},
             **{f"ch_{k}": v for k, v in zip(_FEATURES, cf.as_row(), strict=True)},

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from stylesync.metrics import imitation as im
 from stylesync.motion.stance_fsm import Stance
 from stylesync.session import STANCE_CODE, SessionResult
 
@@ -64,6 +65,28 @@ def summarize(result: SessionResult) -> dict:
         "dropped_joint_values": result.dropped_joint_values,
         "bound_violations": result.bound_counts,
         "input_latency_ms": _latency(result.input_latency_ms),
+    } | imitation_metrics(result)
+
+
+def imitation_metrics(result: SessionResult) -> dict:
+    """MPJPE, UHC/PHC fall, foot skating, jitter and synchronisation lag (imitation.py)."""
+    lg = result.log
+    t = lg.array("t")
+    if len(t) < 3:
+        return {}
+    dt = float(np.median(np.diff(t)))
+    ch = lg.array("ch_joints")
+    ref = im.scale_operator_to_character(lg.array("op_joints"), lg.array("scale"), ch[0, 0])
+    uhc = im.uhc_fall_index(ch, ref)
+    feet = [im.JOINT_PAIRS.index(("left_ankle", "ANKLE_LEFT")), im.JOINT_PAIRS.index(("right_ankle", "ANKLE_RIGHT"))]
+    rel_ch, rel_ref = ch - ch[:, :1], ref - ref[:, :1]
+    return {
+        "mpjpe_global_mm": round(im.mpjpe_mm(ch, ref), 1),
+        "mpjpe_root_mm": round(im.mpjpe_mm(ch, ref, root_relative=True), 1),
+        "uhc_fall_time_s": None if uhc is None else float(t[uhc]),
+        "foot_skate_mm": round(im.foot_skate_mm(ch[:, feet], lg.array("foot_contact").astype(bool)), 3),
+        "jitter_mps2": round(im.jitter_mps2(ch, dt), 3),
+        "sync_lag_s": round(im.sync_lag_s(rel_ref.reshape(len(t), -1), rel_ch.reshape(len(t), -1), dt), 4),
     }
 
 

@@ -1,0 +1,96 @@
+"""Field-standard motion-imitation metrics (definitions in docs/metrics.md).
+
+Inputs are per-control-tick arrays: positions (T, J, 3) in metres in the world frame (z up), times in seconds.
+The operator's joints are first scaled to the character (:func:`scale_operator_to_character`), as in physics-based
+imitation benchmarks (UHC, PHC), so that errors measure imitation rather than the difference in body size.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from stylesync.sim.character import LINK_NAMES
+
+# Character links whose frame origin is the joint of the same name on the operator (canonical joints).
+JOINT_PAIRS: tuple[tuple[str, str], ...] = (
+    ("root", "PELVIS"), ("chest", "SPINE_CHEST"), ("neck", "NECK"),
+    ("left_hip", "HIP_LEFT"), ("left_knee", "KNEE_LEFT"), ("left_ankle", "ANKLE_LEFT"),
+    ("right_hip", "HIP_RIGHT"), ("right_knee", "KNEE_RIGHT"), ("right_ankle", "ANKLE_RIGHT"),
+    ("left_shoulder", "SHOULDER_LEFT"), ("left_elbow", "ELBOW_LEFT"), ("left_wrist", "WRIST_LEFT"),
+    ("right_shoulder", "SHOULDER_RIGHT"), ("right_elbow", "ELBOW_RIGHT"), ("right_wrist", "WRIST_RIGHT"),
+)
+CHARACTER_LINKS = np.array([LINK_NAMES.index(c) for c, _ in JOINT_PAIRS])
+OPERATOR_JOINTS: tuple[str, ...] = tuple(o for _, o in JOINT_PAIRS)
+UHC_FALL_DISTANCE_M = 0.5  # termination when the mean joint distance exceeds this (UHC/PHC) [m]
+
+
+def scale_operator_to_character(op_pos: np.ndarray, scale: np.ndarray | float, char_root0: np.ndarray) -> np.ndarray:
+    """Operator joints (T, J, 3) scaled by the leg-length ratio (Eq. 9) about the operator's first pelvis ground
+    point (joint 0) and moved onto the character's first pelvis ground point ``char_root0``."""
+    op_pos = np.asarray(op_pos, dtype=float)
+    s = np.broadcast_to(np.asarray(scale, dtype=float), (op_pos.shape[0],))[:, None, None]
+    base = np.array([op_pos[0, 0, 0], op_pos[0, 0, 1], 0.0])
+    anchor = np.array([char_root0[0], char_root0[1], 0.0])
+    return anchor + s * (op_pos - base)
+
+
+def mpjpe_mm(char_pos: np.ndarray, ref_pos: np.ndarray, root_relative: bool = False) -> float:
+    """Mean per-joint position error [mm]; root-relative subtracts joint 0 (the pelvis) from both first."""
+    a, b = np.asarray(char_pos, dtype=float), np.asarray(ref_pos, dtype=float)
+    if root_relative:
+        a = a - a[:, :1]
+        b = b - b[:, :1]
+    return float(np.linalg.norm(a - b, axis=-1).mean() * 1e3)
+
+
+def uhc_fall_index(char_pos: np.ndarray, ref_pos: np.ndarray, limit_m: float = UHC_FALL_DISTANCE_M) -> int | None:
+    """First tick whose mean joint distance to the reference exceeds ``limit_m`` (UHC/PHC termination), or None."""
+    d = np.linalg.norm(np.asarray(char_pos) - np.asarray(ref_pos), axis=-1).mean(axis=1)
+    over = np.where(d > limit_m)[0]
+    return int(over[0]) if len(over) else None
+
+
+def foot_skate_mm(foot_pos: np.ndarray, in_contact: np.ndarray) -> float:
+    """Foot skating [mm]: mean horizontal displacement, per tick, of a foot that is in contact at both ends of the
+    tick. ``foot_pos`` (T, F, 3), ``in_contact`` (T, F) booleans."""
+    p = np.asarray(foot_pos, dtype=float)
+    c = np.asarray(in_contact, dtype=bool)
+    both = c[1:] & c[:-1]
+    if not both.any():
+        return 0.0
+    step = np.linalg.norm(p[1:, :, :2] - p[:-1, :, :2], axis=-1)
+    return float(step[both].mean() * 1e3)
+
+
+def jitter_mps2(pos: np.ndarray, dt_s: float) -> float:
+    """Jitter: mean joint acceleration magnitude by second differences [m/s^2]."""
+    p = np.asarray(pos, dtype=float)
+    if len(p) < 3:
+        return 0.0
+    acc = (p[2:] - 2 * p[1:-1] + p[:-2]) / dt_s**2
+    return float(np.linalg.norm(acc, axis=-1).mean())
+
+
+def sync_lag_s(operator: np.ndarray, character: np.ndarray, dt_s: float, max_lag_s: float = 1.0) -> float:
+    """Synchronisation lag [s]: the shift of the character's trajectories that best aligns them with the
+    operator's, by normalised cross-correlation summed over channels (positive: the character is late).
+
+    ``operator`` and ``character`` are (T, K) channel arrays sampled every ``dt_s``.
+    """
+    a = np.asarray(operator, dtype=float).reshape(len(operator), -1)
+    b = np.asarray(character, dtype=float).reshape(len(character), -1)
+    a = a - a.mean(axis=0)
+    b = b - b.mean(axis=0)
+    n = len(a)
+    max_k = min(int(round(max_lag_s / dt_s)), n // 2)
+    best, best_k = -np.inf, 0
+    for k in range(-max_k, max_k + 1):
+        x, y = (a[: n - k], b[k:]) if k >= 0 else (a[-k:], b[: n + k])
+        denom = np.sqrt((x * x).sum(axis=0) * (y * y).sum(axis=0))
+        valid = denom > 1e-12
+        if not valid.any():
+            continue
+        score = float(((x * y).sum(axis=0)[valid] / denom[valid]).mean())
+        if score > best:
+            best, best_k = score, k
+    return best_k * dt_s
