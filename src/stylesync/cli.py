@@ -177,6 +177,16 @@ def _replay(args: argparse.Namespace) -> int:
     return 0
 
 
+def _bench(args: argparse.Namespace) -> int:
+    from stylesync.metrics.bench import run_bench
+
+    shared = Path(args.shared) if args.shared else Path(__file__).resolve().parents[3] / "shared"
+    report = run_bench(Path(args.out), args.duration, args.seed, shared if shared.is_dir() else None)
+    print(report["table"])
+    print(f"outputs in {args.out}")
+    return 0
+
+
 def _add_export_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--export-bvh", help="write the character's motion as BVH")
     p.add_argument("--export-mp4", help="write an MP4 of the character (software renderer)")
@@ -252,6 +262,12 @@ def main(argv: list[str] | None = None) -> int:
     measure.add_argument("--mass", type=float, default=75.8, help="operator's total mass [kg]")
     measure.add_argument("--point-cloud", help="body point cloud (.ply or .npy, metres, world frame)")
     measure.set_defaults(func=_measure)
+    bench = sub.add_parser("bench", help="stylesync vs plain PD vs no model-based compensation over the clip suite")
+    bench.add_argument("--duration", type=float, default=10.0, help="simulated seconds per clip")
+    bench.add_argument("--seed", type=int, default=0)
+    bench.add_argument("--out", default="out/bench", help="output folder (bench.md, bench.json)")
+    bench.add_argument("--shared", help="folder holding mocap/cmu (default: ../shared beside the checkout)")
+    bench.set_defaults(func=_bench)
     replay = sub.add_parser("replay", help="replay a session file (no re-simulation) into BVH and/or MP4")
     replay.add_argument("file", help="session file (.jsonl) written by run or demo")
     replay.add_argument("--speed", type=float, default=1.0, help="viewer playback speed (1 = real time)")
