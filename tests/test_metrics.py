@@ -73,3 +73,32 @@ def test_uhc_termination_and_operator_scaling():
     scaled = im.scale_operator_to_character(op, 0.5, np.array([0.0, 0.0, 0.9]))
     np.testing.assert_allclose(scaled[0, 0], [0.0, 0.0, 0.5])
     np.testing.assert_allclose(scaled[0, 1], [0.0, 0.0, 0.0])
+
+
+def test_report_holds_metrics_figures_and_versions(tmp_path):
+    from stylesync.metrics.report import write_report
+
+    (tmp_path / "metrics.json").write_text('{"fell": false, "mpjpe_global_mm": 123.4, "delay": {"max": 0.1}}')
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots()
+    ax.plot([0, 1], [0, 1])
+    fig.savefig(tmp_path / "fig.png")
+    plt.close(fig)
+    text = write_report(tmp_path).read_text()
+    assert "mpjpe_global_mm" in text and "123.4" in text and "delay.max" in text
+    assert "data:image/png;base64," in text and "pybullet" in text
+
+
+def test_experiments_not_built_fail_with_one_line(capsys):
+    from stylesync.cli import main
+
+    with pytest.raises(SystemExit) as e:
+        main(["experiment", "nonsense"])
+    assert e.value.code == 2
+    assert main(["experiment", "kick"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1] == "stylesync: error: experiment 'kick' is not implemented yet; available: sync"

@@ -76,7 +76,10 @@ def _run_session(cfg: SessionConfig, source, out: Path, extra: dict, args: argpa
     write_plots(result, out)
     write_strip(session.renders, out / "render_strip.png")
     print(json.dumps({k: metrics[k] for k in _HEADLINE}))
-    print(f"outputs in {out}")
+    from stylesync.metrics.report import write_report
+
+    write_report(out)
+    print(f"outputs in {out} (report.html)")
     return 0
 
 
@@ -183,7 +186,32 @@ def _bench(args: argparse.Namespace) -> int:
     shared = Path(args.shared) if args.shared else Path(__file__).resolve().parents[3] / "shared"
     report = run_bench(Path(args.out), args.duration, args.seed, shared if shared.is_dir() else None)
     print(report["table"])
-    print(f"outputs in {args.out}")
+    from stylesync.metrics.report import write_report
+
+    print(f"outputs in {args.out}; report: {write_report(args.out)}")
+    return 0
+
+
+def _experiment(args: argparse.Namespace) -> int:
+    from stylesync.metrics.report import write_report
+
+    if args.name != "sync":
+        raise StylesyncError(f"experiment '{args.name}' is not implemented yet; available: sync")
+    from stylesync.experiments.sync import run
+
+    out = Path(args.out) / args.name
+    holds, summary = run(out, args.duration, args.seed)
+    print(json.dumps(summary))
+    print(f"claim {'holds' if holds else 'does NOT hold'}; report: {write_report(out)}")
+    return 0 if holds else 1
+
+
+def _report(args: argparse.Namespace) -> int:
+    from stylesync.metrics.report import write_report
+
+    if not Path(args.folder).is_dir():
+        raise StylesyncError(f"{args.folder}: not a folder")
+    print(write_report(args.folder))
     return 0
 
 
@@ -262,6 +290,15 @@ def main(argv: list[str] | None = None) -> int:
     measure.add_argument("--mass", type=float, default=75.8, help="operator's total mass [kg]")
     measure.add_argument("--point-cloud", help="body point cloud (.ply or .npy, metres, world frame)")
     measure.set_defaults(func=_measure)
+    experiment = sub.add_parser("experiment", help="re-run one of the paper's experiments (Sec. 7.4)")
+    experiment.add_argument("name", choices=("sync", "push", "styles", "kick", "squat-jump", "tune"))
+    experiment.add_argument("--duration", type=float, default=12.0)
+    experiment.add_argument("--seed", type=int, default=0)
+    experiment.add_argument("--out", default="out/experiments")
+    experiment.set_defaults(func=_experiment)
+    report = sub.add_parser("report", help="write report.html for a run, bench or experiment folder")
+    report.add_argument("folder")
+    report.set_defaults(func=_report)
     bench = sub.add_parser("bench", help="stylesync vs plain PD vs no model-based compensation over the clip suite")
     bench.add_argument("--duration", type=float, default=10.0, help="simulated seconds per clip")
     bench.add_argument("--seed", type=int, default=0)

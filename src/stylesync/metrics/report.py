@@ -1,0 +1,77 @@
+"""``report.html`` for a run, a bench or an experiment folder: its figures, its metrics as a table, the
+configuration it recorded and the versions of what ran it. One self-contained file (figures inlined)."""
+
+from __future__ import annotations
+
+import base64
+import html
+import json
+import platform
+from importlib import metadata
+from pathlib import Path
+
+_PACKAGES = ("stylesync", "pybullet", "numpy", "scipy", "viser", "bvhio")
+
+
+def _flatten(d: dict, prefix: str = "") -> list[tuple[str, str]]:
+    rows = []
+    for k, v in d.items():
+        key = f"{prefix}{k}"
+        if isinstance(v, dict):
+            rows += _flatten(v, key + ".")
+        elif isinstance(v, list) and len(v) > 8:
+            rows.append((key, f"[{len(v)} items]"))
+        else:
+            rows.append((key, json.dumps(v) if not isinstance(v, str) else v))
+    return rows
+
+
+def _versions() -> dict[str, str]:
+    out = {"python": platform.python_version(), "platform": platform.platform()}
+    for p in _PACKAGES:
+        try:
+            out[p] = metadata.version(p)
+        except metadata.PackageNotFoundError:
+            out[p] = "absent"
+    return out
+
+
+def _config(folder: Path) -> dict | None:
+    session = folder / "session.jsonl"
+    if not session.is_file():
+        return None
+    with session.open(encoding="utf-8") as f:
+        first = f.readline()
+    try:
+        return json.loads(first).get("config")
+    except json.JSONDecodeError:
+        return None
+
+
+def write_report(folder: str | Path) -> Path:
+    folder = Path(folder)
+    parts = [f"<h1>stylesync report: {html.escape(folder.name)}</h1>"]
+    for name in ("metrics.json", "bench.json"):
+        p = folder / name
+        if p.is_file():
+            data = json.loads(p.read_text())
+            rows = "".join(f"<tr><td>{html.escape(k)}</td><td>{html.escape(v)}</td></tr>"
+                           for k, v in _flatten(data))
+            parts.append(f"<h2>{name}</h2><table>{rows}</table>")
+    md = folder / "bench.md"
+    if md.is_file():
+        parts.append(f"<h2>bench.md</h2><pre>{html.escape(md.read_text())}</pre>")
+    for png in sorted(folder.glob("*.png")):
+        b64 = base64.b64encode(png.read_bytes()).decode()
+        parts.append(f"<h2>{html.escape(png.name)}</h2><img src='data:image/png;base64,{b64}'>")
+    cfg = _config(folder)
+    if cfg is not None:
+        parts.append(f"<h2>configuration</h2><pre>{html.escape(json.dumps(cfg, indent=1))}</pre>")
+    vrows = "".join(f"<tr><td>{k}</td><td>{html.escape(v)}</td></tr>" for k, v in _versions().items())
+    parts.append(f"<h2>versions</h2><table>{vrows}</table>")
+    style = ("body{font-family:sans-serif;max-width:1100px;margin:auto}table{border-collapse:collapse}"
+             "td{border:1px solid #ccc;padding:2px 8px;font-size:13px}img{max-width:100%}")
+    out = folder / "report.html"
+    out.write_text(f"<!doctype html><meta charset='utf-8'><title>stylesync report</title><style>{style}</style>"
+                   + "".join(parts), encoding="utf-8")
+    return out
