@@ -11,28 +11,13 @@ meaningful on a noisy machine even when the absolute figures are not.
 from __future__ import annotations
 
 import argparse
-import time
 
 import numpy as np
 
 from stylesync.config import OperatorConfig, SessionConfig
+from stylesync.metrics.bench import physics_only_rtf
 from stylesync.session import Session
-from stylesync.sim.backend import Torques, make_backend
 from stylesync.sources.builtin_operator import builtin_operator
-
-
-def physics_only_rtf(cfg: SessionConfig, sim_s: float) -> float:
-    backend = make_backend(cfg.world, cfg.clocks.physics_hz)
-    backend.reset(np.array([0.0, 0.0, 0.9]), np.array([1.0, 0.0, 0.0, 0.0]))
-    n = int(sim_s * cfg.clocks.physics_hz)
-    zero = Torques.zeros()
-    t0 = time.perf_counter()
-    for _ in range(n):
-        backend.apply_torques(zero)
-        backend.step()
-    wall = time.perf_counter() - t0
-    backend.close()
-    return sim_s / wall
 
 
 def main() -> None:
