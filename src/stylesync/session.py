@@ -95,6 +95,7 @@ class Session:
         self.paused = False
         self.stop_on_fall = True
         self.closed = False
+        self.fell = False  # the run has recorded a fall (viewers show it)
 
     def reset_character(self) -> None:
         """Stand the character up again where the operator now stands (an interactive reset; it is not a force
@@ -102,10 +103,14 @@ class Session:
         sample = self.last_sample
         if sample is None:
             return
-        yaw = rot.yaw_from_quat(sample.quat["PELVIS"])
-        pelvis = sample.pos["PELVIS"]
-        self.backend.reset(np.array([pelvis[0], pelvis[1], STANDING_ROOT_HEIGHT_M + 0.003]), rot.quat_from_yaw(yaw))
+        self._stand_at(sample.pos["PELVIS"], sample.quat["PELVIS"])
         self.controller.pid.reset()
+
+    def _stand_at(self, pelvis_world: np.ndarray, pelvis_quat_wxyz: np.ndarray) -> None:
+        """Character standing at the operator's pelvis position (horizontally) and heading."""
+        yaw = rot.yaw_from_quat(pelvis_quat_wxyz)
+        self.backend.reset(np.array([pelvis_world[0], pelvis_world[1], STANDING_ROOT_HEIGHT_M + 0.003]),
+                           rot.quat_from_yaw(yaw))
 
     def _service_commands(self) -> None:
         while True:
@@ -126,9 +131,7 @@ class Session:
         for f in frames:
             self.processing.push(f)
         f0 = frames[-1]
-        yaw = rot.yaw_from_quat(f0.quat("PELVIS"))
-        pelvis = f0.pos("PELVIS")
-        self.backend.reset(np.array([pelvis[0], pelvis[1], STANDING_ROOT_HEIGHT_M + 0.003]), rot.quat_from_yaw(yaw))
+        self._stand_at(f0.pos("PELVIS"), f0.quat("PELVIS"))
 
     def run(self, progress: Callable[[float, float], None] | None = None,
             render_every_s: float | None = None) -> SessionResult:
@@ -186,6 +189,7 @@ class Session:
                 reason = self._fall_reason(state)
                 if reason and not fell:
                     fell, fall_time, fall_reason = True, t, reason
+                    self.fell = True
                     log.warning("character fell at t=%.2f s (%s)", t, reason)
                 if fell and self.stop_on_fall:
                     break

@@ -43,16 +43,22 @@ def export_bvh(session: SessionFile, path: str | Path, fps: float = 60.0) -> int
     return len(ticks)
 
 
-def export_mp4(session: SessionFile, path: str | Path, fps: float = 30.0, width: int = 480, height: int = 360) -> int:
-    ticks = resample_ticks(session, fps)
+def posed_backend(ticks: list[dict]):
+    """For each recorded tick, a backend posed kinematically in that tick's state (no simulation): yields
+    (tick, backend); the backend is closed when the iteration ends."""
     backend = make_backend(WorldConfig(), 600.0)
-    frames = []
     try:
         for tk in ticks:
             backend.reset(np.array(tk["root_pos_world"]), np.array(tk["root_quat_wxyz"]), np.array(tk["joint_pos"]))
-            target = [tk["root_pos_world"][0], tk["root_pos_world"][1], 0.8]
-            frames.append(backend.render_rgb(target, width=width, height=height))  # type: ignore[attr-defined]
+            yield tk, backend
     finally:
         backend.close()
+
+
+def export_mp4(session: SessionFile, path: str | Path, fps: float = 30.0, width: int = 480, height: int = 360) -> int:
+    frames = []
+    for tk, backend in posed_backend(resample_ticks(session, fps)):
+        target = [tk["root_pos_world"][0], tk["root_pos_world"][1], 0.8]
+        frames.append(backend.render_rgb(target, width=width, height=height))  # type: ignore[attr-defined]
     write_mp4(path, frames, fps)
     return len(frames)

@@ -22,7 +22,6 @@ from stylesync.sim.backend import make_backend
 from stylesync.viewer.snapshot import Snapshot, snapshot_from_state
 
 log = logging.getLogger("stylesync.viewer")
-VIEWER_KINDS = ("none", "web", "gui")
 BALL_SPEED_MPS = 7.0  # a pushed ball's speed [m/s]
 BALL_START_M = 1.5  # a pushed ball starts this far in front of the chest [m]
 
@@ -113,7 +112,7 @@ def session_hook(session, viewer, draw_hz: float) -> Callable:
         balls = tuple(session.backend.body_position(b) for b in getattr(session.backend, "balls", []))
         viewer.publish(snapshot_from_state(
             state, com, ref.character_stance, ref.operator_stance, None if sample is None else sample.pos,
-            ref.scale, session.bounds.active, balls, fell=session._fall_reason(state) != ""))
+            ref.scale, session.bounds.active, balls, fell=session.fell))
 
     return hook
 
@@ -130,17 +129,14 @@ def chain(*hooks: Callable | None) -> Callable:
 
 def replay_snapshots(ticks: list[dict], operator_joints: list[str]):
     """Snapshots of a recorded session, posing the character kinematically (no simulation)."""
-    backend = make_backend(WorldConfig(), 600.0)
-    try:
-        for tk in ticks:
-            backend.reset(np.array(tk["root_pos_world"]), np.array(tk["root_quat_wxyz"]), np.array(tk["joint_pos"]))
-            state = backend.read_state(float(tk["t"]))
-            ch, op = Stance(tk["character_stance"]), Stance(tk["operator_stance"])
-            feet = {"left": ch is not Stance.RS, "right": ch is not Stance.LS}
-            op_pos = None if tk.get("operator_pos") is None else dict(zip(operator_joints, tk["operator_pos"],
-                                                                          strict=True))
-            com = tk.get("character_com_world") or backend.mass_properties().com(state)
-            yield snapshot_from_state(state, np.asarray(com), ch, op, op_pos, float(tk.get("scale", 0.8)),
-                                      {}, feet_down=feet)
-    finally:
-        backend.close()
+    from stylesync.export.replay import posed_backend
+
+    for tk, backend in posed_backend(ticks):
+        state = backend.read_state(float(tk["t"]))
+        ch, op = Stance(tk["character_stance"]), Stance(tk["operator_stance"])
+        feet = {"left": ch is not Stance.RS, "right": ch is not Stance.LS}
+        op_pos = None if tk.get("operator_pos") is None else dict(zip(operator_joints, tk["operator_pos"],
+                                                                      strict=True))
+        com = tk.get("character_com_world") or backend.mass_properties().com(state)
+        yield snapshot_from_state(state, np.asarray(com), ch, op, op_pos, float(tk.get("scale", 0.8)),
+                                  {}, feet_down=feet)

@@ -64,6 +64,13 @@ def _shape_mesh(shape: LinkShape) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces, dtype=np.uint32)
 
 
+def _aim(client, com_world: np.ndarray) -> None:
+    """Point a browser's camera at the character from CAMERA_OFFSET_M beside its COM's ground point."""
+    c = com_world
+    client.camera.position = (c[0] + CAMERA_OFFSET_M[0], c[1] + CAMERA_OFFSET_M[1], CAMERA_OFFSET_M[2])
+    client.camera.look_at = (c[0], c[1] + 0.4, 0.8)
+
+
 def _ring_segments(points_2d: np.ndarray, z_m: float) -> np.ndarray:
     """Closed polyline through ``points_2d`` as (n, 2, 3) segments at height ``z_m``."""
     p = np.column_stack([points_2d, np.full(len(points_2d), z_m)])
@@ -96,7 +103,6 @@ class WebViewer:
         self._last_plot = 0.0
         self._last_text = 0.0
         self._camera_target = np.full(2, np.inf)
-        self.frames_drawn = 0
         self._build_scene()
         self._build_gui(uplot)
         self.server.on_client_connect(self._place_camera)
@@ -165,9 +171,7 @@ class WebViewer:
 
     def _place_camera(self, client) -> None:
         snap = self._latest
-        c = snap.com_world if snap is not None else np.array([0.0, 0.0, 0.8])
-        client.camera.position = (c[0] + CAMERA_OFFSET_M[0], c[1] + CAMERA_OFFSET_M[1], CAMERA_OFFSET_M[2])
-        client.camera.look_at = (c[0], c[1] + 0.4, 0.8)
+        _aim(client, snap.com_world if snap is not None else np.zeros(3))
 
     def publish(self, snap: Snapshot) -> None:
         self._latest = snap
@@ -184,7 +188,6 @@ class WebViewer:
                 except Exception:  # a drawing error must not take the session down
                     log.exception("web viewer: drawing failed")
                 self._drawn = snap
-                self.frames_drawn += 1
             self._stop.wait(max(0.0, period - (time.perf_counter() - t0)))
 
     def _draw(self, snap: Snapshot) -> None:
@@ -235,8 +238,7 @@ class WebViewer:
         if self._follow.value and np.linalg.norm(target - self._camera_target) > CAMERA_DEADBAND_M:
             self._camera_target = target
             for client in self.server.get_clients().values():
-                client.camera.position = (com[0] + CAMERA_OFFSET_M[0], com[1] + CAMERA_OFFSET_M[1], CAMERA_OFFSET_M[2])
-                client.camera.look_at = (com[0], com[1] + 0.4, 0.8)
+                _aim(client, com)
 
     def _texts(self, snap: Snapshot) -> None:
         status = (f"**t = {snap.time_s:.2f} s** · character {_STANCE_TEXT[snap.character_stance]} · "
