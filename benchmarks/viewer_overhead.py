@@ -17,23 +17,22 @@ import statistics
 import tempfile
 from pathlib import Path
 
-from stylesync.config import OperatorConfig, SessionConfig
+from stylesync.config import VIEWER_DRAW_HZ, OperatorConfig, SessionConfig
 from stylesync.session import Session
 from stylesync.sources.builtin_operator import builtin_operator
 from stylesync.viewer.attach import chain, open_viewer, session_hook
 
-DRAW_HZ = 20.0
 
-
-def run_once(cfg: SessionConfig, with_viewer: bool, browser, viewer_cpus: set[int] | None = None) -> tuple[float, int]:
+def run_once(cfg: SessionConfig, with_viewer: bool, browser, draw_hz: float,
+             viewer_cpus: set[int] | None = None) -> tuple[float, int]:
     source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
     session = Session(cfg, source)
     viewer, page = None, None
     if with_viewer:
-        viewer = open_viewer("web", session, draw_hz=DRAW_HZ)
+        viewer = open_viewer("web", session, draw_hz=draw_hz)
         if viewer_cpus:
             os.sched_setaffinity(viewer._proc.pid, viewer_cpus)
-        session.on_tick = chain(session_hook(session, viewer, DRAW_HZ))
+        session.on_tick = chain(session_hook(session, viewer, draw_hz))
         page = browser.new_page(viewport={"width": 1000, "height": 700})
         page.goto(viewer.url)
         page.get_by_text("Push (throw a ball at the chest)").wait_for(timeout=30000)
@@ -62,6 +61,7 @@ def main() -> None:
     ap.add_argument("--duration", type=float, default=15.0)
     ap.add_argument("--repeats", type=int, default=2)
     ap.add_argument("--clip", default="stand")
+    ap.add_argument("--draw-hz", type=float, default=VIEWER_DRAW_HZ, help="viewer drawing rate [Hz]")
     ap.add_argument("--pin", action="store_true",
                     help="pin the control loop to the first CPU, the viewer process and the browser to the others "
                          "(as on a machine whose browser renders on a GPU)")
@@ -84,15 +84,15 @@ def main() -> None:
         browser = p.chromium.launch(executable_path=_wrapper(launch),
                                     args=["--no-sandbox", "--use-gl=swiftshader", "--enable-unsafe-swiftshader"])
         for _ in range(args.repeats):
-            without.append(run_once(cfg, False, browser)[0])
-            rtf, frames = run_once(cfg, True, browser, browser_cpus)
+            without.append(run_once(cfg, False, browser, args.draw_hz)[0])
+            rtf, frames = run_once(cfg, True, browser, args.draw_hz, browser_cpus)
             with_.append(rtf)
             print(f"  without viewer {without[-1]:.2f}x, with viewer and a browser {rtf:.2f}x "
                   f"({frames} snapshots sent)")
         browser.close()
     a, b = statistics.median(without), statistics.median(with_)
     print(f"clip {args.clip}, {args.duration:.0f} s simulated per run, {args.repeats} runs each, viewer at "
-          f"{DRAW_HZ:.0f} Hz, {'loop and browser on separate CPUs' if browser_cpus else 'no CPU pinning'}")
+          f"{args.draw_hz:.0f} Hz, {'loop and browser on separate CPUs' if browser_cpus else 'no CPU pinning'}")
     print(f"realtime factor without viewer (median): {a:.2f}x")
     print(f"realtime factor with viewer + browser:   {b:.2f}x")
     print(f"drop: {100 * (1 - b / a):.1f} %")

@@ -9,7 +9,7 @@ import logging
 import sys
 from pathlib import Path
 
-from stylesync.config import ClockConfig, ControlConfig, OperatorConfig, SessionConfig
+from stylesync.config import VIEWER_DRAW_HZ, ClockConfig, ControlConfig, OperatorConfig, SessionConfig
 from stylesync.errors import StylesyncError
 
 _HEADLINE = ("fell", "fall_time_s", "sim_duration_s", "operator_steps", "character_steps", "realtime_factor")
@@ -193,12 +193,11 @@ def _bench(args: argparse.Namespace) -> int:
 
 
 def _experiment(args: argparse.Namespace) -> int:
+    import importlib
+
     from stylesync.metrics.report import write_report
 
-    if args.name != "sync":
-        raise StylesyncError(f"experiment '{args.name}' is not implemented yet; available: sync")
-    from stylesync.experiments.sync import run
-
+    run = importlib.import_module(f"stylesync.experiments.{args.name.replace('-', '_')}").run
     out = Path(args.out) / args.name
     holds, summary = run(out, args.duration, args.seed)
     print(json.dumps(summary))
@@ -223,7 +222,7 @@ def _add_export_args(p: argparse.ArgumentParser) -> None:
                         "A viewer paces the run to the wall clock")
     p.add_argument("--viewer-host", default="127.0.0.1", help="address the web viewer listens on")
     p.add_argument("--viewer-port", type=int, help="web viewer port (default: a free one)")
-    p.add_argument("--viewer-hz", type=float, default=20.0, help="viewer drawing rate [Hz]")
+    p.add_argument("--viewer-hz", type=float, default=VIEWER_DRAW_HZ, help="viewer drawing rate [Hz]")
 
 
 def _add_session_args(p: argparse.ArgumentParser, out_default: str, realtime_help: str) -> None:

@@ -11,6 +11,8 @@ from dataclasses import dataclass, field
 
 from stylesync.errors import ConfigError
 
+VIEWER_DRAW_HZ = 20.0  # default drawing rate of a viewer, independent of the control rate [Hz]
+
 
 def _positive(name: str, value: float) -> None:
     if not (value > 0):
@@ -130,6 +132,9 @@ class ControlConfig:
     root_torque_kd: float = 100.0  # Table 3 gives 1000; see below [N·m·s/rad]
     # Extra scaling of the root torque about the vertical (heading), which the stance hips also carry.
     root_yaw_gain_scale: float = 1.0
+    # In single stance the stance hip carries the root torque alone and cancels the other pelvis joints'
+    # feedback (SIMBICON's torso control, controller.py); otherwise the root torque is one more implicit term.
+    stance_hip_torso: bool = True
     gravity_compensation: bool = True  # Eq. 14-15
     com_virtual_force: bool = True  # Eq. 16-17
     root_virtual_torque: bool = True  # Eq. 16, 18

@@ -39,9 +39,10 @@ from stylesync.control.support import limit_ankle_moment
 from stylesync.motion.reference import ReferencePose
 from stylesync.motion.stance_fsm import Stance
 from stylesync.sim.backend import CONTACT_FORCE_N, CharacterState, JointFeedback, MassProperties, Torques
-from stylesync.sim.character import JOINTS, ROOT_DOFS
+from stylesync.sim.character import JOINT_DOF_START, JOINTS, Q_WORLD_MODEL, ROOT_DOFS
 
 TORQUE_LIMIT = np.array([j.torque_limit_nm for j in JOINTS])[:, None]
+PELVIS_CHILDREN = tuple(k for k, j in enumerate(JOINTS) if j.parent == "root")  # chest and both hips
 
 
 @dataclass
@@ -83,6 +84,7 @@ class BalanceController:
         self._damping[j, j] = flatten_joint_values(self.pid.kd * dt + self.pid.kp * dt * dt)
         self._gain = np.eye(N_DOFS - ROOT_DOFS)  # G of stable_pd, joint rows and columns
         self._root_map = np.zeros((N_DOFS - ROOT_DOFS, 3))  # S: world root torque -> stance-hip DOF torques
+        self._torso_hip: int | None = None  # the stance hip that carries the root torque explicitly (see torques)
 
     def _prepare_implicit(self, state: CharacterState, stance_weight: dict[str, float],
                           mass_matrix: np.ndarray) -> None:
@@ -90,7 +92,13 @@ class BalanceController:
         dt = self.physics_dt_s
         d = self._damping.copy()
         s_map = np.zeros((N_DOFS - ROOT_DOFS, 3))
-        if self.cfg.root_virtual_torque:
+        single = [side for side, ws in stance_weight.items() if ws >= 1.0]
+        self._torso_hip = HIP_JOINT[single[0]] if (self.cfg.root_virtual_torque and self.cfg.stance_hip_torso
+                                                   and single) else None
+        if self._torso_hip is not None:  # no PD on that hip: the implicit prediction must not count on one
+            dofs = self._hip_dofs(self._torso_hip)
+            d[dofs, dofs] = 0.0
+        if self.cfg.root_virtual_torque and self._torso_hip is None:
             hips = {side: state.joint_pos[HIP_JOINT[side]] for side in ("left", "right")}
             s_map = stance_hip_map(state.root_quat_wxyz, hips, stance_weight)
             # Q_hips = S τ_r(ω_next): the root damping is implicit in the root's angular acceleration (DOFs 3-5).
@@ -171,6 +179,9 @@ class BalanceController:
         # Eq. 13 feedback r, evaluated implicitly (stable_pd.py): position error predicted one step ahead.
         r = self.pid(fb.joint_pos, fb.joint_vel, ref.joint_pos, self._ref_vel, predict_dt_s=self.physics_dt_s)
         r_flat = flatten_joint_values(r)
+        if self._torso_hip is not None:
+            r_flat[self._hip_dofs(self._torso_hip) - ROOT_DOFS] = 0.0
+        tau_r = np.zeros(3)
         if self.cfg.root_virtual_torque:  # Eq. 16 (second line), Eq. 18: -w τ_r on each stance hip
             tau_r = root_virtual_torque(ref.root_quat_wxyz, fb.root_quat_wxyz, fb.root_ang_vel_world, self.root_kp,
                                         self.root_kd, self.cfg.root_yaw_gain_scale, predict_dt_s=self.physics_dt_s)
@@ -178,4 +189,29 @@ class BalanceController:
             r_flat += self._root_map @ tau_r
         tau = unflatten_joint_values(self._gain @ r_flat) + self._ff
         tau[~IS_BALL, 1:] = 0.0
+        if self._torso_hip is not None:
+            tau[self._torso_hip] = self._torso_hip_torque(fb, tau, tau_r)
         return Torques(np.clip(tau, -TORQUE_LIMIT, TORQUE_LIMIT))
+
+    @staticmethod
+    def _hip_dofs(k: int) -> np.ndarray:
+        """Rows of a ball joint's three DOFs in the floating-base DOF layout (root DOFs first)."""
+        return ROOT_DOFS + JOINT_DOF_START[k] + np.arange(3)
+
+    def _torso_hip_torque(self, fb: JointFeedback, tau: np.ndarray, tau_r: np.ndarray) -> np.ndarray:
+        """The single-stance hip's torque (child frame) that gives the pelvis exactly the root torque of Eq. 16.
+
+        Eq. 18 read as SIMBICON [2] does it: every joint torque on the pelvis (chest, swing hip, stance hip) acts
+        on it with the opposite sign, so the stance hip takes ``τ_A = -τ_r - Σ_c τ_c`` over the pelvis's other
+        children, feedback parts only; the feed-forward parts (gravity compensation, Eq. 14-15, and the COM
+        virtual force, Eq. 17) stay on every joint. Without this the swing hip's reaction (hundreds of N·m when
+        the swing leg reaches forward) tilts the pelvis and the upper body with it, against the root PD alone.
+        """
+        q_pelvis_model = rot.multiply(fb.root_quat_wxyz, Q_WORLD_MODEL)
+        world = -np.asarray(tau_r, dtype=float)
+        for k in PELVIS_CHILDREN:
+            if k != self._torso_hip:
+                r_child = rot.matrix_from_quat(rot.multiply(q_pelvis_model, fb.joint_pos[k]))
+                world -= r_child @ (tau[k] - self._ff[k])
+        r_stance = rot.matrix_from_quat(rot.multiply(q_pelvis_model, fb.joint_pos[self._torso_hip]))
+        return self._ff[self._torso_hip] + r_stance.T @ world

@@ -15,7 +15,7 @@ from collections.abc import Callable
 import numpy as np
 
 from stylesync import rotations as rot
-from stylesync.config import WorldConfig
+from stylesync.config import VIEWER_DRAW_HZ, WorldConfig
 from stylesync.errors import SimulationError
 from stylesync.motion.stance_fsm import Stance
 from stylesync.sim.backend import make_backend
@@ -24,7 +24,6 @@ from stylesync.viewer.snapshot import Snapshot, snapshot_from_state
 log = logging.getLogger("stylesync.viewer")
 BALL_SPEED_MPS = 7.0  # a pushed ball's speed [m/s]
 BALL_START_M = 1.5  # a pushed ball starts this far in front of the chest [m]
-
 
 class GuiMirror:
     """A PyBullet GUI window posed from snapshots at ``draw_hz``; it never steps (nothing simulated there)."""
@@ -55,7 +54,8 @@ class GuiMirror:
         self.backend.close()
 
 
-def open_viewer(kind: str, session=None, host: str = "127.0.0.1", port: int | None = None, draw_hz: float = 20.0):
+def open_viewer(kind: str, session=None, host: str = "127.0.0.1", port: int | None = None,
+                draw_hz: float = VIEWER_DRAW_HZ):
     """A viewer of ``kind`` ('web' or 'gui'); with ``session`` its controls act on that session."""
     if kind == "gui":
         try:

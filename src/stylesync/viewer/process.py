@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 import multiprocessing as mp
+import os
 import queue
 import threading
 from collections.abc import Callable
@@ -23,12 +24,16 @@ from stylesync.viewer.snapshot import Snapshot
 log = logging.getLogger("stylesync.viewer")
 START_TIMEOUT_S = 60.0
 _STOP = "stop"
+VIEWER_NICENESS = 10  # added to the viewer process's niceness
 
 
 def _serve(shapes: list[LinkShape], host: str, port: int, draw_hz: float, interactive: bool,
            snapshots: mp.Queue, actions: mp.Queue, ready: Any) -> None:
     from stylesync.viewer.web_viewer import WebViewer
 
+    # The viewer yields to the control loop when they compete for a core: a late frame is harmless, a late
+    # control tick is not.
+    os.nice(VIEWER_NICENESS)
     viewer = WebViewer(shapes, host, port, draw_hz, on_action=actions.put if interactive else None)
     ready.set()
     try:

@@ -113,6 +113,8 @@ class WebViewer:
     def _build_scene(self) -> None:
         sc = self.server.scene
         sc.set_up_direction("+z")
+        # Without a GPU the browser renders WebGL in software; a shadow map is a second render pass per frame.
+        sc.configure_default_lights(enabled=True, cast_shadow=False)
         sc.add_grid("/ground", width=20.0, height=20.0, cell_size=0.5, position=(0.0, 0.0, 0.0))
         # The whole body is one mesh whose vertices are re-posed each frame: one message per frame instead of two
         # per shape (the per-shape handles cost the loop measurably more).
