@@ -128,6 +128,15 @@ class PhysicsBackend(ABC):
         """The character's collision shapes (what touches the ground), for viewers."""
 
     @abstractmethod
+    def throw_ball(self, pos_world: np.ndarray, vel_world: np.ndarray, mass_kg: float = 0.43,
+                   radius_m: float = 0.11) -> int:
+        """Spawn a football at ``pos_world`` [m] moving at ``vel_world`` [m/s] (a scripted disturbance); its id."""
+
+    @abstractmethod
+    def body_position(self, body: int) -> np.ndarray:
+        """World position [m] of a body the backend spawned (a ball)."""
+
+    @abstractmethod
     def close(self) -> None: ...
 
 

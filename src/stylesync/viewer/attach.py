@@ -14,16 +14,14 @@ from collections.abc import Callable
 
 import numpy as np
 
-from stylesync import rotations as rot
 from stylesync.config import VIEWER_DRAW_HZ, WorldConfig
 from stylesync.errors import SimulationError
 from stylesync.motion.stance_fsm import Stance
 from stylesync.sim.backend import make_backend
+from stylesync.sim.disturbance import throw_ball_at_chest
 from stylesync.viewer.snapshot import Snapshot, snapshot_from_state
 
 log = logging.getLogger("stylesync.viewer")
-BALL_SPEED_MPS = 7.0  # a pushed ball's speed [m/s]
-BALL_START_M = 1.5  # a pushed ball starts this far in front of the chest [m]
 
 class GuiMirror:
     """A PyBullet GUI window posed from snapshots at ``draw_hz``; it never steps (nothing simulated there)."""
@@ -83,18 +81,9 @@ def apply_action(session, action: str) -> None:
     elif action == "reset":
         session.commands.put(lambda s: s.reset_character())
     elif action == "push":
-        session.commands.put(throw_ball_at_chest)
+        session.commands.put(lambda s: throw_ball_at_chest(s.backend, s.backend.read_state(0.0)))
     else:
         log.warning("viewer: unknown action %r ignored", action)
-
-
-def throw_ball_at_chest(session) -> None:
-    """A football thrown at the chest from the front (a scripted disturbance, Sec. 7.4.2)."""
-    state = session.backend.read_state(0.0)
-    chest = state.link_com_world[1]
-    heading = rot.yaw_from_quat(state.root_quat_wxyz)
-    forward = np.array([np.cos(heading), np.sin(heading), 0.0])
-    session.backend.throw_ball(chest + BALL_START_M * forward, -BALL_SPEED_MPS * forward)
 
 
 def session_hook(session, viewer, draw_hz: float) -> Callable:

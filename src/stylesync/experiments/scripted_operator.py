@@ -1,0 +1,70 @@
+"""Operator responses scripted on the human model, for the experiments that no recorded clip covers (the push
+recoveries of Sec. 7.4.2, the squat of Sec. 7.4.5).
+
+Each response is a function of time giving the pelvis position and the canonical joint rotations of a
+:class:`HumanModel`; the legs are placed by a two-link inverse kinematics in the sagittal plane so that the feet
+are where the script puts them (on the floor when planted). The result goes through the same Kinect-like sensor
+model as the built-in operator (16 Hz, noise, jitter, fixed seed).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from stylesync import rotations as rot
+from stylesync.config import ClockConfig, OperatorConfig
+from stylesync.sources.base import RecordedSource
+from stylesync.sources.frame import OperatorFrame
+from stylesync.sources.human_model import HumanModel
+from stylesync.sources.sensor_model import SensorModel
+
+_Y = np.array([0.0, 1.0, 0.0])
+REACTION_S = 0.0  # the operator sees the ball coming: his response starts when it is thrown [s]
+
+
+def smooth_step(x: float) -> float:
+    """0 -> 1 with zero slope at both ends (x clamped to [0, 1])."""
+    x = min(max(x, 0.0), 1.0)
+    return x * x * (3.0 - 2.0 * x)
+
+
+def sagittal_leg(human: HumanModel, ankle_rel_hip_m: np.ndarray) -> dict[str, float]:
+    """Hip, knee and ankle pitch [rad] (rotations about +y, canonical axes; + moves the distal end backward) that
+    put the ankle at ``(dx, dz)`` from the hip (x forward, z up), knee flexed, foot level."""
+    dx, dz = float(ankle_rel_hip_m[0]), float(ankle_rel_hip_m[1])
+    T, S = human.thigh_m, human.shank_m
+    d = min(float(np.hypot(dx, dz)), T + S - 1e-6)
+    knee = float(np.arccos(np.clip((d * d - T * T - S * S) / (2 * T * S), -1.0, 1.0)))
+    lean = float(np.arctan2(-dx, -dz))  # leg line from the vertical, + when the ankle is behind the hip
+    hip = lean - float(np.arctan2(S * np.sin(knee), T + S * np.cos(knee)))
+    return {"hip": hip, "knee": knee, "ankle": -(hip + knee)}
+
+
+def pose_frame(human: HumanModel, t_s: float, pelvis_world: np.ndarray, ankles_world: dict[str, np.ndarray],
+               extra: dict[str, np.ndarray] | None = None) -> OperatorFrame:
+    """A frame with the pelvis at ``pelvis_world`` (facing +x) and each ankle at ``ankles_world[side]`` (its
+    lateral offset is the hip's), plus any other canonical joint rotations in ``extra``."""
+    quats: dict[str, np.ndarray] = {"PELVIS": rot.IDENTITY_WXYZ}
+    for side in ("left", "right"):
+        rel = ankles_world[side] - pelvis_world
+        leg = sagittal_leg(human, np.array([rel[0], rel[2]]))
+        S = side.upper()
+        quats[f"HIP_{S}"] = rot.quat_from_rotvec(_Y * leg["hip"])
+        quats[f"KNEE_{S}"] = rot.quat_from_rotvec(_Y * leg["knee"])
+        quats[f"ANKLE_{S}"] = rot.quat_from_rotvec(_Y * leg["ankle"])
+    quats.update(extra or {})
+    return human.frame_from_pose(t_s, pelvis_world, quats)
+
+
+def standing_ankles(human: HumanModel) -> dict[str, np.ndarray]:
+    hw = float(next(s for s in human.segments if s.name == "thigh_left").offset_in_parent[1])  # hip half width
+    return {"left": np.array([0.0, hw, human.ankle_height_m]), "right": np.array([0.0, -hw, human.ankle_height_m])}
+
+
+def recorded(performer: Callable[[float], OperatorFrame], operator: OperatorConfig, clocks: ClockConfig,
+             duration_s: float, seed: int, name: str) -> RecordedSource:
+    """The performer seen through the Kinect-like sensor, as a recorded source."""
+    frames = SensorModel.kinect(operator, clocks, seed).sample(performer, duration_s)
+    return RecordedSource(frames, name=name)
