@@ -93,12 +93,13 @@ def test_report_holds_metrics_figures_and_versions(tmp_path):
     assert "data:image/png;base64," in text and "pybullet" in text
 
 
-def test_experiments_not_built_fail_with_one_line(capsys):
+def test_unknown_experiment_and_missing_shared_clips_fail_with_one_line(capsys, tmp_path):
     from stylesync.cli import main
+    from stylesync.errors import StylesyncError
+    from stylesync.experiments import styles
 
     with pytest.raises(SystemExit) as e:
         main(["experiment", "nonsense"])
     assert e.value.code == 2
-    assert main(["experiment", "kick"]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert err[-1] == "stylesync: error: experiment 'kick' is not implemented yet; available: sync"
+    with pytest.raises(StylesyncError, match="needs .*humanoid3d_stealthy_walk.txt"):
+        styles.run(tmp_path / "out", shared=tmp_path / "no-shared")

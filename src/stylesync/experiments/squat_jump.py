@@ -26,6 +26,7 @@ from stylesync.metrics.summary import summarize  # noqa: E402
 from stylesync.motion.stance_fsm import Stance  # noqa: E402
 from stylesync.session import STANCE_CODE, Session  # noqa: E402
 from stylesync.sources.builtin_operator import builtin_operator  # noqa: E402
+from stylesync.sources.deepmimic_clip import DeepMimicClip  # noqa: E402
 from stylesync.sources.human_model import TABLE2_HUMAN_TOTAL_KG, HumanModel  # noqa: E402
 
 STATURES_M = (1.55, 1.75, 1.95)
@@ -62,8 +63,7 @@ def run_one(task: str, stature_m: float, seed: int):
         source = recorded(squat_performer(human), op, cfg.clocks, duration + 1.0, seed, "squat")
     else:
         op = operator_of(stature_m, JUMP_CLIP)
-        _, performer = builtin_operator(op, SessionConfig().clocks, 0.0, seed)
-        duration = op.standing_lead_in_s + (performer.clip.duration_s if performer.clip else 0.0) + SETTLE_S
+        duration = op.standing_lead_in_s + DeepMimicClip.builtin(JUMP_CLIP).duration_s + SETTLE_S
         cfg = SessionConfig(duration_s=duration, seed=seed, operator=op)
         source, _ = builtin_operator(op, cfg.clocks, duration + 1.0, seed)
     session = Session(cfg, source)

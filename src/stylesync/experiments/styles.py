@@ -80,7 +80,7 @@ def run(out: Path, duration_s: float = DURATION_S, seed: int = 0, shared: Path =
         session.stop_on_fall = False  # the operator's clip is measured to its end
         r = session.run()
         session.backend.close()
-        end = r.fall_time_s if r.fell else r.sim_duration_s
+        end = r.fall_time_s if r.fall_time_s is not None else r.sim_duration_s
         m = style_measures(r.log, op.standing_lead_in_s, end)
         m.update(fell=r.fell, fall_time_s=r.fall_time_s)
         measures[style], logs[style] = m, r.log
