@@ -131,3 +131,26 @@ def test_free_character_stands_still_with_a_standing_operator():
     settled = com[t >= 1.0]
     drift = np.linalg.norm(settled - settled[0], axis=1).max()
     assert drift < 0.02
+
+
+def test_torso_hip_gives_the_pelvis_exactly_the_root_torque():
+    # Eq. 18 realised as SIMBICON's torso control: the pelvis's joints' feedback torques add up to -τ_r on it.
+    from stylesync.control.controller import PELVIS_CHILDREN, BalanceController
+    from stylesync.control.crvc import HIP_JOINT
+    from stylesync.sim.backend import JointFeedback, MassProperties
+    from stylesync.sim.character import LINK_NAMES, Q_WORLD_MODEL
+
+    rng = np.random.default_rng(4)
+    ctl = BalanceController(ControlConfig(stance_hip_torso=True), MassProperties(np.ones(len(LINK_NAMES))), 9.8,
+                            1 / 600, 1 / 133)
+    ctl._torso_hip = HIP_JOINT["left"]
+    ctl._ff = rng.normal(0, 5, (12, 3))
+    q = random_pose(9)
+    fb = JointFeedback(q, np.zeros((12, 3)), rot.quat_from_rotvec(rng.normal(0, 0.2, 3)), np.zeros(3))
+    tau = rng.normal(0, 50, (12, 3))
+    tau_r = rng.normal(0, 30, 3)
+    tau[ctl._torso_hip] = ctl._torso_hip_torque(fb, tau, tau_r)
+    q_pelvis = rot.multiply(fb.root_quat_wxyz, Q_WORLD_MODEL)
+    on_pelvis = -sum(rot.matrix_from_quat(rot.multiply(q_pelvis, q[k])) @ (tau[k] - ctl._ff[k])
+                     for k in PELVIS_CHILDREN)
+    assert np.allclose(on_pelvis, tau_r, atol=1e-9)

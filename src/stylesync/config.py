@@ -133,8 +133,9 @@ class ControlConfig:
     # Extra scaling of the root torque about the vertical (heading), which the stance hips also carry.
     root_yaw_gain_scale: float = 1.0
     # In single stance the stance hip carries the root torque alone and cancels the other pelvis joints'
-    # feedback (SIMBICON's torso control, controller.py); otherwise the root torque is one more implicit term.
-    stance_hip_torso: bool = True
+    # feedback (SIMBICON's torso control, controller.py); off by default: measured no better overall
+    # (docs/decisions.md). Off, the root torque is one more implicit term on the stance hips.
+    stance_hip_torso: bool = False
     gravity_compensation: bool = True  # Eq. 14-15
     com_virtual_force: bool = True  # Eq. 16-17
     root_virtual_torque: bool = True  # Eq. 16, 18
