@@ -24,6 +24,7 @@ import numpy as np  # noqa: E402
 
 from stylesync import rotations as rot  # noqa: E402
 from stylesync.config import OperatorConfig, SessionConfig  # noqa: E402
+from stylesync.experiments.common import plan_view, run_session, save_figure  # noqa: E402
 from stylesync.session import Session  # noqa: E402
 from stylesync.sim.character import SHANK_LENGTH_M, THIGH_LENGTH_M  # noqa: E402
 from stylesync.sources.builtin_operator import builtin_operator  # noqa: E402
@@ -81,8 +82,7 @@ def run_one(scenario: str, seed: int):
             reach[0] = min(reach[0], float(np.linalg.norm((a - p)[:2])))
 
     session.on_tick = hook
-    result = session.run()
-    session.backend.close()
+    result = run_session(session)
     path = np.array(track) if track else ball0[None, :]
     moved = float(np.linalg.norm((path[-1] - ball0)[:2]))
     return result, {"ball_start_m": ball0.tolist(), "closest_foot_m": reach[0], "reached": reach[0] <= REACH_M,
@@ -103,13 +103,8 @@ def run(out: Path, duration_s: float = 0.0, seed: int = 0) -> tuple[bool, dict]:
         ax.add_patch(plt.Circle(tuple(m["ball_start_m"][:2]), REACH_M, color="red", alpha=0.15,
                                 label="reach area"))
         ax.set_title(f"{name}: " + ("fell" if m["fell"] else "no fall") + (", kicked" if m["kicked"] else ""))
-        ax.set_xlabel("x [m]")
-        ax.set_ylabel("y [m]")
-        ax.axis("equal")
-        ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(out / "fig15_kick.png", dpi=100)
-    plt.close(fig)
+        plan_view(ax)
+    save_figure(fig, out / "fig15_kick.png")
     holds = all(m["reached"] and m["kicked"] and not m["fell"] for m in scenarios.values())
     summary = {"experiment": "kick", "claim_holds": holds, "reach_m": REACH_M, "kicked_m": KICKED_M,
                "scenarios": scenarios}

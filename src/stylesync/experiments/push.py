@@ -25,6 +25,7 @@ import numpy as np  # noqa: E402
 
 from stylesync import rotations as rot  # noqa: E402
 from stylesync.config import OperatorConfig, SessionConfig  # noqa: E402
+from stylesync.experiments.common import run_session  # noqa: E402
 from stylesync.experiments.scripted_operator import (  # noqa: E402
     pose_frame,
     recorded,
@@ -86,9 +87,7 @@ def run_one(pattern: str, speed_mps: float, seed: int):
             thrown.append(throw_ball_at_chest(session.backend, state, speed_mps, BALL_START_M))
 
     session = Session(cfg, source, on_tick=hook)
-    result = session.run()
-    session.backend.close()
-    return result
+    return run_session(session)
 
 
 def run(out: Path, duration_s: float = 0.0, seed: int = 0) -> tuple[bool, dict]:

@@ -21,6 +21,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from stylesync.config import OperatorConfig, SessionConfig  # noqa: E402
+from stylesync.experiments.common import run_session  # noqa: E402
 from stylesync.experiments.scripted_operator import pose_frame, recorded, smooth_step, standing_ankles  # noqa: E402
 from stylesync.metrics.summary import summarize  # noqa: E402
 from stylesync.motion.stance_fsm import Stance  # noqa: E402
@@ -66,10 +67,7 @@ def run_one(task: str, stature_m: float, seed: int):
         duration = op.standing_lead_in_s + DeepMimicClip.builtin(JUMP_CLIP).duration_s + SETTLE_S
         cfg = SessionConfig(duration_s=duration, seed=seed, operator=op)
         source, _ = builtin_operator(op, cfg.clocks, duration + 1.0, seed)
-    session = Session(cfg, source)
-    result = session.run()
-    session.backend.close()
-    return result
+    return run_session(Session(cfg, source))
 
 
 def run(out: Path, duration_s: float = 0.0, seed: int = 0) -> tuple[bool, dict]:

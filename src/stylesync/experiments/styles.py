@@ -27,6 +27,7 @@ import numpy as np  # noqa: E402
 
 from stylesync.config import OperatorConfig, SessionConfig  # noqa: E402
 from stylesync.errors import StylesyncError  # noqa: E402
+from stylesync.experiments.common import plan_view, run_session, save_figure  # noqa: E402
 from stylesync.session import Session  # noqa: E402
 from stylesync.sources.registry import open_source  # noqa: E402
 
@@ -76,10 +77,7 @@ def run(out: Path, duration_s: float = DURATION_S, seed: int = 0, shared: Path =
     for style, spec in specs.items():
         cfg = SessionConfig(duration_s=duration_s, seed=seed, operator=op)
         opened = open_source(spec, cfg.clocks, op, seed=seed, duration_s=duration_s + 1.0)
-        session = Session(cfg, opened.source)
-        session.stop_on_fall = False  # the operator's clip is measured to its end
-        r = session.run()
-        session.backend.close()
+        r = run_session(Session(cfg, opened.source), stop_on_fall=False)  # the operator's clip is measured to its end
         end = r.fall_time_s if r.fall_time_s is not None else r.sim_duration_s
         m = style_measures(r.log, op.standing_lead_in_s, end)
         m.update(fell=r.fell, fall_time_s=r.fall_time_s)
@@ -117,13 +115,8 @@ def _figures(out: Path, logs: dict, measures: dict) -> None:
                        label=f"{side} foot down")
         fell = measures[style]["fell"]
         ax.set_title(style + (f" (fell at {measures[style]['fall_time_s']:.2f} s)" if fell else ""))
-        ax.set_xlabel("x [m]")
-        ax.set_ylabel("y [m]")
-        ax.axis("equal")
-        ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(out / "fig13_com_footsteps.png", dpi=100)
-    plt.close(fig)
+        plan_view(ax)
+    save_figure(fig, out / "fig13_com_footsteps.png")
     fig, axes = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
     for style, lg in logs.items():
         t = lg.array("t")
