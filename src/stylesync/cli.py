@@ -9,7 +9,7 @@ import logging
 import sys
 from pathlib import Path
 
-from stylesync.config import VIEWER_DRAW_HZ, ClockConfig, ControlConfig, OperatorConfig, SessionConfig
+from stylesync.config import SHARED_DIR, VIEWER_DRAW_HZ, ClockConfig, ControlConfig, OperatorConfig, SessionConfig
 from stylesync.errors import StylesyncError
 
 _HEADLINE = ("fell", "fall_time_s", "sim_duration_s", "operator_steps", "character_steps", "realtime_factor")
@@ -183,7 +183,7 @@ def _replay(args: argparse.Namespace) -> int:
 def _bench(args: argparse.Namespace) -> int:
     from stylesync.metrics.bench import run_bench
 
-    shared = Path(args.shared) if args.shared else Path(__file__).resolve().parents[3] / "shared"
+    shared = Path(args.shared) if args.shared else SHARED_DIR
     report = run_bench(Path(args.out), args.duration, args.seed, shared if shared.is_dir() else None)
     print(report["table"])
     from stylesync.metrics.report import write_report

@@ -8,9 +8,12 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from stylesync.errors import ConfigError
 
+# ../shared beside the checkout: recorded motion capture that benches and experiments use when it is present.
+SHARED_DIR = Path(__file__).resolve().parents[3] / "shared"
 VIEWER_DRAW_HZ = 20.0  # default drawing rate of a viewer, independent of the control rate [Hz]
 
 

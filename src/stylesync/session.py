@@ -28,7 +28,7 @@ from stylesync.motion.stance_fsm import Stance
 from stylesync.motion.style_features import ROW_NAMES as _FEATURES
 from stylesync.motion.style_features import StyleExtractor
 from stylesync.processing.operator_processing import OperatorProcessing, OperatorSample
-from stylesync.sim.backend import CONTACT_FORCE_N, CharacterState, PhysicsBackend, make_backend
+from stylesync.sim.backend import CharacterState, PhysicsBackend, make_backend
 from stylesync.sim.character import LINK_NAMES, STANDING_ROOT_HEIGHT_M
 from stylesync.sources.base import OperatorSource
 
@@ -147,7 +147,7 @@ class Session:
         next_control = 0.0
         next_render = 0.0
         last_frame_sim = 0.0
-        fell, fall_time, fall_reason = False, None, ""
+        self.fell, fall_time, fall_reason = False, None, ""
         latency_ms: list[float] = []
         wall0 = time.perf_counter()
         step = 0
@@ -187,11 +187,10 @@ class Session:
                 if self.on_tick is not None:
                     self.on_tick(state, ref)
                 reason = self._fall_reason(state)
-                if reason and not fell:
-                    fell, fall_time, fall_reason = True, t, reason
-                    self.fell = True
+                if reason and not self.fell:
+                    self.fell, fall_time, fall_reason = True, t, reason
                     log.warning("character fell at t=%.2f s (%s)", t, reason)
-                if fell and self.stop_on_fall:
+                if self.fell and self.stop_on_fall:
                     break
                 if self.closed:
                     break
@@ -216,8 +215,8 @@ class Session:
                 if lag > 0:
                     time.sleep(lag)
         wall = time.perf_counter() - wall0
-        sim_t = (step + 1) * dt if not (fell and self.stop_on_fall) else float(fall_time or 0.0)
-        return SessionResult(tick_log, fell, fall_time, fall_reason, sim_t, wall, step + 1,
+        sim_t = (step + 1) * dt if not (self.fell and self.stop_on_fall) else float(fall_time or 0.0)
+        return SessionResult(tick_log, self.fell, fall_time, fall_reason, sim_t, wall, step + 1,
                              getattr(self.source, "rejected_frames", 0), self.processing.dropped_joint_values,
                              dict(self.bounds.counts), stage_ms, latency_ms)
 
@@ -260,8 +259,6 @@ class Session:
             joint_err_deg=float(np.degrees(np.linalg.norm(err, axis=1)).mean()),
             ch_joints=state.link_origin_world[CHARACTER_LINKS].copy(),
             op_joints=np.array([sample.pos[n] for n in OPERATOR_JOINTS]),
-            foot_contact=(state.foot_contact_force_n["left_ankle"] > CONTACT_FORCE_N,
-                          state.foot_contact_force_n["right_ankle"] > CONTACT_FORCE_N),
             lipm_fx=self.controller.telemetry.lipm_force_n[0], lipm_fy=self.controller.telemetry.lipm_force_n[1],
             **{f"op_{k}": v for k, v in zip(_FEATURES, ref.operator_features.as_row(), strict=True)},
             **{f"ch_{k}": v for k, v in zip(_FEATURES, cf.as_row(), strict=True)},

@@ -33,6 +33,7 @@ from stylesync.control.stable_pd import (
     N_DOFS,
     flatten_joint_values,
     implicit_gain,
+    joint_damping,
     unflatten_joint_values,
 )
 from stylesync.control.support import limit_ankle_moment
@@ -77,14 +78,12 @@ class BalanceController:
         self._ref_vel = np.zeros((len(JOINTS), 3))
         self.telemetry = ControlTelemetry(np.zeros(3), np.zeros(3), np.zeros(3))
         self.root_kp, self.root_kd = cfg.root_torque_kp, cfg.root_torque_kd
-        dt = physics_dt_s
         # D of stable_pd.py: the joints' diagonal is constant; the root torque's block is filled per tick.
-        self._damping = np.zeros((N_DOFS, N_DOFS))
-        j = np.arange(ROOT_DOFS, N_DOFS)
-        self._damping[j, j] = flatten_joint_values(self.pid.kd * dt + self.pid.kp * dt * dt)
+        self._damping = joint_damping(self.pid.kp, self.pid.kd, physics_dt_s)
         self._gain = np.eye(N_DOFS - ROOT_DOFS)  # G of stable_pd, joint rows and columns
         self._root_map = np.zeros((N_DOFS - ROOT_DOFS, 3))  # S: world root torque -> stance-hip DOF torques
         self._torso_hip: int | None = None  # the stance hip that carries the root torque explicitly (see torques)
+        self._torso_dofs = np.zeros(0, dtype=int)  # its DOF rows in the joint layout
 
     def _prepare_implicit(self, state: CharacterState, stance_weight: dict[str, float],
                           mass_matrix: np.ndarray) -> None:
@@ -95,9 +94,9 @@ class BalanceController:
         single = [side for side, ws in stance_weight.items() if ws >= 1.0]
         self._torso_hip = HIP_JOINT[single[0]] if (self.cfg.root_virtual_torque and self.cfg.stance_hip_torso
                                                    and single) else None
-        if self._torso_hip is not None:  # no PD on that hip: the implicit prediction must not count on one
-            dofs = self._hip_dofs(self._torso_hip)
-            d[dofs, dofs] = 0.0
+        self._torso_dofs = (JOINT_DOF_START[self._torso_hip] + np.arange(3) if self._torso_hip is not None
+                            else np.zeros(0, dtype=int))
+        d[ROOT_DOFS + self._torso_dofs, ROOT_DOFS + self._torso_dofs] = 0.0  # no PD there: nothing to predict
         if self.cfg.root_virtual_torque and self._torso_hip is None:
             hips = {side: state.joint_pos[HIP_JOINT[side]] for side in ("left", "right")}
             s_map = stance_hip_map(state.root_quat_wxyz, hips, stance_weight)
@@ -179,8 +178,7 @@ class BalanceController:
         # Eq. 13 feedback r, evaluated implicitly (stable_pd.py): position error predicted one step ahead.
         r = self.pid(fb.joint_pos, fb.joint_vel, ref.joint_pos, self._ref_vel, predict_dt_s=self.physics_dt_s)
         r_flat = flatten_joint_values(r)
-        if self._torso_hip is not None:
-            r_flat[self._hip_dofs(self._torso_hip) - ROOT_DOFS] = 0.0
+        r_flat[self._torso_dofs] = 0.0
         tau_r = np.zeros(3)
         if self.cfg.root_virtual_torque:  # Eq. 16 (second line), Eq. 18: -w τ_r on each stance hip
             tau_r = root_virtual_torque(ref.root_quat_wxyz, fb.root_quat_wxyz, fb.root_ang_vel_world, self.root_kp,
@@ -192,11 +190,6 @@ class BalanceController:
         if self._torso_hip is not None:
             tau[self._torso_hip] = self._torso_hip_torque(fb, tau, tau_r)
         return Torques(np.clip(tau, -TORQUE_LIMIT, TORQUE_LIMIT))
-
-    @staticmethod
-    def _hip_dofs(k: int) -> np.ndarray:
-        """Rows of a ball joint's three DOFs in the floating-base DOF layout (root DOFs first)."""
-        return ROOT_DOFS + JOINT_DOF_START[k] + np.arange(3)
 
     def _torso_hip_torque(self, fb: JointFeedback, tau: np.ndarray, tau_r: np.ndarray) -> np.ndarray:
         """The single-stance hip's torque (child frame) that gives the pelvis exactly the root torque of Eq. 16.

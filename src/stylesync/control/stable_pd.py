@@ -40,6 +40,15 @@ def unflatten_joint_values(flat: np.ndarray) -> np.ndarray:
     return out
 
 
+def joint_damping(kp: np.ndarray, kd: np.ndarray, dt_s: float) -> np.ndarray:
+    """D (N_DOFS square) of the joints' PD gains (n_joints, 3): Kd dt + Kp dt^2 on the joint DOFs' diagonal, zero on
+    the root's rows and columns (unactuated)."""
+    d = np.zeros((N_DOFS, N_DOFS))
+    j = np.arange(ROOT_DOFS, N_DOFS)
+    d[j, j] = flatten_joint_values(kd * dt_s + kp * dt_s * dt_s)
+    return d
+
+
 def implicit_gain(mass_matrix: np.ndarray, damping_matrix: np.ndarray) -> np.ndarray:
     """G = I - D (M + D)^-1 (N_DOFS square): maps the explicit feedback r to the force it produces implicitly."""
     n = mass_matrix.shape[0]

@@ -1,8 +1,6 @@
-"""Small pieces every experiment uses: one closed session run, a floor-plan axis, saving a figure."""
+"""What every experiment does with a session: run it to its end and close its engine."""
 
 from __future__ import annotations
-
-from pathlib import Path
 
 from stylesync.session import Session, SessionResult
 
@@ -14,19 +12,3 @@ def run_session(session: Session, stop_on_fall: bool = True) -> SessionResult:
         return session.run()
     finally:
         session.backend.close()
-
-
-def plan_view(ax) -> None:
-    """A top view of the floor [m], equal axes."""
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.axis("equal")
-    ax.legend(fontsize=7)
-
-
-def save_figure(fig, path: Path) -> None:
-    import matplotlib.pyplot as plt
-
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)

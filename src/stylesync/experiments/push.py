@@ -28,12 +28,13 @@ from stylesync.config import OperatorConfig, SessionConfig  # noqa: E402
 from stylesync.experiments.common import run_session  # noqa: E402
 from stylesync.experiments.scripted_operator import (  # noqa: E402
     pose_frame,
-    recorded,
     smooth_step,
     standing_ankles,
 )
+from stylesync.metrics.plots import plan_view, save_figure  # noqa: E402
 from stylesync.session import Session  # noqa: E402
 from stylesync.sim.disturbance import BALL_MASS_KG, throw_ball_at_chest  # noqa: E402
+from stylesync.sources.builtin_operator import sensed  # noqa: E402
 from stylesync.sources.human_model import HumanModel  # noqa: E402
 
 THROW_S = 2.0  # the character has stood this long when the ball is thrown [s]
@@ -79,7 +80,7 @@ def run_one(pattern: str, speed_mps: float, seed: int):
     op = OperatorConfig(clip=f"push-{pattern}")
     cfg = SessionConfig(duration_s=THROW_S + AFTER_S, seed=seed, operator=op)
     human = HumanModel(op.height_m, op.mass_kg)
-    source = recorded(performer(pattern, human), op, cfg.clocks, cfg.duration_s + 1.0, seed, f"push:{pattern}")
+    source = sensed(performer(pattern, human), op, cfg.clocks, cfg.duration_s + 1.0, seed, f"push:{pattern}")
     thrown: list[int] = []
 
     def hook(state, ref) -> None:
@@ -122,15 +123,10 @@ def _figure(out: Path, traces: dict) -> None:
         t = log.array("t")
         axes[0].plot(log.array("com_x"), log.array("com_y"), label=f"{pattern} ({BALL_MASS_KG * v:.1f} kg·m/s)")
         axes[1].plot(t, log.array("com_x"), label=pattern)
-    axes[0].set_xlabel("COM x [m]")
-    axes[0].set_ylabel("COM y [m]")
-    axes[0].axis("equal")
     axes[0].set_title("COM path at the largest ball survived (Fig. 12a, c)")
     axes[1].axvline(THROW_S, color="grey", ls=":")
     axes[1].set_xlabel("t [s]")
     axes[1].set_ylabel("COM x [m]")
-    for ax in axes:
-        ax.legend()
-    fig.tight_layout()
-    fig.savefig(out / "fig12_push.png", dpi=100)
-    plt.close(fig)
+    axes[1].legend()
+    plan_view(axes[0])
+    save_figure(fig, out / "fig12_push.png")

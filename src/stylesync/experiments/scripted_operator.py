@@ -4,21 +4,16 @@ recoveries of Sec. 7.4.2, the squat of Sec. 7.4.5).
 Each response is a function of time giving the pelvis position and the canonical joint rotations of a
 :class:`HumanModel`; the legs are placed by a two-link inverse kinematics in the sagittal plane so that the feet
 are where the script puts them (on the floor when planted). The result goes through the same Kinect-like sensor
-model as the built-in operator (16 Hz, noise, jitter, fixed seed).
+model as the built-in operator (`builtin_operator.sensed`: 16 Hz, noise, jitter, fixed seed).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
-
 import numpy as np
 
 from stylesync import rotations as rot
-from stylesync.config import ClockConfig, OperatorConfig
-from stylesync.sources.base import RecordedSource
 from stylesync.sources.frame import OperatorFrame
 from stylesync.sources.human_model import HumanModel
-from stylesync.sources.sensor_model import SensorModel
 
 _Y = np.array([0.0, 1.0, 0.0])
 REACTION_S = 0.0  # the operator sees the ball coming: his response starts when it is thrown [s]
@@ -61,10 +56,3 @@ def pose_frame(human: HumanModel, t_s: float, pelvis_world: np.ndarray, ankles_w
 def standing_ankles(human: HumanModel) -> dict[str, np.ndarray]:
     hw = float(next(s for s in human.segments if s.name == "thigh_left").offset_in_parent[1])  # hip half width
     return {"left": np.array([0.0, hw, human.ankle_height_m]), "right": np.array([0.0, -hw, human.ankle_height_m])}
-
-
-def recorded(performer: Callable[[float], OperatorFrame], operator: OperatorConfig, clocks: ClockConfig,
-             duration_s: float, seed: int, name: str) -> RecordedSource:
-    """The performer seen through the Kinect-like sensor, as a recorded source."""
-    frames = SensorModel.kinect(operator, clocks, seed).sample(performer, duration_s)
-    return RecordedSource(frames, name=name)

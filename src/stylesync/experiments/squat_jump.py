@@ -22,11 +22,12 @@ import numpy as np  # noqa: E402
 
 from stylesync.config import OperatorConfig, SessionConfig  # noqa: E402
 from stylesync.experiments.common import run_session  # noqa: E402
-from stylesync.experiments.scripted_operator import pose_frame, recorded, smooth_step, standing_ankles  # noqa: E402
+from stylesync.experiments.scripted_operator import pose_frame, smooth_step, standing_ankles  # noqa: E402
+from stylesync.metrics.plots import save_figure  # noqa: E402
 from stylesync.metrics.summary import summarize  # noqa: E402
 from stylesync.motion.stance_fsm import Stance  # noqa: E402
 from stylesync.session import STANCE_CODE, Session  # noqa: E402
-from stylesync.sources.builtin_operator import builtin_operator  # noqa: E402
+from stylesync.sources.builtin_operator import builtin_operator, sensed  # noqa: E402
 from stylesync.sources.deepmimic_clip import DeepMimicClip  # noqa: E402
 from stylesync.sources.human_model import TABLE2_HUMAN_TOTAL_KG, HumanModel  # noqa: E402
 
@@ -61,7 +62,7 @@ def run_one(task: str, stature_m: float, seed: int):
         duration = SQUAT_START_S + SQUAT_DOWN_S + SQUAT_HOLD_S + SQUAT_UP_S + SETTLE_S
         cfg = SessionConfig(duration_s=duration, seed=seed, operator=op)
         human = HumanModel(op.height_m, op.mass_kg)
-        source = recorded(squat_performer(human), op, cfg.clocks, duration + 1.0, seed, "squat")
+        source = sensed(squat_performer(human), op, cfg.clocks, duration + 1.0, seed, "squat")
     else:
         op = operator_of(stature_m, JUMP_CLIP)
         duration = op.standing_lead_in_s + DeepMimicClip.builtin(JUMP_CLIP).duration_s + SETTLE_S
@@ -90,9 +91,7 @@ def run(out: Path, duration_s: float = 0.0, seed: int = 0) -> tuple[bool, dict]:
         ax.set_xlabel("t [s]")
         ax.legend()
     axes[0].set_ylabel("pelvis height [m]")
-    fig.tight_layout()
-    fig.savefig(out / "fig16_squat_jump.png", dpi=100)
-    plt.close(fig)
+    save_figure(fig, out / "fig16_squat_jump.png")
     holds = all(v["ends_in_ds"] for v in runs.values())
     summary = {"experiment": "squat-jump", "claim_holds": holds, "statures_m": STATURES_M, "runs": runs}
     (out / "metrics.json").write_text(json.dumps(summary, indent=2))

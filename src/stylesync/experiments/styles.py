@@ -25,13 +25,14 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from stylesync.config import OperatorConfig, SessionConfig  # noqa: E402
+from stylesync.config import SHARED_DIR, OperatorConfig, SessionConfig  # noqa: E402
 from stylesync.errors import StylesyncError  # noqa: E402
-from stylesync.experiments.common import plan_view, run_session, save_figure  # noqa: E402
+from stylesync.experiments.common import run_session  # noqa: E402
+from stylesync.metrics.plots import plan_view, save_figure  # noqa: E402
 from stylesync.session import Session  # noqa: E402
 from stylesync.sources.registry import open_source  # noqa: E402
 
-SHARED_CLIPS = Path(__file__).resolve().parents[3] / ".." / "shared" / "mocap" / "deepmimic"
+SHARED_CLIPS = SHARED_DIR / "mocap" / "deepmimic"
 STYLES = {"normal": "walk", "sneaky": "humanoid3d_stealthy_walk.txt", "zombie": "humanoid3d_zombie_walk.txt"}
 FEATURES = ("T_l", "T_r", "N_l_y", "N_r_y", "H")
 DURATION_S = 10.0
@@ -130,6 +131,4 @@ def _figures(out: Path, logs: dict, measures: dict) -> None:
     axes[2].set_xlabel("t [s]")
     for ax in axes:
         ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(out / "fig14_style_features.png", dpi=100)
-    plt.close(fig)
+    save_figure(fig, out / "fig14_style_features.png")

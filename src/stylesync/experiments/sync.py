@@ -16,6 +16,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from stylesync.config import ControlConfig, OperatorConfig, SessionConfig  # noqa: E402
+from stylesync.experiments.common import run_session  # noqa: E402
+from stylesync.metrics.plots import save_figure, stance_axes  # noqa: E402
 from stylesync.metrics.summary import summarize  # noqa: E402
 from stylesync.session import Session  # noqa: E402
 from stylesync.sources.builtin_operator import builtin_operator  # noqa: E402
@@ -30,22 +32,17 @@ def run(out: Path, duration_s: float = 12.0, seed: int = 0) -> tuple[bool, dict]
         cfg = SessionConfig(duration_s=duration_s, seed=seed, operator=OperatorConfig(clip="walk"),
                             control=ControlConfig(lipm_time_sync=lipm))
         source, _ = builtin_operator(cfg.operator, cfg.clocks, duration_s + 1.0, seed)
-        results[label] = Session(cfg, source).run()
+        results[label] = run_session(Session(cfg, source))
         metrics[label] = summarize(results[label])
     fig, axes = plt.subplots(2, 1, figsize=(9, 5), sharex=True)
     for ax, label in zip(axes, ("with", "without"), strict=True):
-        lg = results[label].log
-        ax.step(lg.array("t"), lg.array("op_state"), where="post", label="operator")
-        ax.step(lg.array("t"), lg.array("char_state"), where="post", label="character")
-        ax.set_yticks([0, 1, 2], ["LS", "DS", "RS"])
+        stance_axes(ax, results[label].log)
         m = metrics[label]
         ax.set_title(f"{label} LIPM time sync: max delay {m['state_transition_delay_s']['max']:.3f} s, "
                      + (f"fell at {m['fall_time_s']:.2f} s" if m["fell"] else "no fall"))
         ax.legend(loc="upper right")
     axes[-1].set_xlabel("t [s]")
-    fig.tight_layout()
-    fig.savefig(out / "fig11_states.png", dpi=100)
-    plt.close(fig)
+    save_figure(fig, out / "fig11_states.png")
     w, wo = metrics["with"], metrics["without"]
     holds = (not w["fell"] and w["state_transition_delay_s"]["max"] <= PAPER["with_max_delay_s"]
              and (wo["fell"] or wo["state_transition_delay_s"]["max"] > w["state_transition_delay_s"]["max"]))

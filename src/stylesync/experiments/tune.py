@@ -27,7 +27,7 @@ from stylesync.config import ControlConfig, PidGains, WorldConfig
 from stylesync.control.gravity_compensation import gravity_torques
 from stylesync.control.jacobian_transpose import JointFrames
 from stylesync.control.pid import IS_BALL, JointPid, joint_error
-from stylesync.control.stable_pd import flatten_joint_values, implicit_gain, unflatten_joint_values
+from stylesync.control.stable_pd import flatten_joint_values, implicit_gain, joint_damping, unflatten_joint_values
 from stylesync.processing.joint_map import hinge_angle
 from stylesync.sim.backend import Torques, make_backend
 from stylesync.sim.character import JOINT_NAMES, JOINTS, N_JOINT_DOFS, ROOT_DOFS, model_quat_from_canonical
@@ -92,9 +92,7 @@ def ramp_error(group: str, gains: PidGains, slope: float, height: float, axis: n
     backend.reset(np.array([0.0, 0.0, 1.5]), rot.IDENTITY_WXYZ, zero)
     mass = backend.mass_properties()
     pid = JointPid(cfg, dt)
-    d = np.zeros((ROOT_DOFS + N_JOINT_DOFS,) * 2)
-    j = np.arange(ROOT_DOFS, ROOT_DOFS + N_JOINT_DOFS)
-    d[j, j] = flatten_joint_values(pid.kd * dt + pid.kp * dt * dt)
+    d = joint_damping(pid.kp, pid.kd, dt)
     ramp_s = height / slope
     n = int((ramp_s + HOLD_S) * PHYSICS_HZ)
     errors = np.zeros(n)

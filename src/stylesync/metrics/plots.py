@@ -13,10 +13,27 @@ import numpy as np  # noqa: E402
 from stylesync.session import SessionResult  # noqa: E402
 
 
-def _save(fig, path: Path) -> Path:
+def save_figure(fig, path: Path) -> Path:
+    fig.tight_layout()
     fig.savefig(path, dpi=100)
     plt.close(fig)
     return path
+
+
+def plan_view(ax) -> None:
+    """A top view of the floor [m], equal axes."""
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.axis("equal")
+    ax.legend(fontsize=7)
+
+
+def stance_axes(ax, log, character_offset: float = 0.0) -> None:
+    """Operator and character stance states over time (Fig. 11)."""
+    t = log.array("t")
+    ax.step(t, log.array("op_state"), where="post", label="operator")
+    ax.step(t, log.array("char_state") + character_offset, where="post", label="character")
+    ax.set_yticks([0, 1, 2], ["LS", "DS", "RS"])
 
 
 def write_plots(result: SessionResult, out: Path) -> list[Path]:
@@ -31,21 +48,16 @@ def write_plots(result: SessionResult, out: Path) -> list[Path]:
         z = lg.array(f"a{side}_z")
         on = z < 0.075
         ax.scatter(lg.array(f"a{side}_x")[on], lg.array(f"a{side}_y")[on], s=4, c=c, alpha=0.3)
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.axis("equal")
-    ax.legend()
+    plan_view(ax)
     ax.set_title("COM trajectory and footsteps")
-    paths.append(_save(fig, out / "com_footsteps.png"))
+    paths.append(save_figure(fig, out / "com_footsteps.png"))
 
     fig, ax = plt.subplots(figsize=(8, 3))
-    ax.step(t, lg.array("op_state"), where="post", label="operator")
-    ax.step(t, lg.array("char_state") + 0.05, where="post", label="character")
-    ax.set_yticks([0, 1, 2], ["LS", "DS", "RS"])
+    stance_axes(ax, lg, character_offset=0.05)
     ax.set_xlabel("t [s]")
     ax.legend()
     ax.set_title("Stance states")
-    paths.append(_save(fig, out / "stance_states.png"))
+    paths.append(save_figure(fig, out / "stance_states.png"))
 
     fig, axes = plt.subplots(3, 1, figsize=(8, 7), sharex=True)
     for ax, key, label in zip(axes, ("N_r_y", "T_r", "H"), ("N_r (y)", "T_r [rad]", "H [rad]"), strict=True):
@@ -54,7 +66,7 @@ def write_plots(result: SessionResult, out: Path) -> list[Path]:
         ax.set_ylabel(label)
     axes[0].legend()
     axes[-1].set_xlabel("t [s]")
-    paths.append(_save(fig, out / "style_features.png"))
+    paths.append(save_figure(fig, out / "style_features.png"))
     return paths
 
 

@@ -7,6 +7,7 @@ import numpy as np
 from stylesync.metrics import imitation as im
 from stylesync.motion.stance_fsm import Stance
 from stylesync.session import STANCE_CODE, SessionResult
+from stylesync.sim.backend import CONTACT_FORCE_N
 
 _DS = STANCE_CODE[Stance.DS]
 
@@ -80,11 +81,12 @@ def imitation_metrics(result: SessionResult) -> dict:
     uhc = im.uhc_fall_index(ch, ref)
     feet = [im.JOINT_PAIRS.index(("left_ankle", "ANKLE_LEFT")), im.JOINT_PAIRS.index(("right_ankle", "ANKLE_RIGHT"))]
     rel_ch, rel_ref = ch - ch[:, :1], ref - ref[:, :1]
+    foot_down = np.stack([lg.array("contact_l"), lg.array("contact_r")], axis=1) > CONTACT_FORCE_N
     return {
         "mpjpe_global_mm": round(im.mpjpe_mm(ch, ref), 1),
         "mpjpe_root_mm": round(im.mpjpe_mm(ch, ref, root_relative=True), 1),
         "uhc_fall_time_s": None if uhc is None else float(t[uhc]),
-        "foot_skate_mm": round(im.foot_skate_mm(ch[:, feet], lg.array("foot_contact").astype(bool)), 3),
+        "foot_skate_mm": round(im.foot_skate_mm(ch[:, feet], foot_down), 3),
         "jitter_mps2": round(im.jitter_mps2(ch, dt), 3),
         "sync_lag_s": round(im.sync_lag_s(rel_ref.reshape(len(t), -1), rel_ch.reshape(len(t), -1), dt), 4),
     }

@@ -6,11 +6,12 @@ import numpy as np
 
 from stylesync import rotations as rot
 from stylesync.sim.backend import CharacterState, PhysicsBackend
+from stylesync.sim.character import LINK_NAMES
 
 BALL_START_M = 1.5  # a pushed ball starts this far in front of the chest [m]
 BALL_SPEED_MPS = 7.0  # a pushed ball's speed [m/s]
 BALL_MASS_KG = 0.43  # a size-5 football
-_CHEST_LINK = 1
+_CHEST_LINK = LINK_NAMES.index("chest")
 
 
 def throw_ball_at_chest(backend: PhysicsBackend, state: CharacterState, speed_mps: float = BALL_SPEED_MPS,

@@ -10,6 +10,8 @@ path is scaled by the ratio of its leg length to the clip character's so that it
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from stylesync import rotations as rot
@@ -58,13 +60,18 @@ class ClipPerformer:
         return self.human.frame_from_pose(t_s, root, pose.local_quats)
 
 
+def sensed(pose_at: Callable[[float], OperatorFrame], operator: OperatorConfig, clocks: ClockConfig,
+           duration_s: float, seed: int, name: str) -> RecordedSource:
+    """A performer seen through the operator's Kinect-like sensor model, as a recorded source."""
+    frames = SensorModel.kinect(operator, clocks, seed).sample(pose_at, duration_s)
+    return RecordedSource(frames, name=name)
+
+
 def builtin_operator(
     operator: OperatorConfig, clocks: ClockConfig, duration_s: float, seed: int
 ) -> tuple[RecordedSource, ClipPerformer]:
     clip = None if operator.clip == STAND_CLIP else DeepMimicClip.builtin(operator.clip)
     human = HumanModel(operator.height_m, operator.mass_kg)
     performer = ClipPerformer(clip, human, operator.standing_lead_in_s)
-    sensor = SensorModel.kinect(operator, clocks, seed)
-    frames = sensor.sample(performer.frame_at, duration_s)
-    return RecordedSource(frames, name=f"builtin:{operator.clip}"), performer
+    return sensed(performer.frame_at, operator, clocks, duration_s, seed, f"builtin:{operator.clip}"), performer
 
