@@ -14,6 +14,7 @@ from stylesync.errors import ConfigError
 
 # ../shared beside the checkout: recorded motion capture that benches and experiments use when it is present.
 SHARED_DIR = Path(__file__).resolve().parents[3] / "shared"
+BALANCE_METHODS = ("inverse_dynamics", "jacobian_transpose")
 VIEWER_DRAW_HZ = 20.0  # default drawing rate of a viewer, independent of the control rate [Hz]
 
 
@@ -139,6 +140,17 @@ class ControlConfig:
     # feedback (SIMBICON's torso control, controller.py); off by default: measured no better overall
     # (docs/decisions.md). Off, the root torque is one more implicit term on the stance hips.
     stance_hip_torso: bool = False
+    # How the virtual forces are realised: "inverse_dynamics" (momentum_balance.py: ground forces on the soles,
+    # then contact-consistent inverse dynamics) or "jacobian_transpose" (controller.py: Eq. 17-18 and Eq. 20 as
+    # printed, with the stable PD). See docs/decisions.md.
+    balance: str = "inverse_dynamics"
+    joint_tracking_omega_rad_s: float = 20.0  # inverse dynamics: Eq. 13 as q̈* = ω² e + 2 ζ ω ė
+    joint_tracking_damping_ratio: float = 1.0
+    joint_tracking_weight: float = 10.0  # inverse dynamics: weight of M_ii Δq̈_i² against the wrench error
+    momentum_root_kp: float = 200.0  # inverse dynamics: root virtual torque of Eq. 16 about the COM [N·m/rad]
+    momentum_root_kd: float = 40.0  # [N·m·s/rad]
+    momentum_moment_weight_per_m: float = 2.0  # weight of the moment rows against the force rows [1/m]
+    contact_velocity_gain: float = 10.0  # a supporting foot's residual velocity is damped at this rate [1/s]
     gravity_compensation: bool = True  # Eq. 14-15
     com_virtual_force: bool = True  # Eq. 16-17
     root_virtual_torque: bool = True  # Eq. 16, 18
@@ -152,6 +164,12 @@ class ControlConfig:
             _non_negative(f"ControlConfig.{n}", getattr(self, n))
         _positive("ControlConfig.integral_limit_rad_s", self.integral_limit_rad_s)
         _positive("ControlConfig.root_yaw_gain_scale", self.root_yaw_gain_scale)
+        if self.balance not in BALANCE_METHODS:
+            raise ConfigError(f"ControlConfig.balance must be one of {BALANCE_METHODS}, got {self.balance!r}")
+        for n in ("joint_tracking_omega_rad_s", "joint_tracking_damping_ratio", "momentum_moment_weight_per_m"):
+            _positive(f"ControlConfig.{n}", getattr(self, n))
+        for n in ("momentum_root_kp", "momentum_root_kd", "contact_velocity_gain"):
+            _non_negative(f"ControlConfig.{n}", getattr(self, n))
         for group in ("chest", "neck", "hip", "knee", "ankle", "shoulder", "elbow"):
             if group not in self.pid:
                 raise ConfigError(f"ControlConfig.pid lacks gains for '{group}'")

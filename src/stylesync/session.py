@@ -20,6 +20,7 @@ from stylesync import rotations as rot
 from stylesync.config import SessionConfig
 from stylesync.control.bounds import BoundsMonitor
 from stylesync.control.controller import BalanceController
+from stylesync.control.momentum_balance import MomentumBalanceController
 from stylesync.control.pid import joint_error
 from stylesync.errors import SourceError
 from stylesync.metrics.imitation import CHARACTER_LINKS, OPERATOR_JOINTS
@@ -80,9 +81,11 @@ class Session:
         self.processing = OperatorProcessing(config.clocks, config.filters)
         self.bounds = BoundsMonitor()
         self.motion = MotionOptimizer(config.motion, config.clocks.control_hz, self.bounds)
-        self.controller = BalanceController(config.control, self.mass, config.world.gravity_mps2,
-                                            1.0 / config.clocks.physics_hz, 1.0 / config.clocks.control_hz,
-                                            self.bounds, config.world.friction)
+        controller_class = (MomentumBalanceController if config.control.balance == "inverse_dynamics"
+                            else BalanceController)
+        self.controller = controller_class(config.control, self.mass, config.world.gravity_mps2,
+                                           1.0 / config.clocks.physics_hz, 1.0 / config.clocks.control_hz,
+                                           self.bounds, config.world.friction)
         self.char_style = StyleExtractor()
         self.on_tick = on_tick
         self.renders: list[tuple[float, np.ndarray]] = []

@@ -28,7 +28,7 @@ from stylesync.control.crvc import (
 from stylesync.control.gravity_compensation import ANKLE_JOINT, gravity_torques
 from stylesync.control.jacobian_transpose import JointFrames
 from stylesync.control.model_compensation import ipm_ankle_moments, lipm_sync_force
-from stylesync.control.pid import IS_BALL, JointPid
+from stylesync.control.pid import IS_BALL, JointPid, reference_velocity
 from stylesync.control.stable_pd import (
     N_DOFS,
     flatten_joint_values,
@@ -162,11 +162,7 @@ class BalanceController:
         self._ff = ff + frames.torque_from_moment(moment)
         # Reference velocity for the derivative term, from successive references at the control rate.
         if self._prev_ref_pos is not None:
-            vel = np.zeros_like(self._ref_vel)
-            prev, cur = self._prev_ref_pos, ref.joint_pos
-            vel[IS_BALL] = rot.batch_rotvec(rot.batch_multiply(rot.batch_conjugate(prev[IS_BALL]), cur[IS_BALL]))
-            vel[~IS_BALL, 0] = cur[~IS_BALL, 0] - prev[~IS_BALL, 0]
-            self._ref_vel = vel / self.control_dt_s
+            self._ref_vel = reference_velocity(self._prev_ref_pos, ref.joint_pos, self.control_dt_s)
         self._prev_ref_pos = ref.joint_pos.copy()
         self._ref = ref
         self.telemetry = ControlTelemetry(force, f_lipm, self.telemetry.root_torque_nm)

@@ -34,6 +34,12 @@ def joint_error(q_current: np.ndarray, q_desired: np.ndarray) -> np.ndarray:
     return e
 
 
+def reference_velocity(q_previous: np.ndarray, q_current: np.ndarray, dt_s: float) -> np.ndarray:
+    """(n_joints, 3) joint velocity of a reference between two control ticks: child-frame angular velocity for
+    ball joints, rate in column 0 for hinges [rad/s]."""
+    return joint_error(q_previous, q_current) / dt_s
+
+
 class JointPid:
     def __init__(self, cfg: ControlConfig, dt_s: float):
         kp, ki, kd = gain_arrays(cfg)

@@ -25,6 +25,7 @@ class ReferencePose:
     time_s: float
     joint_pos: np.ndarray  # (n_joints, 4) desired local rotations (model axes), hinge angle in column 0
     root_quat_wxyz: np.ndarray  # desired canonical pelvis orientation (level, heading H)
+    pelvis_world: np.ndarray  # desired pelvis origin (Eq. 9-10) [m]
     com_world: np.ndarray  # desired character COM [m]
     com_vel_world: np.ndarray  # [m/s]
     operator_stance: Stance

@@ -154,6 +154,16 @@ class PyBulletBackend(PhysicsBackend):
                 angle = 0.0 if joint_pos is None else float(joint_pos[k, 0])
                 c.resetJointState(self.body, j, angle, 0.0)
 
+    def set_velocities(self, root_lin_vel_world, root_ang_vel_world, joint_vel) -> None:
+        """Initial velocities (tests of the kinematics): root [m/s], [rad/s] (world), joints as in
+        ``CharacterState.joint_vel``."""
+        c = self._pb
+        c.resetBaseVelocity(self.body, list(root_lin_vel_world), list(root_ang_vel_world))
+        for k, j in enumerate(self._joint_idx):
+            pos = c.getJointStateMultiDof(self.body, j)[0]
+            vel = list(joint_vel[k]) if self._is_ball[k] else [float(joint_vel[k, 0])]
+            c.resetJointStateMultiDof(self.body, j, pos, vel)
+
     def mass_properties(self) -> MassProperties:
         return self._mass
 

@@ -1,0 +1,67 @@
+"""Ground reaction forces that realise a desired rate of change of the body's momentum (Sec. 6.2-6.3).
+
+The COM virtual force of Eq. 16 and the root virtual torque of Eq. 16/18 are, taken together, a desired wrench on
+the whole body about its COM: ``F_d = m (p̈_d + g ẑ)`` and ``τ_d``. Only the ground can give it, through the soles
+in contact: each sole corner passes a force inside its friction cone (linearised as a 4-sided pyramid), which
+keeps every centre of pressure on its sole and every foot from sliding or twisting (the constraints that
+support.py and bounds.py approximate one at a time). This module gives the pyramid's edges at every sole corner
+and the wrench about the COM each edge's unit force makes, ``A = [β_e ; (p_c - c) × β_e]``; the magnitudes λ >= 0
+are found together with the body's accelerations (inverse_dynamics.py), with the weight ε_s on a foot's λ growing
+as its stance weight falls, so that a foot about to lift off is unloaded before it leaves the ground.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from stylesync import rotations as rot
+from stylesync.sim.character import ANKLE_HEIGHT_M, FOOT_CENTER_AHEAD_OF_ANKLE_M, FOOT_LENGTH_M, FOOT_WIDTH_M
+
+SOLE_MARGIN = 0.9  # fraction of the sole's length and width the corner forces may use
+FRICTION_MARGIN = 0.8  # fraction of the friction coefficient the pyramid uses
+REGULARISATION = 1e-4  # ε of a full-weight foot [1/N² against N² of residual]
+MIN_WEIGHT = 0.05  # a stance weight below this is treated as this (ε_s = REGULARISATION / weight)
+_HALF_L, _HALF_W = SOLE_MARGIN * FOOT_LENGTH_M / 2, SOLE_MARGIN * FOOT_WIDTH_M / 2
+# Sole corners relative to the ankle joint in the foot's canonical frame (x forward, y left, z up) [m], (4, 3).
+SOLE_CORNERS_IN_FOOT = np.array([[FOOT_CENTER_AHEAD_OF_ANKLE_M + sx * _HALF_L, sy * _HALF_W, -ANKLE_HEIGHT_M]
+                                 for sx in (1.0, -1.0) for sy in (1.0, -1.0)])
+_EDGE_DIRS = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]])
+
+
+def sole_corners_world(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray) -> np.ndarray:
+    """(4, 3) world positions of a foot's sole corners [m]."""
+    return np.asarray(ankle_world, dtype=float) + SOLE_CORNERS_IN_FOOT @ rot.matrix_from_quat(foot_quat_wxyz).T
+
+
+def pyramid_edges(friction: float) -> np.ndarray:
+    """(4, 3) unit edges of the linearised friction cone of a flat ground."""
+    mu = FRICTION_MARGIN * friction
+    e = np.column_stack([mu * _EDGE_DIRS, np.ones(4)])
+    return e / np.linalg.norm(e, axis=1, keepdims=True)
+
+
+@dataclass
+class ContactForces:
+    points_world: dict[str, np.ndarray]  # side -> (4, 3) sole corners [m]
+    forces_world: dict[str, np.ndarray]  # side -> (4, 3) force at each corner [N]
+    residual_force_n: np.ndarray  # (3,) achieved minus desired total force [N]
+    residual_moment_nm: np.ndarray  # (3,) achieved minus desired moment about the COM [N·m]
+
+
+def wrench_basis(com_world: np.ndarray, corners_world: dict[str, np.ndarray],
+                 friction: float) -> tuple[np.ndarray, np.ndarray]:
+    """Per pyramid edge of every corner (n_λ = 16 per foot, feet in ``corners_world`` order): the force
+    directions (n_λ, 3) and their points (n_λ, 3), and the wrench about the COM, A (6, n_λ)."""
+    edges = pyramid_edges(friction)
+    dirs = np.concatenate([np.tile(edges, (4, 1)) for _ in corners_world])
+    points = np.concatenate([np.repeat(c, 4, axis=0) for c in corners_world.values()])
+    a = np.concatenate([dirs, rot.cross(points - com_world, dirs)], axis=1).T
+    return np.concatenate([dirs, points], axis=1), a
+
+
+def regularisation(corners_world: dict[str, np.ndarray], stance_weight: dict[str, float]) -> np.ndarray:
+    """ε per λ (see the module): larger on a foot with a small stance weight."""
+    return np.concatenate([np.zeros(0)] + [np.full(16, REGULARISATION / max(stance_weight.get(s, 0.0), MIN_WEIGHT))
+                                           for s in corners_world])

@@ -1,0 +1,73 @@
+"""Contact-consistent inverse dynamics of the floating character: joint torques that give the chosen ground forces.
+
+With the ground forces fixed (contact_forces.py), the equations of motion ``M q̈ + h = S^T τ + Q_c`` split into the
+root's six unactuated rows, which fix how the whole body accelerates under those forces, and the joint rows, which
+give the torques. The accelerations are the ones closest to the desired ones (joint PD, Eq. 13 in acceleration
+form) that obey the root's rows and keep each supporting foot where it is:
+
+    min Σ w_d (q̈_d - q̈_d*)²   s.t.   M_root q̈ = Q_c,root - h_root ,   J_c q̈ = -k_c J_c q̇
+
+(a small KKT system), and then ``τ = (M q̈ + h - Q_c)_joints``. h holds gravity only: the velocity-product terms
+of this character at teleoperation speeds are a few N·m against the hundreds gravity asks, and are left to the
+feedback, as Eq. 14-15 do.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.optimize import nnls
+
+from stylesync.control.stable_pd import N_DOFS
+from stylesync.sim.character import ROOT_DOFS
+
+
+def joint_torques(mass_matrix: np.ndarray, bias_force: np.ndarray, contact_force: np.ndarray,
+                  qdd: np.ndarray) -> np.ndarray:
+    """(N_JOINT_DOFS,) torques [N·m] of ``M q̈ + h = S^T τ + Q_c``."""
+    return (mass_matrix @ qdd + bias_force - contact_force)[ROOT_DOFS:]
+
+
+def solve_with_contact_forces(mass_matrix: np.ndarray, bias_force: np.ndarray, force_basis: np.ndarray,
+                              contact_jacobian: np.ndarray, contact_accel: np.ndarray, qdd_desired: np.ndarray,
+                              weights: np.ndarray, wrench_matrix: np.ndarray, wrench_desired: np.ndarray,
+                              wrench_row_weights: np.ndarray, force_regularisation: np.ndarray,
+                              task_jacobian: np.ndarray, task_accel: np.ndarray,
+                              task_weight: float) -> tuple[np.ndarray, np.ndarray]:
+    """q̈ (N_DOFS,) and the contact-force magnitudes λ >= 0 of one problem over both:
+
+        min Σ w_d (q̈_d - q̈_d*)² + w_t |J_t q̈ - a_t|² + |W_f (A λ - F*)|² + Σ ε_i λ_i²
+        s.t. M_root q̈ = (B λ)_root - h_root ,  J_c q̈ = a_c ,  λ >= 0
+
+    B (N_DOFS, n_λ) maps λ to generalised forces, A (6, n_λ) to the wrench about the COM. For a fixed λ the
+    accelerations are affine in λ (the KKT system of :func:`solve_accelerations`), q̈ = r + P λ; substituted, the
+    problem is a non-negative least squares in λ alone. Joint tracking and the desired wrench are thereby traded
+    against each other in one objective: the momentum the soles cannot give is not forced onto the arms.
+    """
+    a_eq = np.vstack([mass_matrix[:ROOT_DOFS], contact_jacobian])
+    k = a_eq.shape[0]
+    kkt = np.zeros((N_DOFS + k, N_DOFS + k))
+    hess = np.diag(weights) + task_weight * task_jacobian.T @ task_jacobian
+    kkt[:N_DOFS, :N_DOFS] = hess
+    kkt[:N_DOFS, N_DOFS:] = a_eq.T
+    kkt[N_DOFS:, :N_DOFS] = a_eq
+    n_lam = force_basis.shape[1]
+    rhs = np.zeros((N_DOFS + k, 1 + n_lam))
+    rhs[:N_DOFS, 0] = weights * qdd_desired + task_weight * task_jacobian.T @ task_accel
+    rhs[N_DOFS:N_DOFS + ROOT_DOFS, 0] = -bias_force[:ROOT_DOFS]
+    rhs[N_DOFS + ROOT_DOFS:, 0] = contact_accel
+    rhs[N_DOFS:N_DOFS + ROOT_DOFS, 1:] = force_basis[:ROOT_DOFS]
+    try:
+        sol = np.linalg.solve(kkt, rhs)
+    except np.linalg.LinAlgError:
+        sol = np.linalg.lstsq(kkt, rhs, rcond=None)[0]
+    r, p = sol[:N_DOFS, 0], sol[:N_DOFS, 1:]
+    if n_lam == 0:  # no support: the accelerations follow from the root's rows alone
+        return r, np.zeros(0)
+    sw = np.sqrt(weights)
+    st = np.sqrt(task_weight)
+    a_rows = np.vstack([sw[:, None] * p, st * task_jacobian @ p, wrench_row_weights[:, None] * wrench_matrix,
+                        np.diag(np.sqrt(force_regularisation))])
+    b_rows = np.concatenate([sw * (qdd_desired - r), st * (task_accel - task_jacobian @ r),
+                             wrench_row_weights * wrench_desired, np.zeros(n_lam)])
+    lam, _ = nnls(a_rows, b_rows, maxiter=50 * n_lam)
+    return r + p @ lam, lam

@@ -1,0 +1,71 @@
+"""The floating-base Jacobians, the contact-force basis and the inverse-dynamics balance controller."""
+
+import numpy as np
+import pytest
+
+from stylesync import rotations as rot
+from stylesync.config import WorldConfig
+from stylesync.control.contact_forces import pyramid_edges, sole_corners_world, wrench_basis
+from stylesync.control.floating_jacobian import FloatingJacobians
+from stylesync.control.jacobian_transpose import JointFrames
+from stylesync.control.stable_pd import flatten_joint_values
+from stylesync.sim.backend import make_backend
+from stylesync.sim.character import ANKLE_HEIGHT_M, JOINTS, JointKind
+
+
+@pytest.fixture(scope="module")
+def moving_character():
+    """The character in a random pose and random velocities, in the air."""
+    b = make_backend(WorldConfig(), 600.0)
+    rng = np.random.default_rng(1)
+    q = np.zeros((len(JOINTS), 4))
+    for k, j in enumerate(JOINTS):
+        if j.kind is JointKind.BALL:
+            q[k] = rot.quat_from_rotvec(rng.normal(0.0, 0.4, 3))
+        else:
+            q[k, 0] = rng.uniform(-1.0, 0.2)
+    b.reset(np.array([0.1, 0.2, 1.5]), rot.quat_from_rotvec(np.array([0.2, -0.3, 0.7])), q)
+    b.set_velocities(rng.normal(0.0, 1.0, 3), rng.normal(0.0, 1.0, 3),  # type: ignore[attr-defined]
+                     rng.normal(0.0, 1.0, (len(JOINTS), 3)))
+    yield b, b.read_state(0.0)
+    b.close()
+
+
+def _qdot(state):
+    return np.concatenate([state.root_lin_vel_world, state.root_ang_vel_world, flatten_joint_values(state.joint_vel)])
+
+
+def test_point_jacobians_give_the_engines_link_velocities(moving_character):
+    b, s = moving_character
+    jac = FloatingJacobians(s, JointFrames(s))
+    qd = _qdot(s)
+    for i in range(len(s.link_com_world)):
+        np.testing.assert_allclose(jac.point_linear(i, s.link_com_world[i]) @ qd, s.link_com_vel_world[i], atol=1e-6)
+        np.testing.assert_allclose(jac.angular(i) @ qd, s.link_ang_vel_world[i], atol=1e-6)
+
+
+def test_momentum_jacobian_matches_the_engines_mass_matrix(moving_character):
+    """The linear-momentum rows of M q̇ are Σ m_i v_i: the Jacobians and the mass matrix share one layout."""
+    b, s = moving_character
+    mass = b.mass_properties()
+    jac = FloatingJacobians(s, JointFrames(s))
+    qd = _qdot(s)
+    p = mass.link_mass_kg @ s.link_com_vel_world
+    np.testing.assert_allclose(jac.mass_weighted_linear(s.link_com_world, mass.link_mass_kg) @ qd, p, atol=1e-5)
+    np.testing.assert_allclose((b.joint_space_inertia() @ qd)[:3], p, atol=1e-3)
+
+
+def test_wrench_basis_forces_stay_in_the_friction_cone_and_on_the_sole():
+    corners = {"left": sole_corners_world(np.array([0.0, 0.1, ANKLE_HEIGHT_M]), np.array([1.0, 0.0, 0.0, 0.0]))}
+    dirs_points, a = wrench_basis(np.array([0.05, 0.0, 0.9]), corners, friction=0.9)
+    dirs = dirs_points[:, :3]
+    assert np.allclose(np.linalg.norm(dirs, axis=1), 1.0)
+    assert np.all(np.hypot(dirs[:, 0], dirs[:, 1]) <= 0.9 * dirs[:, 2] + 1e-12)
+    assert np.allclose(dirs_points[:, 5], 0.0, atol=1e-9)  # forces act on the ground plane
+    # any non-negative mix: total moment about the ankle column has its centre of pressure inside the sole
+    lam = np.random.default_rng(0).uniform(0.0, 1.0, a.shape[1])
+    f = a[:3] @ lam
+    cop = (dirs_points[:, 3:5] * (dirs[:, 2] * lam)[:, None]).sum(axis=0) / f[2]
+    xs, ys = corners["left"][:, 0], corners["left"][:, 1]
+    assert xs.min() <= cop[0] <= xs.max() and ys.min() <= cop[1] <= ys.max()
+    assert len(pyramid_edges(0.9)) == 4
