@@ -69,3 +69,17 @@ def test_wrench_basis_forces_stay_in_the_friction_cone_and_on_the_sole():
     xs, ys = corners["left"][:, 0], corners["left"][:, 1]
     assert xs.min() <= cop[0] <= xs.max() and ys.min() <= cop[1] <= ys.max()
     assert len(pyramid_edges(0.9)) == 4
+
+
+def test_standing_character_bears_arm_waving_and_a_squat():
+    """Double stance with a moving upper body and a deep knee bend (the cases the Jacobian-transpose mapping fell
+    on): no fall, and the squat ends in double stance."""
+    from stylesync.experiments import push, squat_jump
+    from stylesync.motion.stance_fsm import Stance
+    from stylesync.session import STANCE_CODE
+
+    wave = push.run_one("wave", 2.0, seed=0)
+    assert not wave.fell, wave.fall_reason
+    squat = squat_jump.run_one("squat", 1.75, seed=0)
+    assert not squat.fell, squat.fall_reason
+    assert squat.log.array("char_state")[-1] == STANCE_CODE[Stance.DS]
