@@ -27,7 +27,7 @@ from stylesync.control.crvc import (
 )
 from stylesync.control.gravity_compensation import ANKLE_JOINT, gravity_torques
 from stylesync.control.jacobian_transpose import JointFrames
-from stylesync.control.model_compensation import ipm_ankle_moments, lipm_sync_force
+from stylesync.control.model_compensation import bounded_lipm_sync_force, ipm_ankle_moments
 from stylesync.control.pid import IS_BALL, JointPid, reference_velocity
 from stylesync.control.stable_pd import (
     N_DOFS,
@@ -123,15 +123,8 @@ class BalanceController:
                                        self.mass.total_kg, cfg.com_force_kp_npm, cfg.com_force_kd_nspm)
         f_lipm = np.zeros(3)
         if cfg.lipm_time_sync and ref.lipm is not None:  # Eq. 21-23
-            f_lipm = lipm_sync_force(ref.lipm.d_a_human, ref.lipm.h_human_m, ref.lipm.d_a_char, ref.lipm.h_char_m,
-                                     self.mass.total_kg, self.g)
-            limit = min(cfg.lipm_force_limit_n, bnd.lipm_force_bound_n(self.mass.total_kg, self.g, ref.lipm.h_char_m))
-            mag = float(np.linalg.norm(f_lipm))
-            exceeded = mag > limit
-            self.bounds.report("lipm_force", exceeded and cfg.enforce_bounds, state.time_s,
-                               f"|f_cro| {mag:.0f} N > {limit:.0f} N (Eq. 26)")
-            if exceeded and cfg.enforce_bounds:
-                f_lipm *= limit / mag
+            f_lipm = bounded_lipm_sync_force(ref.lipm, self.mass.total_kg, self.g, cfg.lipm_force_limit_n,
+                                             cfg.enforce_bounds, self.bounds, state.time_s)
             force += f_lipm
         # The whole horizontal virtual force obeys Eq. 26's bound, not only the LIPM part: a stance foot pushes the
         # COM sideways only by moving its centre of pressure, so a larger force just rolls the foot (the COM

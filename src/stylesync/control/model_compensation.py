@@ -46,3 +46,16 @@ def lipm_sync_force(d_a_human: np.ndarray, h_human_m: float, d_a_char: np.ndarra
                                   - np.asarray(d_a_char) / h_char_m)
     f = np.array([f[0], f[1], 0.0])
     return f
+
+
+def bounded_lipm_sync_force(lipm, mass_kg: float, gravity_mps2: float, force_limit_n: float, enforce: bool,
+                            bounds, time_s: float) -> np.ndarray:
+    """Eq. 23 for ``lipm`` (a ``LipmMap``), reported against Eq. 26's bound and clamped to it when ``enforce``."""
+    from stylesync.control.bounds import lipm_force_bound_n
+
+    f = lipm_sync_force(lipm.d_a_human, lipm.h_human_m, lipm.d_a_char, lipm.h_char_m, mass_kg, gravity_mps2)
+    limit = min(force_limit_n, lipm_force_bound_n(mass_kg, gravity_mps2, lipm.h_char_m))
+    mag = float(np.linalg.norm(f))
+    exceeded = mag > limit
+    bounds.report("lipm_force", exceeded and enforce, time_s, f"|f_cro| {mag:.0f} N > {limit:.0f} N (Eq. 26)")
+    return f * (limit / mag) if exceeded and enforce else f

@@ -32,7 +32,7 @@ from stylesync.control.crvc import com_virtual_force, root_virtual_torque
 from stylesync.control.floating_jacobian import FloatingJacobians
 from stylesync.control.inverse_dynamics import joint_torques, solve_with_contact_forces
 from stylesync.control.jacobian_transpose import JointFrames
-from stylesync.control.model_compensation import lipm_sync_force
+from stylesync.control.model_compensation import bounded_lipm_sync_force
 from stylesync.control.pid import JointPid, joint_error, reference_velocity
 from stylesync.control.stable_pd import N_DOFS, flatten_joint_values, unflatten_joint_values
 from stylesync.motion.reference import ReferencePose
@@ -81,15 +81,8 @@ class MomentumBalanceController:
                         - cfg.com_force_kd_nspm * state.root_lin_vel_world[2])
         f_lipm = np.zeros(3)
         if cfg.lipm_time_sync and ref.lipm is not None:  # Eq. 21-23, bounded by Eq. 26
-            f_lipm = lipm_sync_force(ref.lipm.d_a_human, ref.lipm.h_human_m, ref.lipm.d_a_char, ref.lipm.h_char_m,
-                                     m, self.g)
-            limit = min(cfg.lipm_force_limit_n, bnd.lipm_force_bound_n(m, self.g, ref.lipm.h_char_m))
-            mag = float(np.linalg.norm(f_lipm))
-            exceeded = mag > limit
-            self.bounds.report("lipm_force", exceeded and cfg.enforce_bounds, state.time_s,
-                               f"|f_cro| {mag:.0f} N > {limit:.0f} N (Eq. 26)")
-            if exceeded and cfg.enforce_bounds:
-                f_lipm *= limit / mag
+            f_lipm = bounded_lipm_sync_force(ref.lipm, m, self.g, cfg.lipm_force_limit_n, cfg.enforce_bounds,
+                                             self.bounds, state.time_s)
             force += f_lipm
         moment = root_virtual_torque(ref.root_quat_wxyz, state.root_quat_wxyz, state.root_ang_vel_world,
                                      cfg.momentum_root_kp, cfg.momentum_root_kd, cfg.root_yaw_gain_scale)
