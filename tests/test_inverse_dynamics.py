@@ -57,15 +57,19 @@ def test_momentum_jacobian_matches_the_engines_mass_matrix(moving_character):
 
 def test_wrench_basis_forces_stay_in_the_friction_cone_and_on_the_sole():
     corners = {"left": sole_corners_world(np.array([0.0, 0.1, ANKLE_HEIGHT_M]), np.array([1.0, 0.0, 0.0, 0.0]))}
-    dirs_points, a = wrench_basis(np.array([0.05, 0.0, 0.9]), corners, friction=0.9)
-    dirs = dirs_points[:, :3]
-    assert np.allclose(np.linalg.norm(dirs, axis=1), 1.0)
-    assert np.all(np.hypot(dirs[:, 0], dirs[:, 1]) <= 0.9 * dirs[:, 2] + 1e-12)
-    assert np.allclose(dirs_points[:, 5], 0.0, atol=1e-9)  # forces act on the ground plane
-    # any non-negative mix: total moment about the ankle column has its centre of pressure inside the sole
+    com = np.array([0.05, 0.0, 0.9])
+    edges, a = wrench_basis(com, corners, friction=0.9)
+    assert np.allclose(np.linalg.norm(edges, axis=1), 1.0)
+    assert np.all(np.hypot(edges[:, 0], edges[:, 1]) <= 0.9 * edges[:, 2] + 1e-12)
+    assert np.allclose(corners["left"][:, 2], 0.0, atol=1e-9)  # the corners lie on the ground plane
+    points = np.repeat(corners["left"], 4, axis=0)
+    dirs = np.tile(edges, (4, 1))
+    np.testing.assert_allclose(a[:3].T, dirs)
+    np.testing.assert_allclose(a[3:].T, np.cross(points - com, dirs))
+    # any non-negative mix has its centre of pressure inside the sole
     lam = np.random.default_rng(0).uniform(0.0, 1.0, a.shape[1])
     f = a[:3] @ lam
-    cop = (dirs_points[:, 3:5] * (dirs[:, 2] * lam)[:, None]).sum(axis=0) / f[2]
+    cop = (points[:, :2] * (dirs[:, 2] * lam)[:, None]).sum(axis=0) / f[2]
     xs, ys = corners["left"][:, 0], corners["left"][:, 1]
     assert xs.min() <= cop[0] <= xs.max() and ys.min() <= cop[1] <= ys.max()
     assert len(pyramid_edges(0.9)) == 4

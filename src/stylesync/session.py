@@ -19,7 +19,7 @@ import numpy as np
 from stylesync import rotations as rot
 from stylesync.config import SessionConfig
 from stylesync.control.bounds import BoundsMonitor
-from stylesync.control.controller import BalanceController
+from stylesync.control.controller import BalanceController, ControllerBase
 from stylesync.control.momentum_balance import MomentumBalanceController
 from stylesync.control.pid import joint_error
 from stylesync.errors import SourceError
@@ -81,8 +81,8 @@ class Session:
         self.processing = OperatorProcessing(config.clocks, config.filters)
         self.bounds = BoundsMonitor()
         self.motion = MotionOptimizer(config.motion, config.clocks.control_hz, self.bounds)
-        controller_class = (MomentumBalanceController if config.control.balance == "inverse_dynamics"
-                            else BalanceController)
+        controller_class: type[ControllerBase] = (
+            MomentumBalanceController if config.control.balance == "inverse_dynamics" else BalanceController)
         self.controller = controller_class(config.control, self.mass, config.world.gravity_mps2,
                                            1.0 / config.clocks.physics_hz, 1.0 / config.clocks.control_hz,
                                            self.bounds, config.world.friction)
@@ -107,7 +107,7 @@ class Session:
         if sample is None:
             return
         self._stand_at(sample.pos["PELVIS"], sample.quat["PELVIS"])
-        self.controller.pid.reset()
+        self.controller.reset()
 
     def _stand_at(self, pelvis_world: np.ndarray, pelvis_quat_wxyz: np.ndarray) -> None:
         """Character standing at the operator's pelvis position (horizontally) and heading."""

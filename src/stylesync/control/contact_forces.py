@@ -12,8 +12,6 @@ as its stance weight falls, so that a foot about to lift off is unloaded before 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from stylesync import rotations as rot
@@ -42,26 +40,16 @@ def pyramid_edges(friction: float) -> np.ndarray:
     return e / np.linalg.norm(e, axis=1, keepdims=True)
 
 
-@dataclass
-class ContactForces:
-    points_world: dict[str, np.ndarray]  # side -> (4, 3) sole corners [m]
-    forces_world: dict[str, np.ndarray]  # side -> (4, 3) force at each corner [N]
-    residual_force_n: np.ndarray  # (3,) achieved minus desired total force [N]
-    residual_moment_nm: np.ndarray  # (3,) achieved minus desired moment about the COM [N·m]
-
-
 def wrench_basis(com_world: np.ndarray, corners_world: dict[str, np.ndarray],
                  friction: float) -> tuple[np.ndarray, np.ndarray]:
-    """Per pyramid edge of every corner (n_λ = 16 per foot, feet in ``corners_world`` order): the force
-    directions (n_λ, 3) and their points (n_λ, 3), and the wrench about the COM, A (6, n_λ)."""
+    """The pyramid's unit edges (4, 3), the same at every corner, and the wrench about the COM of each edge's unit
+    force, A (6, n_λ): n_λ = 16 per foot, feet in ``corners_world`` order, corner by corner, edge by edge."""
     edges = pyramid_edges(friction)
-    dirs = np.concatenate([np.tile(edges, (4, 1)) for _ in corners_world])
+    dirs = np.tile(edges, (4 * len(corners_world), 1))
     points = np.concatenate([np.repeat(c, 4, axis=0) for c in corners_world.values()])
-    a = np.concatenate([dirs, rot.cross(points - com_world, dirs)], axis=1).T
-    return np.concatenate([dirs, points], axis=1), a
+    return edges, np.concatenate([dirs, rot.cross(points - com_world, dirs)], axis=1).T
 
 
 def regularisation(corners_world: dict[str, np.ndarray], stance_weight: dict[str, float]) -> np.ndarray:
     """ε per λ (see the module): larger on a foot with a small stance weight."""
-    return np.concatenate([np.zeros(0)] + [np.full(16, REGULARISATION / max(stance_weight.get(s, 0.0), MIN_WEIGHT))
-                                           for s in corners_world])
+    return np.repeat([REGULARISATION / max(stance_weight.get(s, 0.0), MIN_WEIGHT) for s in corners_world], 16)

@@ -61,22 +61,50 @@ def supporting_weights(stance_weight: dict[str, float], foot_force_n: dict[str, 
     return {s: v / total for s, v in w.items()} if total > 0 else w
 
 
-class BalanceController:
+class ControllerBase:
+    """What every realisation of the Sec. 6 controller shares: its configuration, the character's mass, the
+    movement-bounds monitor, telemetry, and the reference's joint velocity (from successive control ticks).
+
+    ``update`` runs at each control tick, ``torques`` at each physics step, ``reset`` when the character is stood
+    up again."""
+
     def __init__(self, cfg: ControlConfig, mass: MassProperties, gravity_mps2: float, physics_dt_s: float,
                  control_dt_s: float, bounds: bnd.BoundsMonitor | None = None, friction: float = 0.9):
         self.cfg = cfg
         self.mass = mass
         self.g = gravity_mps2
         self.friction = friction
-        self.pid = JointPid(cfg, physics_dt_s)
         self.physics_dt_s = physics_dt_s
         self.control_dt_s = control_dt_s
         self.bounds = bounds if bounds is not None else bnd.BoundsMonitor()
-        self._ff = np.zeros((len(JOINTS), 3))
-        self._ref: ReferencePose | None = None
+        self.telemetry = ControlTelemetry(np.zeros(3), np.zeros(3), np.zeros(3))
         self._prev_ref_pos: np.ndarray | None = None
         self._ref_vel = np.zeros((len(JOINTS), 3))
-        self.telemetry = ControlTelemetry(np.zeros(3), np.zeros(3), np.zeros(3))
+
+    def update(self, state: CharacterState, ref: ReferencePose, mass_matrix: np.ndarray) -> None:
+        raise NotImplementedError
+
+    def torques(self, fb: JointFeedback) -> Torques:
+        raise NotImplementedError
+
+    def reset(self) -> None:
+        """Forget accumulated state (integral terms) when the character is stood up again."""
+
+    def _update_reference_velocity(self, ref: ReferencePose) -> None:
+        """The reference's joint velocity for the derivative terms, from successive references at the control
+        rate (zero until there are two)."""
+        if self._prev_ref_pos is not None:
+            self._ref_vel = reference_velocity(self._prev_ref_pos, ref.joint_pos, self.control_dt_s)
+        self._prev_ref_pos = ref.joint_pos.copy()
+
+
+class BalanceController(ControllerBase):
+    def __init__(self, cfg: ControlConfig, mass: MassProperties, gravity_mps2: float, physics_dt_s: float,
+                 control_dt_s: float, bounds: bnd.BoundsMonitor | None = None, friction: float = 0.9):
+        super().__init__(cfg, mass, gravity_mps2, physics_dt_s, control_dt_s, bounds, friction)
+        self.pid = JointPid(cfg, physics_dt_s)
+        self._ff = np.zeros((len(JOINTS), 3))
+        self._ref: ReferencePose | None = None
         self.root_kp, self.root_kd = cfg.root_torque_kp, cfg.root_torque_kd
         # D of stable_pd.py: the joints' diagonal is constant; the root torque's block is filled per tick.
         self._damping = joint_damping(self.pid.kp, self.pid.kd, physics_dt_s)
@@ -153,12 +181,12 @@ class BalanceController:
                 moment[k] = limit_ankle_moment(moment[k], ref.ankle_world[side], foot_yaw[side],
                                                ws * self.mass.total_kg * self.g, self.friction)
         self._ff = ff + frames.torque_from_moment(moment)
-        # Reference velocity for the derivative term, from successive references at the control rate.
-        if self._prev_ref_pos is not None:
-            self._ref_vel = reference_velocity(self._prev_ref_pos, ref.joint_pos, self.control_dt_s)
-        self._prev_ref_pos = ref.joint_pos.copy()
+        self._update_reference_velocity(ref)
         self._ref = ref
         self.telemetry = ControlTelemetry(force, f_lipm, self.telemetry.root_torque_nm)
+
+    def reset(self) -> None:
+        self.pid.reset()
 
     def torques(self, fb: JointFeedback) -> Torques:
         ref = self._ref

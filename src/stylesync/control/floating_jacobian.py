@@ -36,6 +36,7 @@ _HINGE_AXIS_MODEL = np.array([JOINTS[k].axis_in_model for k in DOF_JOINT])
 MOVES = np.zeros((len(LINK_NAMES), N_JOINT_DOFS), dtype=bool)
 for _d, _k in enumerate(DOF_JOINT):
     MOVES[subtree_links(JOINTS[_k].name), _d] = True
+_MOVED_BY = MOVES.T.astype(float)  # (N_JOINT_DOFS, n_links) for the subtree sums
 
 
 def _skew(v: np.ndarray) -> np.ndarray:
@@ -79,7 +80,7 @@ class FloatingJacobians:
         j[:, :3] = m_total * np.eye(3)
         j[:, 3:6] = -m_total * _skew(com - self.root_world)
         # Σ_i m_i a_d × (c_i - o_d) over the links DOF d moves = a_d × (Σ m_i c_i - M_d o_d)
-        m_sub = MOVES.T.astype(float) @ link_mass_kg  # (N_JOINT_DOFS,)
-        mc_sub = MOVES.T.astype(float) @ (link_mass_kg[:, None] * link_com_world)  # (N_JOINT_DOFS, 3)
+        m_sub = _MOVED_BY @ link_mass_kg  # (N_JOINT_DOFS,)
+        mc_sub = _MOVED_BY @ (link_mass_kg[:, None] * link_com_world)  # (N_JOINT_DOFS, 3)
         j[:, ROOT_DOFS:] = rot.cross(self.axis_world, mc_sub - m_sub[:, None] * self.origin_world).T
         return j
