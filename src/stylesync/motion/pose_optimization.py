@@ -32,8 +32,8 @@ from stylesync.motion.stance_fsm import (
     swing_side,
 )
 from stylesync.motion.style_features import StyleExtractor, StyleFeatures
-from stylesync.processing.body_parameters import link_length
-from stylesync.processing.joint_map import hinge_angle
+from stylesync.processing.body_parameters import leg_length_m
+from stylesync.processing.joint_map import hinge_angle, local_rotation
 from stylesync.processing.operator_processing import OperatorSample
 from stylesync.sim.backend import CONTACT_FORCE_N, CharacterState, MassProperties
 from stylesync.sim.character import (
@@ -112,8 +112,7 @@ class MotionOptimizer:
             self._held = sample
 
         # Operator size: leg length by Eq. 1, smoothed; scale = h_C / h_H (Eq. 9).
-        leg = float(np.mean([link_length(s.pos[f"HIP_{v}"], s.pos[f"KNEE_{v}"]) +
-                             link_length(s.pos[f"KNEE_{v}"], s.pos[f"ANKLE_{v}"]) for v in _SIDE_UP.values()]))
+        leg = leg_length_m(s.pos, ankle_height_m=0.0)
         op_leg_m = leg if self._op_leg_m is None else self._op_leg_m + _SCALE_SMOOTHING * (leg - self._op_leg_m)
         self._op_leg_m = op_leg_m
         scale = CHAR_LEG_LENGTH_M / op_leg_m
@@ -227,12 +226,10 @@ class MotionOptimizer:
 
         # Upper body from the joint map; the chest keeps the operator's torso orientation in the world.
         local["chest"] = rot.multiply(rot.conjugate(q_root_d), s.quat["SPINE_CHEST"])
-        local["neck"] = rot.multiply(rot.conjugate(s.quat["SPINE_CHEST"]), s.quat["NECK"])
+        local["neck"] = local_rotation(s.quat, "neck")
         for side in ("left", "right"):
-            S = _SIDE_UP[side]
-            local[f"{side}_shoulder"] = rot.multiply(rot.conjugate(s.quat["SPINE_CHEST"]), s.quat[f"SHOULDER_{S}"])
-            q_el = rot.multiply(rot.conjugate(s.quat[f"SHOULDER_{S}"]), s.quat[f"ELBOW_{S}"])
-            knee_angle[f"{side}_elbow"] = hinge_angle(q_el, f"{side}_elbow")
+            local[f"{side}_shoulder"] = local_rotation(s.quat, f"{side}_shoulder")
+            knee_angle[f"{side}_elbow"] = hinge_angle(local_rotation(s.quat, f"{side}_elbow"), f"{side}_elbow")
 
         joint_pos = np.zeros((len(JOINTS), 4))
         for k, spec in enumerate(JOINTS):
