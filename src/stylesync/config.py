@@ -102,6 +102,9 @@ class FilterConfig:
         _non_negative("FilterConfig.floor_threshold_m", self.floor_threshold_m)
 
 
+SWING_PLACEMENTS = ("capture_point", "pelvis")
+
+
 @dataclass(frozen=True)
 class MotionConfig:
     # Sec. 5.1 leaves the foot-height threshold open: 4 cm on the operator's ankle heights, with hysteresis.
@@ -115,8 +118,27 @@ class MotionConfig:
     swing_hip_cd: float = 0.0  # Eq. 12, Sec. 7.2 sets c_d = 0
     swing_hip_cv: float = 0.0  # Eq. 12, Sec. 7.2 sets c_v = 0
     max_swing_foot_lift_m: float = 0.25  # clamp of the scaled swing-ankle height above the ground [m]
+    # Where the swing foot goes, horizontally (pose_optimization.py): the operator's foot relative to his capture
+    # point, scaled, from the character's capture point ("capture_point"), or relative to his pelvis from the
+    # character's pelvis ("pelvis", no balance feedback, as Sec. 7.2's c_d = c_v = 0).
+    swing_placement: str = "capture_point"
+    # With "capture_point", where the swing foot lands relative to the character's capture point, in the heading
+    # frame: at least this far behind it (a foot landing ahead of it stops the body and, once the rear foot
+    # lifts, drops it backwards; the linear inverted pendulum's steady gait lands about step / (e^(ωT) - 1)
+    # behind, 0.1 m at this character's walking step and time) [m]
+    step_behind_capture_point_m: float = 0.1
+    # and this far outside it, sideways (min, max): a foot further out throws the body back harder than the
+    # next step can catch, and the sway grows from step to step [m]
+    step_outside_capture_point_m: tuple[float, float] = (0.02, 0.06)
 
     def __post_init__(self) -> None:
+        lo, hi = self.step_outside_capture_point_m
+        if not lo <= hi:
+            raise ConfigError(f"MotionConfig.step_outside_capture_point_m must be (min, max), got {(lo, hi)}")
+        _non_negative("MotionConfig.step_behind_capture_point_m", self.step_behind_capture_point_m)
+        if self.swing_placement not in SWING_PLACEMENTS:
+            raise ConfigError(f"MotionConfig.swing_placement must be one of {', '.join(SWING_PLACEMENTS)}, "
+                              f"got '{self.swing_placement}'")
         _positive("MotionConfig.stance_height_threshold_m", self.stance_height_threshold_m)
         _non_negative("MotionConfig.stance_hysteresis_m", self.stance_hysteresis_m)
         _positive("MotionConfig.late_contact_timeout_s", self.late_contact_timeout_s)
@@ -146,6 +168,7 @@ class ControlConfig:
     balance: str = "inverse_dynamics"
     joint_tracking_omega_rad_s: float = 20.0  # inverse dynamics: Eq. 13 as q̈* = ω² e + 2 ζ ω ė
     joint_tracking_damping_ratio: float = 1.0
+    joint_acceleration_limit_rad_s2: float = 200.0  # the joint PD's desired acceleration is saturated here
     joint_tracking_weight: float = 10.0  # inverse dynamics: weight of M_ii Δq̈_i² against the wrench error
     momentum_root_kp: float = 200.0  # inverse dynamics: root virtual torque of Eq. 16 about the COM [N·m/rad]
     momentum_root_kd: float = 40.0  # [N·m·s/rad]
@@ -166,7 +189,8 @@ class ControlConfig:
         _positive("ControlConfig.root_yaw_gain_scale", self.root_yaw_gain_scale)
         if self.balance not in BALANCE_METHODS:
             raise ConfigError(f"ControlConfig.balance must be one of {BALANCE_METHODS}, got {self.balance!r}")
-        for n in ("joint_tracking_omega_rad_s", "joint_tracking_damping_ratio", "momentum_moment_weight_per_m"):
+        for n in ("joint_tracking_omega_rad_s", "joint_tracking_damping_ratio", "momentum_moment_weight_per_m",
+                  "joint_acceleration_limit_rad_s2"):
             _positive(f"ControlConfig.{n}", getattr(self, n))
         for n in ("momentum_root_kp", "momentum_root_kd", "contact_velocity_gain"):
             _non_negative(f"ControlConfig.{n}", getattr(self, n))
@@ -186,6 +210,7 @@ class OperatorConfig:
     orientation_noise_rad: float = 0.02  # joint orientation noise (1 sigma) [rad]
     timestamp_jitter_s: float = 0.004  # sample-time jitter (1 sigma) [s]
     standing_lead_in_s: float = 1.0  # operator stands in the first frame's pose before the clip plays [s]
+    start_ramp_s: float = 1.5  # a looping clip's strides grow from standing to full over this time [s]
 
     def __post_init__(self) -> None:
         _positive("OperatorConfig.height_m", self.height_m)
@@ -194,6 +219,7 @@ class OperatorConfig:
         _non_negative("OperatorConfig.orientation_noise_rad", self.orientation_noise_rad)
         _non_negative("OperatorConfig.timestamp_jitter_s", self.timestamp_jitter_s)
         _non_negative("OperatorConfig.standing_lead_in_s", self.standing_lead_in_s)
+        _non_negative("OperatorConfig.start_ramp_s", self.start_ramp_s)
 
 
 @dataclass(frozen=True)

@@ -80,7 +80,8 @@ class Session:
         self.mass = self.backend.mass_properties()
         self.processing = OperatorProcessing(config.clocks, config.filters)
         self.bounds = BoundsMonitor()
-        self.motion = MotionOptimizer(config.motion, config.clocks.control_hz, self.bounds)
+        self.motion = MotionOptimizer(config.motion, config.clocks.control_hz, self.bounds,
+                                      config.world.gravity_mps2)
         controller_class: type[ControllerBase] = (
             MomentumBalanceController if config.control.balance == "inverse_dynamics" else BalanceController)
         self.controller = controller_class(config.control, self.mass, config.world.gravity_mps2,

@@ -19,6 +19,8 @@ from stylesync.sim.character import ANKLE_HEIGHT_M, FOOT_CENTER_AHEAD_OF_ANKLE_M
 
 SOLE_MARGIN = 0.9  # fraction of the sole's length and width the corner forces may use
 FRICTION_MARGIN = 0.8  # fraction of the friction coefficient the pyramid uses
+COP_MARGIN = 0.9  # fraction of the support's extent the desired horizontal force may use
+MOMENTUM_ACCEL_ALLOWANCE_MPS2 = 0.5  # horizontal COM acceleration allowed beyond the pendulum's [m/s²]
 REGULARISATION = 1e-4  # ε of a full-weight foot [1/N² against N² of residual]
 MIN_WEIGHT = 0.05  # a stance weight below this is treated as this (ε_s = REGULARISATION / weight)
 _HALF_L, _HALF_W = SOLE_MARGIN * FOOT_LENGTH_M / 2, SOLE_MARGIN * FOOT_WIDTH_M / 2
@@ -48,6 +50,31 @@ def wrench_basis(com_world: np.ndarray, corners_world: dict[str, np.ndarray],
     dirs = np.tile(edges, (4 * len(corners_world), 1))
     points = np.concatenate([np.repeat(c, 4, axis=0) for c in corners_world.values()])
     return edges, np.concatenate([dirs, rot.cross(points - com_world, dirs)], axis=1).T
+
+
+def feasible_horizontal_force(force_n: np.ndarray, com_world: np.ndarray, corners_world: dict[str, np.ndarray],
+                              mass_kg: float, gravity_mps2: float) -> np.ndarray:
+    """The desired force (3,) [N] with its horizontal part limited to what a centre of pressure inside the support
+    can give: by the linear inverted pendulum (the model of Eq. 21), m p̈ = m g / h (c - p_cop) per horizontal
+    axis, with p_cop within the soles' extent on that axis, shrunk by COP_MARGIN about its middle. A larger
+    request cannot be met by the ground; left in the desired wrench, it would be traded against the vertical force
+    (more weight for more friction) and the moment, which lifts or tips the body."""
+    out = np.array(force_n, dtype=float)
+    if not corners_world:
+        return out
+    pts = np.concatenate(list(corners_world.values()))
+    h = max(float(com_world[2] - pts[:, 2].mean()), 0.1)
+    k = mass_kg * gravity_mps2 / h
+    lo, hi = pts[:, :2].min(axis=0), pts[:, :2].max(axis=0)
+    mid, half = 0.5 * (lo + hi), 0.5 * COP_MARGIN * (hi - lo)
+    # The range always holds zero (with the COM beyond the margin the pendulum model would ask for a push
+    # outwards), and is widened by MOMENTUM_ACCEL_ALLOWANCE_MPS2: a change of the body's angular momentum (the
+    # hip strategy of a squat's leaning trunk) gives some horizontal force the pendulum does not.
+    extra = mass_kg * MOMENTUM_ACCEL_ALLOWANCE_MPS2
+    lo_f = np.minimum(k * (com_world[:2] - mid - half), 0.0) - extra
+    hi_f = np.maximum(k * (com_world[:2] - mid + half), 0.0) + extra
+    out[:2] = np.clip(out[:2], lo_f, hi_f)
+    return out
 
 
 def regularisation(corners_world: dict[str, np.ndarray], stance_weight: dict[str, float]) -> np.ndarray:

@@ -25,7 +25,12 @@ import numpy as np
 
 from stylesync.config import ControlConfig
 from stylesync.control import bounds as bnd
-from stylesync.control.contact_forces import regularisation, sole_corners_world, wrench_basis
+from stylesync.control.contact_forces import (
+    feasible_horizontal_force,
+    regularisation,
+    sole_corners_world,
+    wrench_basis,
+)
 from stylesync.control.controller import TORQUE_LIMIT, ControllerBase, ControlTelemetry, supporting_weights
 from stylesync.control.crvc import com_virtual_force, root_virtual_torque
 from stylesync.control.floating_jacobian import FloatingJacobians
@@ -35,6 +40,7 @@ from stylesync.control.model_compensation import bounded_lipm_sync_force
 from stylesync.control.pid import IS_BALL, joint_error
 from stylesync.control.stable_pd import N_DOFS, flatten_joint_values, unflatten_joint_values
 from stylesync.motion.reference import ReferencePose
+from stylesync.motion.stance_fsm import swing_side
 from stylesync.sim.backend import CharacterState, JointFeedback, MassProperties, Torques
 from stylesync.sim.character import ANKLE_HEIGHT_M, JOINTS, LINK_NAMES
 
@@ -85,6 +91,9 @@ class MomentumBalanceController(ControllerBase):
         kp, kd = omega * omega, 2.0 * zeta * omega
         e = joint_error(state.joint_pos, ref.joint_pos)
         qdd_joint = kp * e + kd * (self._ref_vel - state.joint_vel)
+        # Saturated: a jump of the reference (a stance change, a landing) would otherwise ask for accelerations
+        # whose torques exceed the joints' limits, and the clipped torques no longer realise the planned forces.
+        qdd_joint = np.clip(qdd_joint, -cfg.joint_acceleration_limit_rad_s2, cfg.joint_acceleration_limit_rad_s2)
         # The pelvis orientation as a task of its own (the root virtual torque's PD law, per unit inertia): the
         # whole-body moment above leaves it free to turn against the legs. The root's linear acceleration has no
         # target (weight 0): the ground forces decide it.
@@ -96,10 +105,12 @@ class MomentumBalanceController(ControllerBase):
         weights[:3] = 0.0
 
         # A stance foot that does not touch yet is lowered onto the ground (a foot no force is planned for would
-        # otherwise be lifted by the other's reaction): its sole is driven a little below the ground.
+        # otherwise be lifted by the other's reaction), and so is a swing foot the reference is held for (a late
+        # contact, Sec. 5.1): its sole is driven a little below the ground.
         task_rows, task_acc = [], []
+        swing = swing_side(ref.character_stance)
         for s, ws in ref.stance_weight.items():
-            if ws > 0 and w[s] <= 0:
+            if (ws > 0 and w[s] <= 0) or (ref.held and s == swing):
                 link = _FOOT_LINK[s]
                 ankle = state.link_origin_world[link]
                 row = jac.point_linear(link, ankle)[2]
@@ -112,6 +123,7 @@ class MomentumBalanceController(ControllerBase):
         contact_rows = []
         wrench = np.zeros((6, 0))
         b_force = np.zeros((N_DOFS, 0))
+        force = feasible_horizontal_force(force, com, corners, m, self.g)
         if corners:
             edges, wrench = wrench_basis(com, corners, self.friction)
             cols = []

@@ -52,44 +52,64 @@ from stylesync.sim.character import (
 _MIN_AXIS_SPREAD_M = 0.08
 _UP = np.array([0.0, 0.0, 1.0])
 LATE_CONTACT_PRESS_M = 0.02  # a swing foot held for a late contact is aimed this far below the ground [m]
+LANDING_REACH = 0.97  # hip-ankle distance, as a fraction of the leg's length, at which a landing foot is aimed
+OPERATOR_SWING_S = 0.4  # the operator's swing time before one has been seen [s]
+SWING_BLEND_S = 0.1  # time constant over which a swing foot moves from its lift-off point onto its target [s]
 ANCHOR_BLEND_S = 0.15  # time constant over which a stance change's jump of the retargeting anchor is taken up
 _SCALE_SMOOTHING = 0.02  # per tick, exponential average of the operator's leg length
+_VELOCITY_SMOOTHING = 0.2  # per tick, exponential average of the desired COM velocity
 _SIDE_UP = {"left": "LEFT", "right": "RIGHT"}
 _LINK = {n: i for i, n in enumerate(LINK_NAMES)}
 CHAR_LEG_LENGTH_M = THIGH_LENGTH_M + SHANK_LENGTH_M
 
 
 def _heading_frame_fraction(p_h, al_h, ar_h, al_c, ar_c, scale: float, heading: float) -> np.ndarray:
-    """Eq. 10 (fraction reading) in the heading frame, horizontal components only."""
+    """Eq. 10 (fraction reading) in the heading frame, horizontal components only.
+
+    Along an axis where the feet are close together the fraction is ill-defined; there the operator's offset from
+    the ankle midpoint, scaled, is used. The two are blended by how far apart the feet are (the lesser of the
+    operator's and the character's spread, from _MIN_AXIS_SPREAD_M / 2 to _MIN_AXIS_SPREAD_M * 1.5), so that the
+    target does not jump when a swing foot passes the stance foot.
+    """
     R = rot.matrix_from_quat(rot.quat_from_yaw(heading))
     ph, lh, rh = (R.T @ np.asarray(v) for v in (p_h, al_h, ar_h))
     lc, rc = (R.T @ np.asarray(v) for v in (al_c, ar_c))
     out = np.zeros(3)
     for ax in (0, 1):
         spread_h, spread_c = rh[ax] - lh[ax], rc[ax] - lc[ax]
-        if abs(spread_h) >= _MIN_AXIS_SPREAD_M and abs(spread_c) >= _MIN_AXIS_SPREAD_M:
-            frac = (ph[ax] - lh[ax]) / spread_h
-            out[ax] = lc[ax] + spread_c * frac
-        else:
-            out[ax] = 0.5 * (lc[ax] + rc[ax]) + scale * (ph[ax] - 0.5 * (lh[ax] + rh[ax]))
+        offset = 0.5 * (lc[ax] + rc[ax]) + scale * (ph[ax] - 0.5 * (lh[ax] + rh[ax]))
+        w = min(max(min(abs(spread_h), abs(spread_c)) / _MIN_AXIS_SPREAD_M - 0.5, 0.0), 1.0)
+        out[ax] = offset
+        if w > 0.0:
+            out[ax] += w * (lc[ax] + spread_c * (ph[ax] - lh[ax]) / spread_h - offset)
     return R @ out
 
 
 class MotionOptimizer:
-    def __init__(self, cfg: MotionConfig, control_hz: float, bounds: BoundsMonitor | None = None):
+    def __init__(self, cfg: MotionConfig, control_hz: float, bounds: BoundsMonitor | None = None,
+                 gravity_mps2: float = 9.8):
         self.cfg = cfg
+        self.g = gravity_mps2
         self.dt_s = 1.0 / control_hz
         self.op_fsm = OperatorStanceFsm(cfg.stance_height_threshold_m, cfg.stance_hysteresis_m)
         self.char_fsm = CharacterStanceFsm(cfg.late_contact_timeout_s, cfg.min_swing_s)
         self.op_style = StyleExtractor()
         self._op_leg_m: float | None = None
         self._held: OperatorSample | None = None
+        self._prev_com_d: np.ndarray | None = None
+        self._com_vel_d = np.zeros(3)
         self._prev_com_h: np.ndarray | None = None
-        self._com_vel_h = np.zeros(3)
+        self._com_vel_h = np.zeros(3)  # operator COM velocity, smoothed [m/s]
         self.bounds = bounds if bounds is not None else BoundsMonitor()
         self._anchor_stance: Stance | None = None
         self._anchor_offset = np.zeros((2, 2))  # (pelvis, COM) x (x, y) [m]
         self._last_xy: np.ndarray | None = None
+        self._swing: str | None = None
+        self._swing_offset = np.zeros(2)  # lift-off foot position minus the first swing target, decaying [m]
+        self._swing_t0_s = 0.0  # when the character's current swing began [s]
+        self._op_swing_s = OPERATOR_SWING_S  # the operator's swing time, averaged over his swings [s]
+        self._op_state: Stance | None = None
+        self._op_state_t0_s = 0.0
 
     def operator_features(self, s: OperatorSample) -> StyleFeatures:
         hip = {k: s.pos[f"HIP_{v}"] for k, v in _SIDE_UP.items()}
@@ -105,6 +125,11 @@ class MotionOptimizer:
         op_state = self.op_fsm.update(sample.pos["ANKLE_LEFT"][2], sample.pos["ANKLE_RIGHT"][2])
         contact = {side: state.foot_contact_force_n[f"{side}_ankle"] > CONTACT_FORCE_N for side in ("left", "right")}
         ch_state = self.char_fsm.update(op_state, contact, state.time_s)
+        if op_state is not self._op_state:  # the operator's swing time, for the swing's progress
+            if self._op_state in (Stance.LS, Stance.RS):
+                swing_s = min(max(state.time_s - self._op_state_t0_s, 0.2), 1.0)
+                self._op_swing_s += 0.5 * (swing_s - self._op_swing_s)
+            self._op_state, self._op_state_t0_s = op_state, state.time_s
         if self.char_fsm.hold_reference and self._held is not None:
             s = self._held  # late contact: keep the reference until the character's foot lands
         else:
@@ -130,24 +155,28 @@ class MotionOptimizer:
         com_h = s.com_world
         com_c = mass.com(state)
 
-        # Lower-body retargeting (Eq. 9-10) for the pelvis and the COM.
-        if ch_state is Stance.DS:
+        # Lower-body retargeting (Eq. 9-10) for the pelvis and the COM, anchored on the feet the operator stands
+        # on (on the character's stance while a late contact holds the reference): after an early contact
+        # (Sec. 5.1) the character is in double stance while the operator still swings a foot, whose position
+        # says nothing of where his body is over the ground.
+        anchor = ch_state if self.char_fsm.hold_reference else op_state
+        if anchor is Stance.DS:
             pelvis_xy = _heading_frame_fraction(p_h, a_h["left"], a_h["right"], a_c["left"], a_c["right"],
                                                 scale, heading)
             com_xy = _heading_frame_fraction(com_h, a_h["left"], a_h["right"], a_c["left"], a_c["right"],
                                              scale, heading)
             ankle_h_z = 0.5 * (a_h["left"][2] + a_h["right"][2])
         else:
-            st = "left" if ch_state is Stance.LS else "right"
+            st = "left" if anchor is Stance.LS else "right"
             pelvis_xy = a_c[st] + scale * (p_h - a_h[st])
             com_xy = a_c[st] + scale * (com_h - a_h[st])
             ankle_h_z = a_h[st][2]
         # A change of stance changes the anchor of Eq. 10 (the fraction between the feet, or the stance foot); the
         # operator's and the character's feet are never placed exactly alike, so the targets would jump. The jump
         # is taken up as an offset that decays with ANCHOR_BLEND_S.
-        if ch_state is not self._anchor_stance and self._last_xy is not None:
+        if anchor is not self._anchor_stance and self._last_xy is not None:
             self._anchor_offset += self._last_xy - np.stack([pelvis_xy[:2], com_xy[:2]])
-        self._anchor_stance = ch_state
+        self._anchor_stance = anchor
         self._anchor_offset *= np.exp(-self.dt_s / ANCHOR_BLEND_S)
         pelvis_xy = np.array([*(pelvis_xy[:2] + self._anchor_offset[0]), 0.0])
         com_xy = np.array([*(com_xy[:2] + self._anchor_offset[1]), 0.0])
@@ -156,12 +185,20 @@ class MotionOptimizer:
         # The operator's COM height reflects his own mass distribution, not the character's: the vertical is left
         # to the pelvis height (Eq. 9) through the leg IK, and the COM target keeps the character's own height.
         com_d = np.array([com_xy[0], com_xy[1], com_c[2]])
+        # The desired COM velocity is the rate of change of this target (smoothed), not the operator's own COM
+        # velocity scaled: the two differ whenever the feet the target is anchored on differ (a foot the operator
+        # slides or places elsewhere), and a velocity target that disagrees with the position target drives the
+        # COM past it.
+        if self._prev_com_d is not None:
+            v = (com_d - self._prev_com_d) / self.dt_s
+            self._com_vel_d += _VELOCITY_SMOOTHING * (v - self._com_vel_d)
+        self._prev_com_d = com_d.copy()
+        com_vel_d = self._com_vel_d.copy()
+        com_vel_d[2] = 0.0
         if self._prev_com_h is not None:
             v = (com_h - self._prev_com_h) / self.dt_s
-            self._com_vel_h += 0.2 * (v - self._com_vel_h)
+            self._com_vel_h += _VELOCITY_SMOOTHING * (v - self._com_vel_h)
         self._prev_com_h = com_h.copy()
-        com_vel_d = scale * self._com_vel_h
-        com_vel_d[2] = 0.0
 
         # Leg IK in the motion plane N, feet flat (Sec. 5.3) and the balance strategy (Sec. 5.4).
         weights = stance_weights(ch_state, self._ds_left_share(com_c, a_c))
@@ -170,22 +207,38 @@ class MotionOptimizer:
         knee_angle: dict[str, float] = {}
         step_exceeded = False
         q_cur = state.joint_pos
-        for side, sign in (("left", 1.0), ("right", -1.0)):
-            hip_w = pelvis_d + R_root_d @ np.array([0.0, sign * HIP_HALF_WIDTH_M, 0.0])
-            q_root_frame = q_root_d
-            if side == sw:
-                # The swing leg is solved from where its hip actually is (as SIMBICON's world-frame swing hip):
-                # solved from the desired pelvis, a pelvis a little low or tilted would drive the foot into the
-                # ground and lift the body off its stance foot.
-                hip_w = state.link_origin_world[_LINK[f"{side}_hip"]].copy()
-                q_root_frame = state.root_quat_wxyz
-            N = features.N_l if side == "left" else features.N_r
+        # Foot targets: a planted foot where it is, the swing foot where the operator's is.
+        targets: dict[str, np.ndarray] = {}
+        foot_yaw: dict[str, float] = {}
+        for side in ("left", "right"):
             other = "left" if side == "right" else "right"
             if side == sw:
-                # Where the operator's foot is relative to his pelvis, scaled, from the character's actual pelvis
-                # (horizontally): the foot lands relative to the body that has to be caught.
+                # Where the operator's foot is, scaled, relative to the character's body ("pelvis": from its
+                # pelvis as his is from his; no balance feedback, as Sec. 7.2's c_d = c_v = 0), or
+                # ("capture_point") relative to the stance foot as his is to his, corrected as the swing proceeds
+                # by how far the character's capture point (COM + v / ω, ω = sqrt(g / h), the LIPM of Eq. 21)
+                # is from where the operator's, scaled, would put it: a character slower or faster than the
+                # operator steps shorter or further, as far as it needs to stop over its feet (a foot-position
+                # form of Eq. 12's feedback). The correction grows with the swing's progress (its time over the
+                # operator's last swing time): at lift-off the foot is behind the body, and the full correction
+                # would pull it further back.
                 pelvis_now = state.root_pos_world
                 target = np.array([pelvis_now[0], pelvis_now[1], pelvis_d[2]]) + scale * (a_h[side] - p_h)
+                if cfg.swing_placement == "capture_point":
+                    xi_c = com_c + mass.com_velocity(state) * np.sqrt(max(com_c[2], 0.1) / self.g)
+                    h_h = max(com_h[2] - ankle_h_z + ANKLE_HEIGHT_M / scale, 0.1)
+                    xi_h = com_h + self._com_vel_h * np.sqrt(h_h / self.g)
+                    correction = (xi_c - a_c[other]) - scale * (xi_h - a_h[other])
+                    R_h = rot.matrix_from_quat(rot.quat_from_yaw(heading))
+                    land = R_h.T @ (a_c[other] + scale * (a_h[side] - a_h[other]) + correction - xi_c)
+                    land[0] = min(land[0], -cfg.step_behind_capture_point_m)
+                    side_sign = 1.0 if side == "left" else -1.0
+                    land[1] = side_sign * min(max(side_sign * land[1], cfg.step_outside_capture_point_m[0]),
+                                                  cfg.step_outside_capture_point_m[1])
+                    correction = R_h @ land + xi_c - (a_c[other] + scale * (a_h[side] - a_h[other]))
+                    u = min((state.time_s - self._swing_t0_s) / self._op_swing_s, 1.0)
+                    progress = u * u * (3.0 - 2.0 * u)
+                    target[:2] = (a_c[other] + scale * (a_h[side] - a_h[other]) + progress * correction)[:2]
                 target[2] = min(max(target[2], ankle_c_z), ankle_c_z + cfg.max_swing_foot_lift_m)
                 if self.char_fsm.hold_reference:
                     # Late contact (Sec. 5.1): the operator has landed, the character's foot has not. The held
@@ -200,10 +253,42 @@ class MotionOptimizer:
                                    f"step {dist:.2f} m > bound {bound:.2f} m (Eq. 28)")
                 if step_exceeded:
                     target[:2] = a_c[other][:2] + step * (bound / dist)
-                foot_yaw = rot.twist_angle(s.quat[f"ANKLE_{_SIDE_UP[side]}"], _UP)
+                # The swing starts where the foot lifts off: the difference to the first target is taken up over
+                # SWING_BLEND_S (a target jump would swing the leg hard enough to lift the stance foot).
+                if self._swing != side:
+                    self._swing_offset = a_c[side][:2] - target[:2]
+                    self._swing_t0_s = state.time_s
+                self._swing_offset *= np.exp(-self.dt_s / SWING_BLEND_S)
+                target[:2] += self._swing_offset
+                foot_yaw[side] = rot.twist_angle(s.quat[f"ANKLE_{_SIDE_UP[side]}"], _UP)
             else:
                 target = a_plant[side]
-                foot_yaw = rot.twist_angle(state.link_quat_wxyz[_LINK[f"{side}_ankle"]], _UP)
+                foot_yaw[side] = rot.twist_angle(state.link_quat_wxyz[_LINK[f"{side}_ankle"]], _UP)
+            targets[side] = target
+        self._swing = sw
+        # A foot that has to reach the ground and does not touch it yet (a stance foot, or the swing foot held
+        # for a late contact) must be within the leg's reach of its hip: the pelvis is lowered as far as that
+        # needs. With the pelvis at the operator's height (Eq. 9) the legs are nearly straight, and a foot ahead
+        # of the body could otherwise never land.
+        for side, sign in (("left", 1.0), ("right", -1.0)):
+            must_land = weights[side] > 0 or (side == sw and self.char_fsm.hold_reference)
+            if must_land and not contact[side]:
+                hip_xy = (pelvis_d + R_root_d @ np.array([0.0, sign * HIP_HALF_WIDTH_M, 0.0]))[:2]
+                reach = LANDING_REACH * CHAR_LEG_LENGTH_M
+                d2 = float(np.sum((targets[side][:2] - hip_xy) ** 2))
+                pelvis_d[2] = min(pelvis_d[2], targets[side][2] + float(np.sqrt(max(reach * reach - d2, 0.0))))
+        for side, sign in (("left", 1.0), ("right", -1.0)):
+            hip_w = pelvis_d + R_root_d @ np.array([0.0, sign * HIP_HALF_WIDTH_M, 0.0])
+            q_root_frame = q_root_d
+            if side == sw:
+                # The swing leg is solved from where its hip actually is (as SIMBICON's world-frame swing hip):
+                # solved from the desired pelvis, a pelvis a little low or tilted would drive the foot into the
+                # ground and lift the body off its stance foot.
+                hip_w = state.link_origin_world[_LINK[f"{side}_hip"]].copy()
+                q_root_frame = state.root_quat_wxyz
+            N = features.N_l if side == "left" else features.N_r
+            other = "left" if side == "right" else "right"
+            target = targets[side]
             ik = solve_leg(hip_w, target, THIGH_LENGTH_M, SHANK_LENGTH_M, N)
             q_thigh = ik.thigh_quat_wxyz
             if side == sw:
@@ -215,11 +300,14 @@ class MotionOptimizer:
                 q_hip = stance_hip_blend(q_hip, q_hip_cur, cfg.stance_hip_weight_w0)  # Eq. 11
             local[f"{side}_hip"] = q_hip
             knee_angle[f"{side}_knee"] = ik.knee_angle_rad
-            q_foot = rot.quat_from_yaw(foot_yaw)
-            # Feet flat (Sec. 5.3) on the IK's shank, which keeps the ankles' stiffness against leaning. The twist
-            # about the shank's long axis is left where it is: a difference between the IK's and the actual
-            # shank twist would otherwise twist a planted foot against its sole's friction and spin it.
-            q_ankle_ik = rot.multiply(rot.conjugate(ik.shank_quat_wxyz), q_foot)
+            q_foot = rot.quat_from_yaw(foot_yaw[side])
+            # Feet flat (Sec. 5.3). A planted foot on the IK's shank, which keeps the ankles' stiffness against
+            # leaning; the swing foot on the actual shank, so that it is flat in the world whatever the swing leg's
+            # tracking error, and lands on its sole rather than an edge it would roll over. The twist about the
+            # shank's long axis is left where it is: a difference between the IK's and the actual shank twist
+            # would otherwise twist a planted foot against its sole's friction and spin it.
+            shank = state.link_quat_wxyz[_LINK[f"{side}_knee"]] if side == sw else ik.shank_quat_wxyz
+            q_ankle_ik = rot.multiply(rot.conjugate(shank), q_foot)
             swing_ik, _ = rot.swing_twist(q_ankle_ik, _UP)
             _, twist_now = rot.swing_twist(canonical_quat_from_model(q_cur[JOINT_NAMES.index(f"{side}_ankle")]), _UP)
             local[f"{side}_ankle"] = rot.multiply(swing_ik, twist_now)

@@ -23,19 +23,45 @@ from stylesync.sources.human_model import HumanModel
 from stylesync.sources.sensor_model import SensorModel
 
 STAND_CLIP = "stand"  # an operator standing still, for balance checks
+_RAMP_GRID_HZ = 240.0  # grid of the ramped pelvis path's integral
 
 
 class ClipPerformer:
     """Noise-free operator frames of a human skeleton playing a clip."""
 
     def __init__(self, clip: DeepMimicClip | None, human: HumanModel, lead_in_s: float = 0.0,
-                 blend_s: float = 0.5):
+                 blend_s: float = 0.5, start_ramp_s: float = 0.0):
         self.clip = clip
         self.human = human
         self.lead_in_s = lead_in_s
-        self.blend_s = min(blend_s, lead_in_s)
         self.leg_ratio = (human.hip_height_m) / CLIP_CHARACTER_LEG_LENGTH_M
+        self.start_ramp_s = start_ramp_s if clip is not None and clip.loop else 0.0
+        self.blend_s = 0.0 if self.start_ramp_s > 0 else min(blend_s, lead_in_s)
         self._stand_root, self._stand_quats = self._standing()
+        if self.start_ramp_s > 0:  # ∫_0^s (p_clip(s') - p_clip(0)) ds' on a fine grid, for the ramped pelvis path
+            self._ramp_t = np.linspace(0.0, self.start_ramp_s, int(self.start_ramp_s * _RAMP_GRID_HZ) + 2)
+            p = np.array([self._clip_root(t) for t in self._ramp_t]) - self._clip_root(0.0)
+            steps = 0.5 * (p[1:] + p[:-1]) * np.diff(self._ramp_t)[:, None]
+            self._ramp_integral = np.vstack([np.zeros(3), np.cumsum(steps, axis=0)])
+
+    def _clip_root(self, t_s: float) -> np.ndarray:
+        assert self.clip is not None
+        return self.clip.pose_at(t_s).root_pos_world * self.leg_ratio
+
+    def _ramped(self, u_s: float) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+        """Pelvis position and joint rotations ``u_s`` [s] into a looping clip started from standing (see the
+        module): weight a = u / ramp; pelvis = p_0 + a (p(u) - p(0)) - (1/ramp) ∫_0^u (p - p(0)), which is
+        p_0 + ∫_0^u a ṗ by parts."""
+        assert self.clip is not None
+        ramp = self.start_ramp_s
+        a = min(u_s / ramp, 1.0)
+        pose = self.clip.pose_at(u_s)
+        p0 = self._clip_root(0.0)
+        integral = np.array([np.interp(min(u_s, ramp), self._ramp_t, self._ramp_integral[:, k]) for k in range(3)])
+        root = self._stand_root + a * (pose.root_pos_world * self.leg_ratio - p0) - integral / ramp
+        root[2] = (1 - a) * self._stand_root[2] + a * pose.root_pos_world[2] * self.leg_ratio
+        stand = self._stand_quats
+        return root, {k: rot.slerp(stand.get(k, rot.IDENTITY_WXYZ), q, a) for k, q in pose.local_quats.items()}
 
     def _standing(self) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """Neutral standing pose where the clip starts, facing its first heading."""
@@ -50,6 +76,8 @@ class ClipPerformer:
         stand_root, stand_quats = self._stand_root, self._stand_quats
         if self.clip is None or t_s < self.lead_in_s - self.blend_s:
             return self.human.frame_from_pose(t_s, stand_root, stand_quats)
+        if self.start_ramp_s > 0:
+            return self.human.frame_from_pose(t_s, *self._ramped(t_s - self.lead_in_s))
         pose = self.clip.pose_at(max(0.0, t_s - self.lead_in_s))
         root = pose.root_pos_world * self.leg_ratio
         if t_s < self.lead_in_s:  # blend from standing into the clip's first pose
@@ -72,6 +100,6 @@ def builtin_operator(
 ) -> tuple[RecordedSource, ClipPerformer]:
     clip = None if operator.clip == STAND_CLIP else DeepMimicClip.builtin(operator.clip)
     human = HumanModel(operator.height_m, operator.mass_kg)
-    performer = ClipPerformer(clip, human, operator.standing_lead_in_s)
+    performer = ClipPerformer(clip, human, operator.standing_lead_in_s, start_ramp_s=operator.start_ramp_s)
     return sensed(performer.frame_at, operator, clocks, duration_s, seed, f"builtin:{operator.clip}"), performer
 
