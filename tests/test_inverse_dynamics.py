@@ -87,3 +87,33 @@ def test_standing_character_bears_arm_waving_and_a_squat():
     squat = squat_jump.run_one("squat", 1.75, seed=0)
     assert not squat.fell, squat.fall_reason
     assert squat.log.array("char_state")[-1] == STANCE_CODE[Stance.DS]
+
+
+def test_desired_horizontal_force_is_limited_to_what_the_soles_can_give():
+    """Eq. 21's pendulum: a COM above the middle of the support may be pushed either way, by at most
+    m g / h times the distance to the support's (margined) edge plus the angular-momentum allowance; a COM
+    behind the heels can be brought back only by that allowance; the vertical force is untouched."""
+    from stylesync.control.contact_forces import (
+        COP_MARGIN,
+        MOMENTUM_ACCEL_ALLOWANCE_MPS2,
+        feasible_horizontal_force,
+    )
+
+    corners = {"left": sole_corners_world(np.array([0.0, 0.1, ANKLE_HEIGHT_M]), rot.IDENTITY_WXYZ),
+               "right": sole_corners_world(np.array([0.0, -0.1, ANKLE_HEIGHT_M]), rot.IDENTITY_WXYZ)}
+    pts = np.concatenate(list(corners.values()))
+    lo, hi = pts[:, 0].min(), pts[:, 0].max()
+    mid, half = 0.5 * (lo + hi), 0.5 * COP_MARGIN * (hi - lo)
+    m, g, h = 45.0, 9.8, 0.9
+    com = np.array([mid, 0.0, h])
+    big = np.array([1000.0, 0.0, 441.0])
+    f = feasible_horizontal_force(big, com, corners, m, g)
+    assert f[0] == pytest.approx(m * g / h * half + m * MOMENTUM_ACCEL_ALLOWANCE_MPS2)
+    assert f[2] == 441.0
+    f_back = feasible_horizontal_force(-big, com, corners, m, g)
+    assert f_back[0] == pytest.approx(-f[0])
+    small = np.array([5.0, -3.0, 441.0])
+    assert np.allclose(feasible_horizontal_force(small, com, corners, m, g), small)
+    behind = np.array([lo - 0.2, 0.0, h])  # behind the heels: forwards, only the allowance
+    f_out = feasible_horizontal_force(big, behind, corners, m, g)
+    assert f_out[0] == pytest.approx(m * MOMENTUM_ACCEL_ALLOWANCE_MPS2)

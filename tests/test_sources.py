@@ -33,3 +33,30 @@ def test_builtin_walk_loads_and_loops():
     clip = DeepMimicClip.builtin("walk")
     a, b = clip.pose_at(0.2), clip.pose_at(0.2 + clip.duration_s)
     assert np.linalg.norm((b.root_pos_world - a.root_pos_world)[:2]) > 0.5
+
+
+def test_builtin_walk_starts_from_standing_and_reaches_the_clip_speed():
+    """The looping walk starts from standing: no pelvis jump at the end of the lead-in, a speed that grows over the
+    start ramp, and after it the clip's own pelvis velocity."""
+    from stylesync.config import ClockConfig, OperatorConfig
+    from stylesync.sources.builtin_operator import builtin_operator
+    from stylesync.sources.frame import JOINT_INDEX
+
+    op = OperatorConfig()
+    _, performer = builtin_operator(op, ClockConfig(), 1.0, 0)
+    pelvis = JOINT_INDEX["PELVIS"]
+
+    def pos(t):
+        return performer.frame_at(t).joint_pos_world[pelvis]
+
+    def speed(t):
+        return float(np.linalg.norm((pos(t + 0.01) - pos(t))[:2]) / 0.01)
+
+    start = op.standing_lead_in_s
+    assert np.linalg.norm(pos(start - 0.01) - pos(start + 0.01)) < 1e-3
+    assert speed(start + 0.05) < 0.1 < speed(start + 0.6) < speed(start + op.start_ramp_s + 0.5)
+    clip = performer.clip
+    t_after = start + op.start_ramp_s + 0.5
+    clip_v = (clip.pose_at(t_after - start + 0.01).root_pos_world - clip.pose_at(t_after - start).root_pos_world)
+    v_clip = float(np.linalg.norm(clip_v[:2]) / 0.01) * performer.leg_ratio
+    assert speed(t_after) == pytest.approx(v_clip, rel=1e-6)
