@@ -9,7 +9,8 @@ Per control tick, from the smoothed operator sample and the character's current 
    pelvis keeps the operator's scaled offset from the stance ankle. The desired COM (Eq. 19) is mapped the same
    way;
 3. leg IK in the motion plane N of each leg (unique 2D solution), stance feet where they are, the swing foot
-   where the operator's is (scaled, relative to the pelvis), its step length bounded by Eq. 28;
+   where the operator's is (scaled, relative to his stance foot, corrected towards the character's capture point;
+   or relative to the pelvis), its step length bounded by Eq. 28;
 4. feet flat, heading from the operator's foot (twist T) for the swing foot, current heading for a planted foot;
 5. balance strategy (Sec. 5.4): level root with heading H, Eq. 11 on the stance hips, Eq. 12 on the swing hip.
 """
@@ -85,6 +86,21 @@ def _heading_frame_fraction(p_h, al_h, ar_h, al_c, ar_c, scale: float, heading: 
     return R @ out
 
 
+class _SmoothedRate:
+    """Rate of change of a sampled vector: finite difference, exponentially averaged (_VELOCITY_SMOOTHING)."""
+
+    def __init__(self, dt_s: float):
+        self.dt_s = dt_s
+        self._prev: np.ndarray | None = None
+        self._rate = np.zeros(3)
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        if self._prev is not None:
+            self._rate += _VELOCITY_SMOOTHING * ((x - self._prev) / self.dt_s - self._rate)
+        self._prev = np.array(x, dtype=float)
+        return self._rate.copy()
+
+
 class MotionOptimizer:
     def __init__(self, cfg: MotionConfig, control_hz: float, bounds: BoundsMonitor | None = None,
                  gravity_mps2: float = 9.8):
@@ -96,10 +112,8 @@ class MotionOptimizer:
         self.op_style = StyleExtractor()
         self._op_leg_m: float | None = None
         self._held: OperatorSample | None = None
-        self._prev_com_d: np.ndarray | None = None
-        self._com_vel_d = np.zeros(3)
-        self._prev_com_h: np.ndarray | None = None
-        self._com_vel_h = np.zeros(3)  # operator COM velocity, smoothed [m/s]
+        self._com_d_rate = _SmoothedRate(self.dt_s)  # desired COM velocity [m/s]
+        self._com_h_rate = _SmoothedRate(self.dt_s)  # operator COM velocity [m/s]
         self.bounds = bounds if bounds is not None else BoundsMonitor()
         self._anchor_stance: Stance | None = None
         self._anchor_offset = np.zeros((2, 2))  # (pelvis, COM) x (x, y) [m]
@@ -189,16 +203,9 @@ class MotionOptimizer:
         # velocity scaled: the two differ whenever the feet the target is anchored on differ (a foot the operator
         # slides or places elsewhere), and a velocity target that disagrees with the position target drives the
         # COM past it.
-        if self._prev_com_d is not None:
-            v = (com_d - self._prev_com_d) / self.dt_s
-            self._com_vel_d += _VELOCITY_SMOOTHING * (v - self._com_vel_d)
-        self._prev_com_d = com_d.copy()
-        com_vel_d = self._com_vel_d.copy()
+        com_vel_d = self._com_d_rate(com_d)
         com_vel_d[2] = 0.0
-        if self._prev_com_h is not None:
-            v = (com_h - self._prev_com_h) / self.dt_s
-            self._com_vel_h += _VELOCITY_SMOOTHING * (v - self._com_vel_h)
-        self._prev_com_h = com_h.copy()
+        com_vel_h = self._com_h_rate(com_h)
 
         # Leg IK in the motion plane N, feet flat (Sec. 5.3) and the balance strategy (Sec. 5.4).
         weights = stance_weights(ch_state, self._ds_left_share(com_c, a_c))
@@ -227,7 +234,7 @@ class MotionOptimizer:
                 if cfg.swing_placement == "capture_point":
                     xi_c = com_c + mass.com_velocity(state) * np.sqrt(max(com_c[2], 0.1) / self.g)
                     h_h = max(com_h[2] - ankle_h_z + ANKLE_HEIGHT_M / scale, 0.1)
-                    xi_h = com_h + self._com_vel_h * np.sqrt(h_h / self.g)
+                    xi_h = com_h + com_vel_h * np.sqrt(h_h / self.g)
                     correction = (xi_c - a_c[other]) - scale * (xi_h - a_h[other])
                     R_h = rot.matrix_from_quat(rot.quat_from_yaw(heading))
                     land = R_h.T @ (a_c[other] + scale * (a_h[side] - a_h[other]) + correction - xi_c)
