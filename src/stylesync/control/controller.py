@@ -10,6 +10,7 @@ stable if held for 4.5 physics steps, then clamps to the joint torque limits.
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from dataclasses import dataclass
 
 import numpy as np
@@ -61,7 +62,7 @@ def supporting_weights(stance_weight: dict[str, float], foot_force_n: dict[str, 
     return {s: v / total for s, v in w.items()} if total > 0 else w
 
 
-class ControllerBase:
+class ControllerBase(ABC):
     """What every realisation of the Sec. 6 controller shares: its configuration, the character's mass, the
     movement-bounds monitor, telemetry, and the reference's joint velocity (from successive control ticks).
 
@@ -81,13 +82,15 @@ class ControllerBase:
         self._prev_ref_pos: np.ndarray | None = None
         self._ref_vel = np.zeros((len(JOINTS), 3))
 
+    @abstractmethod
     def update(self, state: CharacterState, ref: ReferencePose, mass_matrix: np.ndarray) -> None:
-        raise NotImplementedError
+        """One control tick: read the state and the reference, prepare the torques."""
 
+    @abstractmethod
     def torques(self, fb: JointFeedback) -> Torques:
-        raise NotImplementedError
+        """The joint torques for this physics step [N·m]."""
 
-    def reset(self) -> None:
+    def reset(self) -> None:  # noqa: B027 (an optional hook: controllers without accumulated state keep it)
         """Forget accumulated state (integral terms) when the character is stood up again."""
 
     def _update_reference_velocity(self, ref: ReferencePose) -> None:

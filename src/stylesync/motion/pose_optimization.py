@@ -222,30 +222,29 @@ class MotionOptimizer:
             if side == sw:
                 # Where the operator's foot is, scaled, relative to the character's body ("pelvis": from its
                 # pelvis as his is from his; no balance feedback, as Sec. 7.2's c_d = c_v = 0), or
-                # ("capture_point") relative to the stance foot as his is to his, corrected as the swing proceeds
-                # by how far the character's capture point (COM + v / ω, ω = sqrt(g / h), the LIPM of Eq. 21)
-                # is from where the operator's, scaled, would put it: a character slower or faster than the
-                # operator steps shorter or further, as far as it needs to stop over its feet (a foot-position
-                # form of Eq. 12's feedback). The correction grows with the swing's progress (its time over the
-                # operator's last swing time): at lift-off the foot is behind the body, and the full correction
-                # would pull it further back.
-                pelvis_now = state.root_pos_world
-                target = np.array([pelvis_now[0], pelvis_now[1], pelvis_d[2]]) + scale * (a_h[side] - p_h)
+                # ("capture_point") relative to the stance foot as his is to his, moved as the swing proceeds
+                # towards where the foot lands relative to the character's capture point (COM + v / ω,
+                # ω = sqrt(g / h), the LIPM of Eq. 21) as his does relative to his, within the landing limits:
+                # a character slower or faster than the operator steps shorter or further, as far as it needs to
+                # stop over its feet (a foot-position form of Eq. 12's feedback). The move grows with the swing's
+                # progress (its time over the operator's last swing time): at lift-off the foot is behind the
+                # body, and the full move would pull it further back.
+                target = pelvis_d + scale * (a_h[side] - p_h)
                 if cfg.swing_placement == "capture_point":
+                    from_stance = a_c[other] + scale * (a_h[side] - a_h[other])
                     xi_c = com_c + mass.com_velocity(state) * np.sqrt(max(com_c[2], 0.1) / self.g)
                     h_h = max(com_h[2] - ankle_h_z + ANKLE_HEIGHT_M / scale, 0.1)
                     xi_h = com_h + com_vel_h * np.sqrt(h_h / self.g)
-                    correction = (xi_c - a_c[other]) - scale * (xi_h - a_h[other])
-                    R_h = rot.matrix_from_quat(rot.quat_from_yaw(heading))
-                    land = R_h.T @ (a_c[other] + scale * (a_h[side] - a_h[other]) + correction - xi_c)
+                    land = R_root_d.T @ (scale * (a_h[side] - xi_h))  # heading frame, from the capture point
                     land[0] = min(land[0], -cfg.step_behind_capture_point_m)
-                    side_sign = 1.0 if side == "left" else -1.0
-                    land[1] = side_sign * min(max(side_sign * land[1], cfg.step_outside_capture_point_m[0]),
-                                                  cfg.step_outside_capture_point_m[1])
-                    correction = R_h @ land + xi_c - (a_c[other] + scale * (a_h[side] - a_h[other]))
+                    out = 1.0 if side == "left" else -1.0
+                    land[1] = out * min(max(out * land[1], cfg.step_outside_capture_point_m[0]),
+                                        cfg.step_outside_capture_point_m[1])
                     u = min((state.time_s - self._swing_t0_s) / self._op_swing_s, 1.0)
                     progress = u * u * (3.0 - 2.0 * u)
-                    target[:2] = (a_c[other] + scale * (a_h[side] - a_h[other]) + progress * correction)[:2]
+                    target[:2] = (from_stance + progress * (xi_c + R_root_d @ land - from_stance))[:2]
+                else:
+                    target[:2] = (state.root_pos_world + scale * (a_h[side] - p_h))[:2]
                 target[2] = min(max(target[2], ankle_c_z), ankle_c_z + cfg.max_swing_foot_lift_m)
                 if self.char_fsm.hold_reference:
                     # Late contact (Sec. 5.1): the operator has landed, the character's foot has not. The held

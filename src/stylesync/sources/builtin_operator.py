@@ -40,7 +40,8 @@ class ClipPerformer:
         self._stand_root, self._stand_quats = self._standing()
         if self.start_ramp_s > 0:  # ∫_0^s (p_clip(s') - p_clip(0)) ds' on a fine grid, for the ramped pelvis path
             self._ramp_t = np.linspace(0.0, self.start_ramp_s, int(self.start_ramp_s * _RAMP_GRID_HZ) + 2)
-            p = np.array([self._clip_root(t) for t in self._ramp_t]) - self._clip_root(0.0)
+            self._clip_root_0 = self._clip_root(0.0)
+            p = np.array([self._clip_root(t) for t in self._ramp_t]) - self._clip_root_0
             steps = 0.5 * (p[1:] + p[:-1]) * np.diff(self._ramp_t)[:, None]
             self._ramp_integral = np.vstack([np.zeros(3), np.cumsum(steps, axis=0)])
 
@@ -56,9 +57,8 @@ class ClipPerformer:
         ramp = self.start_ramp_s
         a = min(u_s / ramp, 1.0)
         pose = self.clip.pose_at(u_s)
-        p0 = self._clip_root(0.0)
         integral = np.array([np.interp(min(u_s, ramp), self._ramp_t, self._ramp_integral[:, k]) for k in range(3)])
-        root = self._stand_root + a * (pose.root_pos_world * self.leg_ratio - p0) - integral / ramp
+        root = self._stand_root + a * (pose.root_pos_world * self.leg_ratio - self._clip_root_0) - integral / ramp
         root[2] = (1 - a) * self._stand_root[2] + a * pose.root_pos_world[2] * self.leg_ratio
         stand = self._stand_quats
         return root, {k: rot.slerp(stand.get(k, rot.IDENTITY_WXYZ), q, a) for k, q in pose.local_quats.items()}
