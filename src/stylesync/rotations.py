@@ -235,6 +235,28 @@ def batch_rotvec(q: Array) -> Array:
     return v * scale[:, None]
 
 
+def batch_quat_from_rotvec(v: Array) -> Array:
+    """Exp map of each row, (n, 3) [rad] -> (n, 4)."""
+    angle = np.linalg.norm(v, axis=1)
+    half = 0.5 * angle
+    # sin(θ/2)/θ, and its limit 1/2 at θ = 0
+    k = np.where(angle > 1e-12, np.sin(half) / np.maximum(angle, 1e-12), 0.5)
+    return np.column_stack([np.cos(half), v * k[:, None]])
+
+
+def batch_align_sign(q: Array, reference: Array) -> Array:
+    """Each row of q or its negative, whichever is closer to the same row of ``reference``."""
+    return np.where(np.einsum("ij,ij->i", q, reference)[:, None] < 0, -q, q)
+
+
+def batch_slerp(q0: Array, q1: Array, t: float) -> Array:
+    """:func:`slerp` of each row, (n, 4)."""
+    q1 = batch_align_sign(q1, q0)
+    d = batch_multiply(batch_conjugate(q0), q1)
+    q = batch_multiply(q0, batch_quat_from_rotvec(t * batch_rotvec(d)))
+    return q / np.linalg.norm(q, axis=1, keepdims=True)
+
+
 def batch_matrix_from_quat(q: Array) -> Array:
     """Rotation matrices of each row, (n, 4) -> (n, 3, 3)."""
     w, x, y, z = q[:, 0], q[:, 1], q[:, 2], q[:, 3]

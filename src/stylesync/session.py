@@ -205,7 +205,7 @@ class Session:
                 if progress is not None:
                     progress(t, time.perf_counter() - wall0)
             p0 = time.perf_counter()
-            fb = self.backend.read_joint_feedback()
+            fb = self.backend.read_joint_feedback() if self.controller.needs_joint_feedback else None
             torques = self.controller.torques(fb)
             self.last_torques = torques.values
             self.backend.apply_torques(torques)

@@ -86,9 +86,13 @@ class ControllerBase(ABC):
     def update(self, state: CharacterState, ref: ReferencePose, mass_matrix: np.ndarray) -> None:
         """One control tick: read the state and the reference, prepare the torques."""
 
+    # Whether ``torques`` reads the joints' state at each physics step; a controller that holds its torques from
+    # one control tick to the next does not, and the joint state is then not read between ticks.
+    needs_joint_feedback = True
+
     @abstractmethod
-    def torques(self, fb: JointFeedback) -> Torques:
-        """The joint torques for this physics step [N·m]."""
+    def torques(self, fb: JointFeedback | None) -> Torques:
+        """The joint torques for this physics step [N·m]; ``fb`` is None unless ``needs_joint_feedback``."""
 
     def reset(self) -> None:  # noqa: B027 (an optional hook: controllers without accumulated state keep it)
         """Forget accumulated state (integral terms) when the character is stood up again."""
@@ -191,9 +195,9 @@ class BalanceController(ControllerBase):
     def reset(self) -> None:
         self.pid.reset()
 
-    def torques(self, fb: JointFeedback) -> Torques:
+    def torques(self, fb: JointFeedback | None) -> Torques:
         ref = self._ref
-        if ref is None:
+        if ref is None or fb is None:
             return Torques.zeros()
         # Eq. 13 feedback r, evaluated implicitly (stable_pd.py): position error predicted one step ahead.
         r = self.pid(fb.joint_pos, fb.joint_vel, ref.joint_pos, self._ref_vel, predict_dt_s=self.physics_dt_s)

@@ -56,11 +56,25 @@ class FloatingJacobians:
 
     def point_linear(self, link: int, p_world: np.ndarray) -> np.ndarray:
         """(3, N_DOFS) Jacobian of the world velocity of point ``p_world`` fixed on link ``link``."""
-        j = np.zeros((3, N_DOFS))
-        j[:, :3] = np.eye(3)
-        j[:, 3:6] = -_skew(p_world - self.root_world)
-        m = MOVES[link]
-        j[:, ROOT_DOFS:][:, m] = rot.cross(self.axis_world[m], p_world[None, :] - self.origin_world[m]).T
+        return self.points_linear(link, np.asarray(p_world, dtype=float)[None, :])[0]
+
+    def points_linear(self, link: int, p_world: np.ndarray) -> np.ndarray:
+        """(n, 3, N_DOFS) Jacobians of the world velocities of points ``p_world`` (n, 3) fixed on link ``link``."""
+        n = p_world.shape[0]
+        j = np.zeros((n, 3, N_DOFS))
+        j[:, :, :3] = np.eye(3)
+        r = p_world - self.root_world  # ω_root × r = -[r]× ω_root
+        j[:, 0, 4], j[:, 0, 5] = r[:, 2], -r[:, 1]
+        j[:, 1, 3], j[:, 1, 5] = -r[:, 2], r[:, 0]
+        j[:, 2, 3], j[:, 2, 4] = r[:, 1], -r[:, 0]
+        m = np.flatnonzero(MOVES[link])
+        axes, origins = self.axis_world[m], self.origin_world[m]  # (k, 3)
+        lx, ly, lz = (p_world[:, None, i] - origins[None, :, i] for i in range(3))  # lever arms, (n, k) each
+        ax, ay, az = axes[:, 0], axes[:, 1], axes[:, 2]
+        cols = ROOT_DOFS + m
+        j[:, 0, cols] = ay * lz - az * ly  # a_d × (p - o_d)
+        j[:, 1, cols] = az * lx - ax * lz
+        j[:, 2, cols] = ax * ly - ay * lx
         return j
 
     def angular(self, link: int) -> np.ndarray:

@@ -42,7 +42,7 @@ from stylesync.control.stable_pd import N_DOFS, flatten_joint_values, unflatten_
 from stylesync.motion.reference import ReferencePose
 from stylesync.motion.stance_fsm import swing_side
 from stylesync.sim.backend import CharacterState, JointFeedback, MassProperties, Torques
-from stylesync.sim.character import ANKLE_HEIGHT_M, JOINTS, LINK_NAMES
+from stylesync.sim.character import ANKLE_HEIGHT_M, LINK_NAMES
 
 _FOOT_LINK = {s: LINK_NAMES.index(f"{s}_ankle") for s in ("left", "right")}
 GROUND_PRESS_M = 0.02  # a stance foot not yet touching is aimed this far below the ground [m]
@@ -53,7 +53,7 @@ class MomentumBalanceController(ControllerBase):
     def __init__(self, cfg: ControlConfig, mass: MassProperties, gravity_mps2: float, physics_dt_s: float,
                  control_dt_s: float, bounds: bnd.BoundsMonitor | None = None, friction: float = 0.9):
         super().__init__(cfg, mass, gravity_mps2, physics_dt_s, control_dt_s, bounds, friction)
-        self._tau = np.zeros((len(JOINTS), 3))  # held from one control tick to the next [N·m]
+        self._tau = Torques.zeros()  # held from one control tick to the next [N·m]
 
     def update(self, state: CharacterState, ref: ReferencePose, mass_matrix: np.ndarray) -> None:
         cfg = self.cfg
@@ -129,8 +129,8 @@ class MomentumBalanceController(ControllerBase):
             cols = []
             for side, pts in corners.items():
                 link = _FOOT_LINK[side]
-                for p in pts:  # B's columns: J(p_c)^T β_e, corner by corner (contact_forces.wrench_basis's order)
-                    cols.append(jac.point_linear(link, p).T @ edges.T)
+                # B's columns: J(p_c)^T β_e, corner by corner, edge by edge (contact_forces.wrench_basis's order)
+                cols.append(np.einsum("cjd,ej->dce", jac.points_linear(link, pts), edges).reshape(N_DOFS, -1))
                 contact_rows += [jac.point_linear(link, pts.mean(axis=0)), jac.angular(link)]
             b_force = np.hstack(cols)
         j_c = np.vstack(contact_rows) if contact_rows else np.zeros((0, N_DOFS))
@@ -143,8 +143,10 @@ class MomentumBalanceController(ControllerBase):
             np.array(task_rows).reshape(-1, N_DOFS), np.array(task_acc), FOOT_TASK_WEIGHT)
         tau = unflatten_joint_values(joint_torques(mass_matrix, bias, b_force @ lam, qdd))
         tau[~IS_BALL, 1:] = 0.0
-        self._tau = np.clip(tau, -TORQUE_LIMIT, TORQUE_LIMIT)
+        self._tau = Torques(np.clip(tau, -TORQUE_LIMIT, TORQUE_LIMIT))
         self.telemetry = ControlTelemetry(force, f_lipm, moment)
 
-    def torques(self, fb: JointFeedback) -> Torques:
-        return Torques(self._tau)
+    needs_joint_feedback = False
+
+    def torques(self, fb: JointFeedback | None) -> Torques:
+        return self._tau

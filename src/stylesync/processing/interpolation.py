@@ -61,7 +61,7 @@ class SlerpRamp:
         if self._out is None:
             self._out = ref.copy()
         self._start = self._out.copy()
-        self._target = np.array([rot.align_sign(r, s) for r, s in zip(ref, self._start, strict=True)])
+        self._target = rot.batch_align_sign(ref, self._start)
         self._i = 0
 
     def step(self) -> np.ndarray:
@@ -69,5 +69,5 @@ class SlerpRamp:
             raise ValueError("SlerpRamp.step() before the first push()")
         self._i += 1
         frac = min(self.k * self._i, 1.0)
-        self._out = np.array([rot.slerp(a, b, frac) for a, b in zip(self._start, self._target, strict=True)])
+        self._out = rot.batch_slerp(self._start, self._target, frac)
         return self._out.copy()

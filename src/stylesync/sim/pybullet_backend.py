@@ -101,6 +101,8 @@ class PyBulletBackend(PhysicsBackend):
         self._link_idx = [index_by_name[n] for n in LINK_NAMES]
         self._foot_idx = {index_by_name[n]: n for n in FOOT_LINKS}
         self._is_ball = np.array([j.kind is JointKind.BALL for j in JOINTS])
+        self._last_torque_values: np.ndarray | None = None  # the last torques applied, and their PyBullet form
+        self._last_forces: list[list[float]] = []
         for j, spec in zip(self._joint_idx, JOINTS, strict=True):
             if spec.kind is JointKind.BALL:
                 c.setJointMotorControlMultiDof(
@@ -177,14 +179,15 @@ class PyBulletBackend(PhysicsBackend):
         com = np.empty((n, 3))
         com_vel = np.empty((n, 3))
         origin = np.empty((n, 3))
-        quat = np.empty((n, 4))
+        quat_xyzw = np.empty((n, 4))
         ang = np.empty((n, 3))
         for i, ls in enumerate(links):
             com[i] = ls[0]
             origin[i] = ls[4]
-            quat[i] = _canonical_from_link_xyzw(ls[5])
+            quat_xyzw[i] = ls[5]
             com_vel[i] = ls[6]
             ang[i] = ls[7]
+        quat = rot.batch_multiply(quat_xyzw[:, [3, 0, 1, 2]], np.broadcast_to(_Q_MODEL_WORLD, (n, 4)))
         foot_force = {name: 0.0 for name in FOOT_LINKS}
         non_foot = False
         for cp in c.getContactPoints(bodyA=self.body, bodyB=self.plane):
@@ -230,9 +233,14 @@ class PyBulletBackend(PhysicsBackend):
 
     def apply_torques(self, torques: Torques) -> None:
         v = torques.values
-        if not np.all(np.isfinite(v)):
-            raise SimulationError("non-finite joint torque requested; refusing to drive the character with it")
-        forces = [list(v[k]) if self._is_ball[k] else [float(v[k, 0])] for k in range(len(self._joint_idx))]
+        if v is self._last_torque_values:  # the same torques as the last step (held over a control tick)
+            forces = self._last_forces
+        else:
+            if not np.all(np.isfinite(v)):
+                raise SimulationError("non-finite joint torque requested; refusing to drive the character with it")
+            rows = v.tolist()
+            forces = [rows[k] if self._is_ball[k] else [rows[k][0]] for k in range(len(self._joint_idx))]
+            self._last_torque_values, self._last_forces = v, forces
         self._pb.setJointMotorControlMultiDofArray(self.body, self._joint_idx, pb.TORQUE_CONTROL, forces=forces)
 
     def joint_space_inertia(self) -> np.ndarray:
