@@ -5,7 +5,13 @@ import pytest
 
 from stylesync import rotations as rot
 from stylesync.config import WorldConfig
-from stylesync.control.contact_forces import pyramid_edges, sole_corners_world, wrench_basis
+from stylesync.control.contact_forces import (
+    SOLE_CONTACT_GAP_M,
+    pyramid_edges,
+    sole_corners_world,
+    sole_touches,
+    wrench_basis,
+)
 from stylesync.control.floating_jacobian import FloatingJacobians
 from stylesync.control.jacobian_transpose import JointFrames
 from stylesync.control.stable_pd import flatten_joint_values
@@ -117,3 +123,15 @@ def test_desired_horizontal_force_is_limited_to_what_the_soles_can_give():
     behind = np.array([lo - 0.2, 0.0, h])  # behind the heels: forwards, only the allowance
     f_out = feasible_horizontal_force(big, behind, corners, m, g)
     assert f_out[0] == pytest.approx(m * MOMENTUM_ACCEL_ALLOWANCE_MPS2)
+
+
+def test_a_planted_sole_just_unloaded_still_supports_and_a_lifted_one_does_not():
+    flat = rot.IDENTITY_WXYZ
+    on_ground = np.array([0.0, 0.0, ANKLE_HEIGHT_M])
+    assert sole_touches(on_ground, flat, 0.0)  # flat on the ground, no load yet
+    assert sole_touches(on_ground + [0, 0, 0.5 * SOLE_CONTACT_GAP_M], flat, 0.0)
+    assert not sole_touches(on_ground + [0, 0, 2.0 * SOLE_CONTACT_GAP_M], flat, 0.0)
+    assert sole_touches(on_ground + [0, 0, 0.05], flat, 100.0)  # pressing: in contact whatever the geometry says
+    # Tilted 10° about the foot's long axis, the ankle 1 cm up: one sole edge is still down.
+    tilted = rot.quat_from_axis_angle(np.array([1.0, 0.0, 0.0]), np.radians(10.0))
+    assert sole_touches(on_ground + [0, 0, 0.005], tilted, 0.0)

@@ -80,6 +80,9 @@ class WorldConfig:
     contact_stiffness_npm: float = 30000.0  # Sec. 7.1, ground damped spring
     contact_damping_nspm: float = 10000.0  # Sec. 7.1
     friction: float = 0.9  # Sec. 7.1
+    # Static friction holds each contact where it began (PyBullet's friction anchors) instead of letting a foot
+    # creep under a sustained sideways force below the friction limit; no force is added (docs/decisions.md).
+    friction_anchor: bool = True
 
     def __post_init__(self) -> None:
         _positive("WorldConfig.gravity_mps2", self.gravity_mps2)

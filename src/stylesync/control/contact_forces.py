@@ -15,12 +15,14 @@ from __future__ import annotations
 import numpy as np
 
 from stylesync import rotations as rot
+from stylesync.sim.backend import CONTACT_FORCE_N
 from stylesync.sim.character import ANKLE_HEIGHT_M, FOOT_CENTER_AHEAD_OF_ANKLE_M, FOOT_LENGTH_M, FOOT_WIDTH_M
 
 SOLE_MARGIN = 0.9  # fraction of the sole's length and width the corner forces may use
 FRICTION_MARGIN = 0.8  # fraction of the friction coefficient the pyramid uses
 COP_MARGIN = 0.9  # fraction of the support's extent the desired horizontal force may use
 MOMENTUM_ACCEL_ALLOWANCE_MPS2 = 0.5  # horizontal COM acceleration allowed beyond the pendulum's [m/s²]
+SOLE_CONTACT_GAP_M = 0.003  # a planted sole this close to the ground still counts as supporting [m]
 REGULARISATION = 1e-4  # ε of a full-weight foot [1/N² against N² of residual]
 MIN_WEIGHT = 0.05  # a stance weight below this is treated as this (ε_s = REGULARISATION / weight)
 _HALF_L, _HALF_W = SOLE_MARGIN * FOOT_LENGTH_M / 2, SOLE_MARGIN * FOOT_WIDTH_M / 2
@@ -33,6 +35,16 @@ _EDGE_DIRS = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]])
 def sole_corners_world(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray) -> np.ndarray:
     """(4, 3) world positions of a foot's sole corners [m]."""
     return np.asarray(ankle_world, dtype=float) + SOLE_CORNERS_IN_FOOT @ rot.matrix_from_quat(foot_quat_wxyz).T
+
+
+def sole_touches(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray, contact_force_n: float) -> bool:
+    """Whether a foot can be given ground forces: it presses the ground (more than CONTACT_FORCE_N), or the lowest
+    corner of its sole is within SOLE_CONTACT_GAP_M of the ground. The second case is a planted foot that has just
+    been unloaded: left out of the plan for as long as it does not press, it is no longer held where it is, and
+    the plan switches between one and two supporting feet from one tick to the next as the load shifts."""
+    if contact_force_n > CONTACT_FORCE_N:
+        return True
+    return float(sole_corners_world(ankle_world, foot_quat_wxyz)[:, 2].min()) < SOLE_CONTACT_GAP_M
 
 
 def pyramid_edges(friction: float) -> np.ndarray:

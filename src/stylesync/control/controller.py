@@ -54,10 +54,10 @@ class ControlTelemetry:
     root_torque_nm: np.ndarray
 
 
-def supporting_weights(stance_weight: dict[str, float], foot_force_n: dict[str, float]) -> dict[str, float]:
+def supporting_weights(stance_weight: dict[str, float], touching: dict[str, bool]) -> dict[str, float]:
     """The stance weights of the feet that actually touch the ground, renormalised. Support torques (gravity
     reaction, COM force, IPM ankle torque, root torque) sent to a foot in the air would only spin it."""
-    w = {s: v if foot_force_n[f"{s}_ankle"] > CONTACT_FORCE_N else 0.0 for s, v in stance_weight.items()}
+    w = {s: v if touching[s] else 0.0 for s, v in stance_weight.items()}
     total = sum(w.values())
     return {s: v / total for s, v in w.items()} if total > 0 else w
 
@@ -143,7 +143,8 @@ class BalanceController(ControllerBase):
 
     def update(self, state: CharacterState, ref: ReferencePose, mass_matrix: np.ndarray) -> None:
         cfg = self.cfg
-        w = supporting_weights(ref.stance_weight, state.foot_contact_force_n)
+        w = supporting_weights(ref.stance_weight, {s: state.foot_contact_force_n[f"{s}_ankle"] > CONTACT_FORCE_N
+                                                   for s in ref.stance_weight})
         foot_yaw = {s: rot.yaw_from_quat(state.link_quat_wxyz[state.link(f"{s}_ankle")]) for s in ("left", "right")}
         self._prepare_implicit(state, w, mass_matrix)
         frames = JointFrames(state)

@@ -29,6 +29,7 @@ from stylesync.control.contact_forces import (
     feasible_horizontal_force,
     regularisation,
     sole_corners_world,
+    sole_touches,
     wrench_basis,
 )
 from stylesync.control.controller import TORQUE_LIMIT, ControllerBase, ControlTelemetry, supporting_weights
@@ -58,7 +59,9 @@ class MomentumBalanceController(ControllerBase):
     def update(self, state: CharacterState, ref: ReferencePose, mass_matrix: np.ndarray) -> None:
         cfg = self.cfg
         m = self.mass.total_kg
-        w = supporting_weights(ref.stance_weight, state.foot_contact_force_n)
+        touching = {s: sole_touches(state.link_origin_world[_FOOT_LINK[s]], state.link_quat_wxyz[_FOOT_LINK[s]],
+                                    state.foot_contact_force_n[f"{s}_ankle"]) for s in ref.stance_weight}
+        w = supporting_weights(ref.stance_weight, touching)
         frames = JointFrames(state)
         jac = FloatingJacobians(state, frames)
         com, com_vel = self.mass.com(state), self.mass.com_velocity(state)

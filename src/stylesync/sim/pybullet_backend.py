@@ -115,6 +115,7 @@ class PyBulletBackend(PhysicsBackend):
             c.changeDynamics(
                 self.body, link, contactStiffness=world.contact_stiffness_npm,
                 contactDamping=world.contact_damping_nspm, lateralFriction=world.friction,
+                frictionAnchor=int(world.friction_anchor),
             )
         c.changeDynamics(
             self.plane, -1, contactStiffness=world.contact_stiffness_npm,
