@@ -132,7 +132,7 @@ class MotionConfig:
     step_behind_capture_point_m: float = 0.1
     # and this far outside it, sideways (min, max): a foot further out throws the body back harder than the
     # next step can catch, and the sway grows from step to step [m]
-    step_outside_capture_point_m: tuple[float, float] = (0.02, 0.06)
+    step_outside_capture_point_m: tuple[float, float] = (0.0, 0.04)
 
     def __post_init__(self) -> None:
         lo, hi = self.step_outside_capture_point_m
