@@ -18,3 +18,16 @@ def test_round_trips(v):
     assert np.allclose(rot.matrix_from_quat(r), rot.matrix_from_quat(q), atol=1e-9)
     r1, r2 = rot.quat_from_rotvec(rot.rotvec_from_quat(q)), rot.quat_from_rotvec(rot.rotvec_from_quat(-q))
     assert np.allclose(rot.matrix_from_quat(r1), rot.matrix_from_quat(r2), atol=1e-9)  # q and -q: one rotation
+
+
+def test_batched_slerp_matches_the_single_one():
+    rng = np.random.default_rng(3)
+    q0 = rng.normal(size=(32, 4))
+    q1 = rng.normal(size=(32, 4))
+    q0 /= np.linalg.norm(q0, axis=1, keepdims=True)
+    q1 /= np.linalg.norm(q1, axis=1, keepdims=True)
+    q1[0] = q0[0]  # no rotation between them
+    q1[1] = -q0[1]  # the same rotation, other sign
+    for t in (0.0, 0.25, 0.5, 1.0):
+        single = np.array([rot.slerp(a, b, t) for a, b in zip(q0, q1, strict=True)])
+        assert np.abs(rot.batch_slerp(q0, q1, t) - single).max() < 1e-12

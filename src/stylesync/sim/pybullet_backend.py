@@ -234,7 +234,9 @@ class PyBulletBackend(PhysicsBackend):
 
     def apply_torques(self, torques: Torques) -> None:
         v = torques.values
-        if v is self._last_torque_values:  # the same torques as the last step (held over a control tick)
+        # The same array as the last step's (a controller holding its torques over a control tick): its PyBullet
+        # form is reused. Torques are values, never changed in place once applied.
+        if v is self._last_torque_values:
             forces = self._last_forces
         else:
             if not np.all(np.isfinite(v)):
