@@ -15,7 +15,6 @@ from __future__ import annotations
 import numpy as np
 
 from stylesync import rotations as rot
-from stylesync.sim.backend import CONTACT_FORCE_N
 from stylesync.sim.character import ANKLE_HEIGHT_M, FOOT_CENTER_AHEAD_OF_ANKLE_M, FOOT_LENGTH_M, FOOT_WIDTH_M
 
 SOLE_MARGIN = 0.9  # fraction of the sole's length and width the corner forces may use
@@ -37,14 +36,12 @@ def sole_corners_world(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray) -> n
     return np.asarray(ankle_world, dtype=float) + SOLE_CORNERS_IN_FOOT @ rot.matrix_from_quat(foot_quat_wxyz).T
 
 
-def sole_touches(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray, contact_force_n: float) -> bool:
-    """Whether a foot can be given ground forces: it presses the ground (more than CONTACT_FORCE_N), or the lowest
-    corner of its sole is within SOLE_CONTACT_GAP_M of the ground. The second case is a planted foot that has just
-    been unloaded: left out of the plan for as long as it does not press, it is no longer held where it is, and
-    the plan switches between one and two supporting feet from one tick to the next as the load shifts."""
-    if contact_force_n > CONTACT_FORCE_N:
-        return True
-    return float(sole_corners_world(ankle_world, foot_quat_wxyz)[:, 2].min()) < SOLE_CONTACT_GAP_M
+def sole_touches(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray, pressing: bool) -> bool:
+    """Whether a foot can be given ground forces: it presses the ground (``CharacterState.feet_pressing``), or the
+    lowest corner of its sole is within SOLE_CONTACT_GAP_M of the ground. The second case is a planted foot that
+    has just been unloaded: left out of the plan for as long as it does not press, it is no longer held where it
+    is, and the plan switches between one and two supporting feet from one tick to the next as the load shifts."""
+    return pressing or float(sole_corners_world(ankle_world, foot_quat_wxyz)[:, 2].min()) < SOLE_CONTACT_GAP_M
 
 
 def pyramid_edges(friction: float) -> np.ndarray:

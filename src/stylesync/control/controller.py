@@ -31,7 +31,6 @@ from stylesync.control.jacobian_transpose import JointFrames
 from stylesync.control.model_compensation import bounded_lipm_sync_force, ipm_ankle_moments
 from stylesync.control.pid import IS_BALL, JointPid, reference_velocity
 from stylesync.control.stable_pd import (
-    N_DOFS,
     flatten_joint_values,
     implicit_gain,
     joint_damping,
@@ -40,8 +39,8 @@ from stylesync.control.stable_pd import (
 from stylesync.control.support import limit_ankle_moment
 from stylesync.motion.reference import ReferencePose
 from stylesync.motion.stance_fsm import Stance
-from stylesync.sim.backend import CONTACT_FORCE_N, CharacterState, JointFeedback, MassProperties, Torques
-from stylesync.sim.character import JOINT_DOF_START, JOINTS, Q_WORLD_MODEL, ROOT_DOFS
+from stylesync.sim.backend import CharacterState, JointFeedback, MassProperties, Torques
+from stylesync.sim.character import JOINT_DOF_START, JOINTS, N_DOFS, Q_WORLD_MODEL, ROOT_DOFS
 
 TORQUE_LIMIT = np.array([j.torque_limit_nm for j in JOINTS])[:, None]
 PELVIS_CHILDREN = tuple(k for k, j in enumerate(JOINTS) if j.parent == "root")  # chest and both hips
@@ -143,8 +142,7 @@ class BalanceController(ControllerBase):
 
     def update(self, state: CharacterState, ref: ReferencePose, mass_matrix: np.ndarray) -> None:
         cfg = self.cfg
-        w = supporting_weights(ref.stance_weight, {s: state.foot_contact_force_n[f"{s}_ankle"] > CONTACT_FORCE_N
-                                                   for s in ref.stance_weight})
+        w = supporting_weights(ref.stance_weight, state.feet_pressing())
         foot_yaw = {s: rot.yaw_from_quat(state.link_quat_wxyz[state.link(f"{s}_ankle")]) for s in ("left", "right")}
         self._prepare_implicit(state, w, mass_matrix)
         frames = JointFrames(state)

@@ -16,12 +16,12 @@ import numpy as np
 
 from stylesync import rotations as rot
 from stylesync.control.jacobian_transpose import JointFrames
-from stylesync.control.stable_pd import N_DOFS
 from stylesync.sim.backend import CharacterState
 from stylesync.sim.character import (
     JOINT_DOF_COUNT,
     JOINTS,
     LINK_NAMES,
+    N_DOFS,
     N_JOINT_DOFS,
     ROOT_DOFS,
     JointKind,

@@ -17,8 +17,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import nnls
 
-from stylesync.control.stable_pd import N_DOFS
-from stylesync.sim.character import ROOT_DOFS
+from stylesync.sim.character import N_DOFS, ROOT_DOFS
 
 
 def joint_torques(mass_matrix: np.ndarray, bias_force: np.ndarray, contact_force: np.ndarray,

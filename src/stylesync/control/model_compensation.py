@@ -15,8 +15,10 @@ from __future__ import annotations
 import numpy as np
 
 from stylesync import rotations as rot
+from stylesync.control.bounds import BoundsMonitor, lipm_force_bound_n
 from stylesync.control.gravity_compensation import ANKLE_JOINT
 from stylesync.control.support import support_point
+from stylesync.motion.reference import LipmMap
 from stylesync.sim.character import JOINTS
 
 
@@ -48,11 +50,9 @@ def lipm_sync_force(d_a_human: np.ndarray, h_human_m: float, d_a_char: np.ndarra
     return f
 
 
-def bounded_lipm_sync_force(lipm, mass_kg: float, gravity_mps2: float, force_limit_n: float, enforce: bool,
-                            bounds, time_s: float) -> np.ndarray:
-    """Eq. 23 for ``lipm`` (a ``LipmMap``), reported against Eq. 26's bound and clamped to it when ``enforce``."""
-    from stylesync.control.bounds import lipm_force_bound_n
-
+def bounded_lipm_sync_force(lipm: LipmMap, mass_kg: float, gravity_mps2: float, force_limit_n: float,
+                            enforce: bool, bounds: BoundsMonitor, time_s: float) -> np.ndarray:
+    """Eq. 23 for ``lipm``, reported against Eq. 26's bound and clamped to it when ``enforce``."""
     f = lipm_sync_force(lipm.d_a_human, lipm.h_human_m, lipm.d_a_char, lipm.h_char_m, mass_kg, gravity_mps2)
     limit = min(force_limit_n, lipm_force_bound_n(mass_kg, gravity_mps2, lipm.h_char_m))
     mag = float(np.linalg.norm(f))

@@ -39,11 +39,11 @@ from stylesync.control.inverse_dynamics import joint_torques, solve_with_contact
 from stylesync.control.jacobian_transpose import JointFrames
 from stylesync.control.model_compensation import bounded_lipm_sync_force
 from stylesync.control.pid import IS_BALL, joint_error
-from stylesync.control.stable_pd import N_DOFS, flatten_joint_values, unflatten_joint_values
+from stylesync.control.stable_pd import flatten_joint_values, unflatten_joint_values
 from stylesync.motion.reference import ReferencePose
 from stylesync.motion.stance_fsm import swing_side
 from stylesync.sim.backend import CharacterState, JointFeedback, MassProperties, Torques
-from stylesync.sim.character import ANKLE_HEIGHT_M, LINK_NAMES
+from stylesync.sim.character import ANKLE_HEIGHT_M, LINK_NAMES, N_DOFS
 
 _FOOT_LINK = {s: LINK_NAMES.index(f"{s}_ankle") for s in ("left", "right")}
 GROUND_PRESS_M = 0.02  # a stance foot not yet touching is aimed this far below the ground [m]
@@ -59,8 +59,8 @@ class MomentumBalanceController(ControllerBase):
     def update(self, state: CharacterState, ref: ReferencePose, mass_matrix: np.ndarray) -> None:
         cfg = self.cfg
         m = self.mass.total_kg
-        touching = {s: sole_touches(state.link_origin_world[_FOOT_LINK[s]], state.link_quat_wxyz[_FOOT_LINK[s]],
-                                    state.foot_contact_force_n[f"{s}_ankle"]) for s in ref.stance_weight}
+        touching = {s: sole_touches(state.link_origin_world[_FOOT_LINK[s]], state.link_quat_wxyz[_FOOT_LINK[s]], p)
+                    for s, p in state.feet_pressing().items()}
         w = supporting_weights(ref.stance_weight, touching)
         frames = JointFrames(state)
         jac = FloatingJacobians(state, frames)

@@ -36,7 +36,7 @@ from stylesync.motion.style_features import StyleExtractor, StyleFeatures
 from stylesync.processing.body_parameters import leg_length_m
 from stylesync.processing.joint_map import hinge_angle, local_rotation
 from stylesync.processing.operator_processing import OperatorSample
-from stylesync.sim.backend import CONTACT_FORCE_N, CharacterState, MassProperties
+from stylesync.sim.backend import CharacterState, MassProperties
 from stylesync.sim.character import (
     ANKLE_HEIGHT_M,
     HIP_HALF_WIDTH_M,
@@ -137,7 +137,7 @@ class MotionOptimizer:
         cfg = self.cfg
         features = self.operator_features(sample)
         op_state = self.op_fsm.update(sample.pos["ANKLE_LEFT"][2], sample.pos["ANKLE_RIGHT"][2])
-        contact = {side: state.foot_contact_force_n[f"{side}_ankle"] > CONTACT_FORCE_N for side in ("left", "right")}
+        contact = state.feet_pressing()
         ch_state = self.char_fsm.update(op_state, contact, state.time_s)
         if op_state is not self._op_state:  # the operator's swing time, for the swing's progress
             if self._op_state in (Stance.LS, Stance.RS):
@@ -167,7 +167,7 @@ class MotionOptimizer:
         ankle_c_z = ANKLE_HEIGHT_M
         p_h = s.pos["PELVIS"]
         com_h = s.com_world
-        com_c = mass.com(state)
+        com_c, com_vel_c = mass.com(state), mass.com_velocity(state)
 
         # Lower-body retargeting (Eq. 9-10) for the pelvis and the COM, anchored on the feet the operator stands
         # on (on the character's stance while a late contact holds the reference): after an early contact
@@ -232,7 +232,7 @@ class MotionOptimizer:
                 target = pelvis_d + scale * (a_h[side] - p_h)
                 if cfg.swing_placement == "capture_point":
                     from_stance = a_c[other] + scale * (a_h[side] - a_h[other])
-                    xi_c = com_c + mass.com_velocity(state) * np.sqrt(max(com_c[2], 0.1) / self.g)
+                    xi_c = com_c + com_vel_c * np.sqrt(max(com_c[2], 0.1) / self.g)
                     h_h = max(com_h[2] - ankle_h_z + ANKLE_HEIGHT_M / scale, 0.1)
                     xi_h = com_h + com_vel_h * np.sqrt(h_h / self.g)
                     land = R_root_d.T @ (scale * (a_h[side] - xi_h))  # heading frame, from the capture point
@@ -299,7 +299,7 @@ class MotionOptimizer:
             q_thigh = ik.thigh_quat_wxyz
             if side == sw:
                 q_thigh = swing_hip_feedback(q_thigh, np.zeros(3), com_c - a_c[other], np.zeros(3),
-                                             mass.com_velocity(state), cfg.swing_hip_cd, cfg.swing_hip_cv, heading)
+                                             com_vel_c, cfg.swing_hip_cd, cfg.swing_hip_cv, heading)
             q_hip = rot.multiply(rot.conjugate(q_root_frame), q_thigh)
             if weights[side] > 0 and ch_state is not Stance.DS:
                 q_hip_cur = canonical_quat_from_model(q_cur[JOINT_NAMES.index(f"{side}_hip")])

@@ -40,6 +40,10 @@ class CharacterState:
     def link(self, name: str) -> int:
         return LINK_NAMES.index(name)
 
+    def feet_pressing(self) -> dict[str, bool]:
+        """Per side ("left", "right"), whether that foot presses the ground harder than CONTACT_FORCE_N."""
+        return {s: self.foot_contact_force_n[f"{s}_ankle"] > CONTACT_FORCE_N for s in ("left", "right")}
+
 
 @dataclass(frozen=True)
 class MassProperties:

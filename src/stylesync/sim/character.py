@@ -64,6 +64,7 @@ ROOT_DOFS = 6
 JOINT_DOF_COUNT: tuple[int, ...] = tuple(3 if j.kind is JointKind.BALL else 1 for j in JOINTS)
 JOINT_DOF_START: tuple[int, ...] = tuple(int(x) for x in np.cumsum((0,) + JOINT_DOF_COUNT[:-1]))
 N_JOINT_DOFS = int(sum(JOINT_DOF_COUNT))
+N_DOFS = ROOT_DOFS + N_JOINT_DOFS  # generalised velocities of the floating character
 JOINT_BY_NAME: dict[str, JointSpec] = {j.name: j for j in JOINTS}
 
 # All rigid links with mass, in URDF order ("root" is the pelvis; wrists are fixed hands).

@@ -126,6 +126,8 @@ class PyBulletBackend(PhysicsBackend):
         masses[0] += base_mass  # the 0.1 g dummy base is welded to the pelvis
         self._mass = MassProperties(np.array(masses))
         self.balls: list[int] = []
+        self._all_joints = list(range(c.getNumJoints(self.body)))
+        self._raw: tuple | None = None  # the engine's state as last read, until the next step or reset
         self._dof_map = self._pybullet_dof_map()
 
     def _pybullet_dof_map(self) -> np.ndarray:
@@ -146,6 +148,7 @@ class PyBulletBackend(PhysicsBackend):
     # ------------------------------------------------------------------------------------------------------
     def reset(self, root_pos_world, root_quat_wxyz, joint_pos=None) -> None:
         c = self._pb
+        self._raw = None
         q_link = rot.multiply(np.asarray(root_quat_wxyz, dtype=float), Q_WORLD_MODEL)
         c.resetBasePositionAndOrientation(self.body, list(root_pos_world), rot.xyzw_from_wxyz(q_link).tolist())
         c.resetBaseVelocity(self.body, [0, 0, 0], [0, 0, 0])
@@ -161,6 +164,7 @@ class PyBulletBackend(PhysicsBackend):
         """Initial velocities (tests of the kinematics): root [m/s], [rad/s] (world), joints as in
         ``CharacterState.joint_vel``."""
         c = self._pb
+        self._raw = None
         c.resetBaseVelocity(self.body, list(root_lin_vel_world), list(root_ang_vel_world))
         for k, j in enumerate(self._joint_idx):
             pos = c.getJointStateMultiDof(self.body, j)[0]
@@ -170,11 +174,20 @@ class PyBulletBackend(PhysicsBackend):
     def mass_properties(self) -> MassProperties:
         return self._mass
 
+    def _read_raw(self) -> tuple:
+        """Base pose and velocity and every joint's state, read once per engine state: the joint feedback, the
+        character state and the mass matrix of one control tick share it."""
+        if self._raw is None:
+            c = self._pb
+            base_pos, base_xyzw = c.getBasePositionAndOrientation(self.body)
+            lin_vel, ang_vel = c.getBaseVelocity(self.body)
+            self._raw = (base_pos, base_xyzw, lin_vel, ang_vel, c.getJointStatesMultiDof(self.body, self._all_joints))
+        return self._raw
+
     def read_state(self, time_s: float) -> CharacterState:
         c = self._pb
         fb = self.read_joint_feedback()
-        base_pos, _ = c.getBasePositionAndOrientation(self.body)
-        lin_vel, _ = c.getBaseVelocity(self.body)
+        base_pos, _, lin_vel, _, _ = self._read_raw()
         links = c.getLinkStates(self.body, self._link_idx, computeLinkVelocity=1, computeForwardKinematics=1)
         n = len(links)
         com = np.empty((n, 3))
@@ -215,12 +228,12 @@ class PyBulletBackend(PhysicsBackend):
         )
 
     def read_joint_feedback(self) -> JointFeedback:
-        c = self._pb
-        states = c.getJointStatesMultiDof(self.body, self._joint_idx)
-        n = len(states)
+        _, base_q, _, ang_vel, all_states = self._read_raw()
+        n = len(self._joint_idx)
         pos = np.zeros((n, 4))
         vel = np.zeros((n, 3))
-        for k, st in enumerate(states):
+        for k, j in enumerate(self._joint_idx):
+            st = all_states[j]
             if self._is_ball[k]:
                 x, y, z, w = st[0]
                 pos[k] = (w, x, y, z)
@@ -228,8 +241,6 @@ class PyBulletBackend(PhysicsBackend):
             else:
                 pos[k, 0] = st[0][0]
                 vel[k, 0] = st[1][0]
-        _, base_q = c.getBasePositionAndOrientation(self.body)
-        _, ang_vel = c.getBaseVelocity(self.body)
         return JointFeedback(pos, vel, _canonical_from_link_xyzw(base_q), np.array(ang_vel))
 
     def apply_torques(self, torques: Torques) -> None:
@@ -247,15 +258,15 @@ class PyBulletBackend(PhysicsBackend):
         self._pb.setJointMotorControlMultiDofArray(self.body, self._joint_idx, pb.TORQUE_CONTROL, forces=forces)
 
     def joint_space_inertia(self) -> np.ndarray:
-        c = self._pb
-        pos, orn = c.getBasePositionAndOrientation(self.body)
+        pos, orn, _, _, states = self._read_raw()
         q = [*pos, *orn]
-        for js in c.getJointStatesMultiDof(self.body, range(c.getNumJoints(self.body))):
+        for js in states:
             q += js[0]
-        m = np.asarray(c.calculateMassMatrix(self.body, q, flags=1))
+        m = np.asarray(self._pb.calculateMassMatrix(self.body, q, flags=1))
         return m[np.ix_(self._dof_map, self._dof_map)]
 
     def step(self) -> None:
+        self._raw = None
         self._pb.stepSimulation()
 
     def collision_shapes(self) -> list[LinkShape]:

@@ -2,17 +2,33 @@
 
 from __future__ import annotations
 
+import json
 import logging
 import threading
 import time
 from abc import ABC, abstractmethod
 from collections import deque
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 
+from stylesync.errors import SourceError
 from stylesync.sources.frame import OperatorFrame
 
 log = logging.getLogger("stylesync.sources")
+
+
+def read_json_file(path: str | Path, what: str) -> Any:
+    """The parsed content of a JSON file; a missing or unreadable file, or invalid JSON, is a one-line
+    SourceError naming ``what`` the file was meant to be."""
+    p = Path(path)
+    try:
+        return json.loads(p.read_text())
+    except FileNotFoundError:
+        raise SourceError(f"{what} not found: {p}") from None
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
+        raise SourceError(f"{what} {p} is not valid JSON: {exc}".splitlines()[0]) from None
 
 
 class OperatorSource(ABC):

@@ -14,7 +14,6 @@ in the rest pose. The floor is placed by :func:`place_on_floor`.
 
 from __future__ import annotations
 
-import json
 import re
 from pathlib import Path
 from typing import Any
@@ -23,6 +22,7 @@ import numpy as np
 
 from stylesync import rotations as rot
 from stylesync.errors import SourceError
+from stylesync.sources.base import read_json_file
 from stylesync.sources.frame import JOINT_INDEX, N_JOINTS
 from stylesync.sources.skeleton_tracks import (
     REQUIRED_JOINTS,
@@ -68,10 +68,7 @@ def normalise_name(name: str) -> str:
 
 
 def load_joint_map(path: str | Path) -> dict[str, str]:
-    try:
-        data = json.loads(Path(path).read_text())
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise SourceError(f"joint map {path}: cannot read a JSON object ({exc})") from None
+    data = read_json_file(path, "joint map")
     if not isinstance(data, dict) or not all(isinstance(k, str) and isinstance(v, str) for k, v in data.items()):
         raise SourceError(f"joint map {path}: expected a JSON object of canonical joint -> BVH joint name")
     unknown = sorted(set(data) - set(JOINT_INDEX))

@@ -8,7 +8,6 @@ metres at the 0.25-scaled character size. We convert to our z-up world and canon
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -18,6 +17,7 @@ import numpy as np
 from stylesync import rotations as rot
 from stylesync.errors import SourceError
 from stylesync.sim.character import Q_WORLD_MODEL, canonical_quat_from_model
+from stylesync.sources.base import read_json_file
 
 FRAME_WIDTH = 44
 # (canonical joint, kind, width) in clip order after dt, root position and root rotation.
@@ -81,12 +81,7 @@ class DeepMimicClip:
     @classmethod
     def load(cls, path: str | Path) -> DeepMimicClip:
         p = Path(path)
-        try:
-            data = json.loads(p.read_text())
-        except FileNotFoundError:
-            raise SourceError(f"DeepMimic clip not found: {p}") from None
-        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-            raise SourceError(f"DeepMimic clip {p} is not valid JSON: {exc}") from None
+        data = read_json_file(p, "DeepMimic clip")
         if not isinstance(data, dict) or not isinstance(data.get("Frames"), list) or not data["Frames"]:
             raise SourceError(f"DeepMimic clip {p} has no 'Frames' list")
         try:

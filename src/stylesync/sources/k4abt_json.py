@@ -27,6 +27,7 @@ import numpy as np
 
 from stylesync import rotations as rot
 from stylesync.errors import SourceError
+from stylesync.sources.base import read_json_file
 from stylesync.sources.frame import K4ABT_JOINTS, N_JOINTS, OperatorFrame
 from stylesync.sources.segment_frames import canonical_quats_from_positions
 from stylesync.sources.skeleton_tracks import TrackPerformer, place_on_floor
@@ -42,12 +43,7 @@ class K4abtRecording:
 
     def __init__(self, path: str | Path):
         p = Path(path)
-        try:
-            data = json.loads(p.read_text())
-        except FileNotFoundError:
-            raise SourceError(f"k4abt JSON file not found: {p}") from None
-        except (OSError, UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
-            raise SourceError(f"k4abt JSON {p} is not valid JSON: {exc}".splitlines()[0]) from None
+        data = read_json_file(p, "k4abt JSON file")
         if not isinstance(data, dict) or not isinstance(data.get("frames"), list):
             raise SourceError(f"k4abt JSON {p}: expected an object with a 'frames' list")
         names = data.get("joint_names")

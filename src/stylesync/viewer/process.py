@@ -53,11 +53,9 @@ class ViewerProcess:
 
     def __init__(self, shapes: list[LinkShape], host: str = "127.0.0.1", port: int | None = None,
                  draw_hz: float = 20.0, on_action: Callable[[str], None] | None = None):
-        try:
-            import viser  # noqa: F401  (fail here, with the install hint, rather than in the child)
-        except ImportError as exc:
-            raise ConfigError(f"the web viewer needs viser ({exc}); install it with: pip install viser") from exc
-        from stylesync.viewer.web_viewer import free_port
+        from stylesync.viewer.web_viewer import free_port, import_viser
+
+        import_viser()  # fail here, with the install hint, rather than in the child
 
         ctx = mp.get_context("spawn")
         self.port = port if port else free_port(host)

@@ -15,7 +15,7 @@ from stylesync import rotations as rot
 from stylesync.control.bounds import ds_com_bound_m, step_length_bound_m
 from stylesync.motion.stance_fsm import Stance
 from stylesync.processing.joint_map import TRACKED_POSITIONS
-from stylesync.sim.backend import CONTACT_FORCE_N, CharacterState, LinkShape
+from stylesync.sim.backend import CharacterState, LinkShape
 from stylesync.sim.character import LINK_NAMES, SHANK_LENGTH_M, THIGH_LENGTH_M
 
 FOOT_SOLE_HALF_EXTENTS_M = (0.0885, 0.045)  # half length and half width of the foot box (collision shape) [m]
@@ -57,7 +57,7 @@ def snapshot_from_state(state: CharacterState, com_world: np.ndarray, character_
                         bounds_active: dict[str, bool], balls_world: tuple[np.ndarray, ...] = (),
                         feet_down: dict[str, bool] | None = None, fell: bool = False) -> Snapshot:
     if feet_down is None:
-        feet_down = {s: state.foot_contact_force_n[f"{s}_ankle"] > CONTACT_FORCE_N for s in ("left", "right")}
+        feet_down = state.feet_pressing()
     ankles = {s: state.link_origin_world[_LINK[f"{s}_ankle"]].copy() for s in ("left", "right")}
     yaw = {s: rot.yaw_from_quat(state.link_quat_wxyz[_LINK[f"{s}_ankle"]]) for s in ("left", "right")}
     op = None if operator_pos is None else {k: np.array(v, dtype=float) for k, v in operator_pos.items()}

@@ -77,6 +77,16 @@ def _ring_segments(points_2d: np.ndarray, z_m: float) -> np.ndarray:
     return np.stack([p, np.roll(p, -1, axis=0)], axis=1)
 
 
+def import_viser():
+    """viser and its uPlot module, or a ConfigError with the install hint."""
+    try:
+        import viser
+        import viser.uplot as uplot
+    except ImportError as exc:
+        raise ConfigError(f"the web viewer needs viser ({exc}); install it with: pip install viser") from exc
+    return viser, uplot
+
+
 class WebViewer:
     """``publish`` a snapshot; ``close`` when done. ``on_action`` receives the controls' actions by name ("reset",
     "push", "pause", "resume"); ``None`` makes the viewer read-only (replay). Runs in the viewer's own process
@@ -84,11 +94,7 @@ class WebViewer:
 
     def __init__(self, shapes: list[LinkShape], host: str = "127.0.0.1", port: int | None = None,
                  draw_hz: float = 20.0, on_action: Callable[[str], None] | None = None):
-        try:
-            import viser
-            import viser.uplot as uplot
-        except ImportError as exc:
-            raise ConfigError(f"the web viewer needs viser ({exc}); install it with: pip install viser") from exc
+        viser, uplot = import_viser()
         self.port = port if port else free_port(host)
         self.host = host
         self.url = f"http://{host}:{self.port}"
