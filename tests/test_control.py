@@ -121,18 +121,28 @@ def test_table3_gains_stay_stable_on_a_root_fixed_character():
     assert err.max() < 15.0  # PD without gravity compensation: a steady sag under gravity, bounded
 
 
-def test_free_character_stands_still_with_a_standing_operator():
-    # The acceptance figure: 60 s standing, the COM within 2 cm of where it settled (after the first second).
-    cfg = SessionConfig(duration_s=60.0, operator=OperatorConfig(clip="stand"))
+def _standing_run(duration_s: float, **options):
+    """COM (n, 2) and ankle (n, 4) horizontal positions after the first second of a standing run."""
+    cfg = SessionConfig(duration_s=duration_s, operator=OperatorConfig(clip="stand"), **options)
     source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
     result = Session(cfg, source).run()
     assert not result.fell
-    com = np.stack([result.log.array("com_x"), result.log.array("com_y")], axis=1)
     t = result.log.array("t")
-    settled = com[t >= 1.0]
-    drift = np.linalg.norm(settled - settled[0], axis=1).max()
-    assert drift < 0.02
+    com = np.stack([result.log.array("com_x"), result.log.array("com_y")], axis=1)[t >= 1.0]
     feet = np.stack([result.log.array(k) for k in ("al_x", "al_y", "ar_x", "ar_y")], axis=1)[t >= 1.0]
+    return com, feet
+
+
+def test_free_character_stands_still_with_a_standing_operator():
+    com, _ = _standing_run(10.0)
+    assert np.linalg.norm(com - com[0], axis=1).max() < 0.02
+
+
+def test_planted_feet_options_keep_a_standing_character_within_2_cm_for_60_s():
+    # The acceptance figure (60 s, COM drift < 2 cm) with friction anchors and the sole contact gap.
+    com, feet = _standing_run(60.0, world=WorldConfig(friction_anchor=True),
+                              control=ControlConfig(sole_contact_gap_m=0.003))
+    assert np.linalg.norm(com - com[0], axis=1).max() < 0.02
     assert np.abs(feet - feet[0]).max() < 0.01  # planted feet stay planted
 
 

@@ -6,7 +6,6 @@ import pytest
 from stylesync import rotations as rot
 from stylesync.config import WorldConfig
 from stylesync.control.contact_forces import (
-    SOLE_CONTACT_GAP_M,
     pyramid_edges,
     sole_corners_world,
     sole_touches,
@@ -126,12 +125,14 @@ def test_desired_horizontal_force_is_limited_to_what_the_soles_can_give():
 
 
 def test_a_planted_sole_just_unloaded_still_supports_and_a_lifted_one_does_not():
+    gap = 0.003
     flat = rot.IDENTITY_WXYZ
     on_ground = np.array([0.0, 0.0, ANKLE_HEIGHT_M])
-    assert sole_touches(on_ground, flat, False)  # flat on the ground, no load yet
-    assert sole_touches(on_ground + [0, 0, 0.5 * SOLE_CONTACT_GAP_M], flat, False)
-    assert not sole_touches(on_ground + [0, 0, 2.0 * SOLE_CONTACT_GAP_M], flat, False)
-    assert sole_touches(on_ground + [0, 0, 0.05], flat, True)  # pressing: in contact whatever the geometry says
+    assert sole_touches(on_ground, flat, False, gap)  # flat on the ground, no load yet
+    assert sole_touches(on_ground + [0, 0, 0.5 * gap], flat, False, gap)
+    assert not sole_touches(on_ground + [0, 0, 2.0 * gap], flat, False, gap)
+    assert sole_touches(on_ground + [0, 0, 0.05], flat, True, gap)  # pressing: in contact whatever the geometry says
     # Tilted 10° about the foot's long axis, the ankle 1 cm up: one sole edge is still down.
     tilted = rot.quat_from_axis_angle(np.array([1.0, 0.0, 0.0]), np.radians(10.0))
-    assert sole_touches(on_ground + [0, 0, 0.005], tilted, False)
+    assert sole_touches(on_ground + [0, 0, 0.005], tilted, False, gap)
+    assert not sole_touches(on_ground, flat, False, 0.0)  # the rule switched off: only pressing counts

@@ -81,8 +81,9 @@ class WorldConfig:
     contact_damping_nspm: float = 10000.0  # Sec. 7.1
     friction: float = 0.9  # Sec. 7.1
     # Static friction holds each contact where it began (PyBullet's friction anchors) instead of letting a foot
-    # creep under a sustained sideways force below the friction limit; no force is added (docs/decisions.md).
-    friction_anchor: bool = True
+    # creep under a sustained sideways force below the friction limit; no force is added. Off by default: with it
+    # the simulation turns micro-differences of the input into visibly different motion (docs/decisions.md).
+    friction_anchor: bool = False
 
     def __post_init__(self) -> None:
         _positive("WorldConfig.gravity_mps2", self.gravity_mps2)
@@ -177,6 +178,10 @@ class ControlConfig:
     momentum_root_kd: float = 40.0  # [N·m·s/rad]
     momentum_moment_weight_per_m: float = 2.0  # weight of the moment rows against the force rows [1/m]
     contact_velocity_gain: float = 10.0  # a supporting foot's residual velocity is damped at this rate [1/s]
+    # Inverse dynamics: a planted sole whose lowest corner is within this height of the ground still counts as
+    # supporting (contact_forces.sole_touches); 0 = only a foot pressing the ground does. Off by default, as
+    # WorldConfig.friction_anchor, with which it keeps a standing character's feet planted [m].
+    sole_contact_gap_m: float = 0.0
     gravity_compensation: bool = True  # Eq. 14-15
     com_virtual_force: bool = True  # Eq. 16-17
     root_virtual_torque: bool = True  # Eq. 16, 18
@@ -195,7 +200,7 @@ class ControlConfig:
         for n in ("joint_tracking_omega_rad_s", "joint_tracking_damping_ratio", "momentum_moment_weight_per_m",
                   "joint_acceleration_limit_rad_s2"):
             _positive(f"ControlConfig.{n}", getattr(self, n))
-        for n in ("momentum_root_kp", "momentum_root_kd", "contact_velocity_gain"):
+        for n in ("momentum_root_kp", "momentum_root_kd", "contact_velocity_gain", "sole_contact_gap_m"):
             _non_negative(f"ControlConfig.{n}", getattr(self, n))
         for group in ("chest", "neck", "hip", "knee", "ankle", "shoulder", "elbow"):
             if group not in self.pid:

@@ -21,7 +21,6 @@ SOLE_MARGIN = 0.9  # fraction of the sole's length and width the corner forces m
 FRICTION_MARGIN = 0.8  # fraction of the friction coefficient the pyramid uses
 COP_MARGIN = 0.9  # fraction of the support's extent the desired horizontal force may use
 MOMENTUM_ACCEL_ALLOWANCE_MPS2 = 0.5  # horizontal COM acceleration allowed beyond the pendulum's [m/s²]
-SOLE_CONTACT_GAP_M = 0.003  # a planted sole this close to the ground still counts as supporting [m]
 REGULARISATION = 1e-4  # ε of a full-weight foot [1/N² against N² of residual]
 MIN_WEIGHT = 0.05  # a stance weight below this is treated as this (ε_s = REGULARISATION / weight)
 _HALF_L, _HALF_W = SOLE_MARGIN * FOOT_LENGTH_M / 2, SOLE_MARGIN * FOOT_WIDTH_M / 2
@@ -36,12 +35,12 @@ def sole_corners_world(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray) -> n
     return np.asarray(ankle_world, dtype=float) + SOLE_CORNERS_IN_FOOT @ rot.matrix_from_quat(foot_quat_wxyz).T
 
 
-def sole_touches(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray, pressing: bool) -> bool:
+def sole_touches(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray, pressing: bool, gap_m: float) -> bool:
     """Whether a foot can be given ground forces: it presses the ground (``CharacterState.feet_pressing``), or the
-    lowest corner of its sole is within SOLE_CONTACT_GAP_M of the ground. The second case is a planted foot that
+    lowest corner of its sole is within ``gap_m`` of the ground (``gap_m`` > 0). The second case is a planted foot that
     has just been unloaded: left out of the plan for as long as it does not press, it is no longer held where it
     is, and the plan switches between one and two supporting feet from one tick to the next as the load shifts."""
-    return pressing or float(sole_corners_world(ankle_world, foot_quat_wxyz)[:, 2].min()) < SOLE_CONTACT_GAP_M
+    return pressing or (gap_m > 0 and float(sole_corners_world(ankle_world, foot_quat_wxyz)[:, 2].min()) < gap_m)
 
 
 def pyramid_edges(friction: float) -> np.ndarray:

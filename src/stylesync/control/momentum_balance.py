@@ -59,8 +59,8 @@ class MomentumBalanceController(ControllerBase):
     def update(self, state: CharacterState, ref: ReferencePose, mass_matrix: np.ndarray) -> None:
         cfg = self.cfg
         m = self.mass.total_kg
-        touching = {s: sole_touches(state.link_origin_world[_FOOT_LINK[s]], state.link_quat_wxyz[_FOOT_LINK[s]], p)
-                    for s, p in state.feet_pressing().items()}
+        touching = {s: sole_touches(state.link_origin_world[_FOOT_LINK[s]], state.link_quat_wxyz[_FOOT_LINK[s]], p,
+                                    cfg.sole_contact_gap_m) for s, p in state.feet_pressing().items()}
         w = supporting_weights(ref.stance_weight, touching)
         frames = JointFrames(state)
         jac = FloatingJacobians(state, frames)
