@@ -31,3 +31,34 @@ def test_batched_slerp_matches_the_single_one():
     for t in (0.0, 0.25, 0.5, 1.0):
         single = np.array([rot.slerp(a, b, t) for a, b in zip(q0, q1, strict=True)])
         assert np.abs(rot.batch_slerp(q0, q1, t) - single).max() < 1e-12
+
+
+def test_batched_product_and_matrix_match_the_single_ones():
+    rng = np.random.default_rng(5)
+    a = rng.normal(size=(32, 4))
+    b = rng.normal(size=(32, 4))
+    a /= np.linalg.norm(a, axis=1, keepdims=True)
+    for i in range(32):
+        assert np.abs(rot.batch_multiply(a, b)[i] - rot.multiply(a[i], b[i])).max() < 1e-12
+        assert np.abs(rot.batch_matrix_from_quat(a)[i] - rot.matrix_from_quat(a[i])).max() < 1e-12
+
+
+def test_batched_style_features_match_the_extractor():
+    from stylesync.motion.style_features import StyleExtractor, style_rows
+
+    rng = np.random.default_rng(7)
+    n = 64
+    hip = rng.normal(size=(n, 2, 3))
+    knee = hip + 0.3 * rng.normal(size=(n, 2, 3))
+    ankle = knee + 0.3 * rng.normal(size=(n, 2, 3))
+    ankle[:8] = knee[:8] + (knee[:8] - hip[:8])  # straight legs: the plane falls back to the pelvis's left
+    quats = rng.normal(size=(n, 5, 4))
+    quats /= np.linalg.norm(quats, axis=2, keepdims=True)
+    shank, foot, pelvis = quats[:, 0:2], quats[:, 2:4], quats[:, 4]
+    com = rng.normal(size=(n, 3))
+    rows = style_rows(hip, knee, ankle, shank, foot, com, pelvis)
+    sides = ("left", "right")
+    for i in range(n):
+        f = StyleExtractor()(*({s: x[i, k] for k, s in enumerate(sides)} for x in (hip, knee, ankle, shank, foot)),
+                             com[i], pelvis[i])
+        assert np.abs(rows[i] - np.array(f.as_row())).max() < 1e-12

@@ -207,18 +207,33 @@ def align_sign(q: Array, reference: Array) -> Array:
 
 
 # ---- batched versions for the per-physics-step controller: arrays of shape (n, 4) / (n, 3) --------------------
+def _product_tensor() -> Array:
+    """(16, 4) K with a ⊗ b = (a b^T flattened) @ K: the Hamilton product as one bilinear map."""
+    k = np.zeros((4, 4, 4))
+    basis = np.eye(4)
+    for i in range(4):
+        for j in range(4):
+            k[i, j] = multiply(basis[i], basis[j])
+    return k.reshape(16, 4)
+
+
+_PRODUCT = _product_tensor()
+# (16, 9): the rotation matrix of a unit quaternion from its outer product q q^T (the diagonal entries use
+# w² + x² - y² - z² = 1 - 2 (y² + z²) for a unit q).
+_matrix_terms = np.zeros((4, 4, 9))
+for _r, _terms in enumerate([
+    [(0, 0, 1), (1, 1, 1), (2, 2, -1), (3, 3, -1)], [(1, 2, 2), (0, 3, -2)], [(1, 3, 2), (0, 2, 2)],
+    [(1, 2, 2), (0, 3, 2)], [(0, 0, 1), (1, 1, -1), (2, 2, 1), (3, 3, -1)], [(2, 3, 2), (0, 1, -2)],
+    [(1, 3, 2), (0, 2, -2)], [(2, 3, 2), (0, 1, 2)], [(0, 0, 1), (1, 1, -1), (2, 2, -1), (3, 3, 1)],
+]):
+    for _i, _j, _c in _terms:
+        _matrix_terms[_i, _j, _r] = _c
+_MATRIX = _matrix_terms.reshape(16, 9)
+
+
 def batch_multiply(a: Array, b: Array) -> Array:
-    aw, ax, ay, az = a[:, 0], a[:, 1], a[:, 2], a[:, 3]
-    bw, bx, by, bz = b[:, 0], b[:, 1], b[:, 2], b[:, 3]
-    return np.stack(
-        [
-            aw * bw - ax * bx - ay * by - az * bz,
-            aw * bx + ax * bw + ay * bz - az * by,
-            aw * by - ax * bz + ay * bw + az * bx,
-            aw * bz + ax * by - ay * bx + az * bw,
-        ],
-        axis=1,
-    )
+    """Hamilton product of each row, (n, 4) x (n, 4) -> (n, 4) (three numpy calls: small n is the common case)."""
+    return (a[:, :, None] * b[:, None, :]).reshape(len(a), 16) @ _PRODUCT
 
 
 def batch_conjugate(q: Array) -> Array:
@@ -258,13 +273,5 @@ def batch_slerp(q0: Array, q1: Array, t: float) -> Array:
 
 
 def batch_matrix_from_quat(q: Array) -> Array:
-    """Rotation matrices of each row, (n, 4) -> (n, 3, 3)."""
-    w, x, y, z = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
-    return np.stack(
-        [
-            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], axis=1),
-            np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], axis=1),
-            np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], axis=1),
-        ],
-        axis=1,
-    )
+    """Rotation matrices of each row (unit quaternions), (n, 4) -> (n, 3, 3)."""
+    return ((q[:, :, None] * q[:, None, :]).reshape(len(q), 16) @ _MATRIX).reshape(len(q), 3, 3)

@@ -27,7 +27,7 @@ from stylesync.metrics.imitation import CHARACTER_LINKS, OPERATOR_JOINTS
 from stylesync.motion.pose_optimization import MotionOptimizer
 from stylesync.motion.stance_fsm import Stance
 from stylesync.motion.style_features import ROW_NAMES as _FEATURES
-from stylesync.motion.style_features import StyleExtractor
+from stylesync.motion.style_features import style_rows
 from stylesync.processing.operator_processing import OperatorProcessing, OperatorSample
 from stylesync.sim.backend import CharacterState, PhysicsBackend, make_backend
 from stylesync.sim.character import LINK_NAMES, STANDING_ROOT_HEIGHT_M
@@ -38,6 +38,8 @@ FALL_ROOT_HEIGHT_M = 0.5  # a fall: pelvis below this height, or a non-foot link
 SILENT_STREAM_TIMEOUT_S = 2.0
 FIRST_FRAME_TIMEOUT_S = 10.0
 _LINK = {n: i for i, n in enumerate(LINK_NAMES)}
+# Hip, knee and ankle links of the left and the right leg, (2, 3).
+_LEG_LINKS = np.array([[_LINK[f"{s}_{j}"] for j in ("hip", "knee", "ankle")] for s in ("left", "right")])
 STANCE_CODE = {Stance.LS: 0, Stance.DS: 1, Stance.RS: 2}
 
 
@@ -87,7 +89,6 @@ class Session:
         self.controller = controller_class(config.control, self.mass, config.world.gravity_mps2,
                                            1.0 / config.clocks.physics_hz, 1.0 / config.clocks.control_hz,
                                            self.bounds, config.world.friction)
-        self.char_style = StyleExtractor()
         self.on_tick = on_tick
         self.renders: list[tuple[float, np.ndarray]] = []
         self.last_sample: OperatorSample | None = None  # newest processed operator sample (recorders, viewers)
@@ -218,6 +219,7 @@ class Session:
                 lag = (t + dt) - (time.perf_counter() - wall0)
                 if lag > 0:
                     time.sleep(lag)
+        _add_character_style(tick_log)
         wall = time.perf_counter() - wall0
         sim_t = (step + 1) * dt if not (self.fell and self.stop_on_fall) else float(fall_time or 0.0)
         return SessionResult(tick_log, self.fell, fall_time, fall_reason, sim_t, wall, step + 1,
@@ -238,12 +240,7 @@ class Session:
     def _log(self, lg: TickLog, t: float, sample, state: CharacterState, ref, tick_ms: float) -> None:
         com = self.mass.com(state)
         self.last_com_world = com
-        hips = {s: state.link_origin_world[_LINK[f"{s}_hip"]] for s in ("left", "right")}
-        knees = {s: state.link_origin_world[_LINK[f"{s}_knee"]] for s in ("left", "right")}
         ankles = {s: state.link_origin_world[_LINK[f"{s}_ankle"]] for s in ("left", "right")}
-        shank = {s: state.link_quat_wxyz[_LINK[f"{s}_knee"]] for s in ("left", "right")}
-        foot = {s: state.link_quat_wxyz[_LINK[f"{s}_ankle"]] for s in ("left", "right")}
-        cf = self.char_style(hips, knees, ankles, shank, foot, com, state.root_quat_wxyz)
         err = joint_error(state.joint_pos, ref.joint_pos)
         lg.add(
             t=t, tick_ms=tick_ms,
@@ -265,6 +262,21 @@ class Session:
             op_joints=np.array([sample.pos[n] for n in OPERATOR_JOINTS]),
             lipm_fx=self.controller.telemetry.lipm_force_n[0], lipm_fy=self.controller.telemetry.lipm_force_n[1],
             **{f"op_{k}": v for k, v in zip(_FEATURES, ref.operator_features.as_row(), strict=True)},
-            **{f"ch_{k}": v for k, v in zip(_FEATURES, cf.as_row(), strict=True)},
+            # The character's style features are computed from these after the run (_add_character_style).
+            _ch_legs=state.link_origin_world[_LEG_LINKS], _ch_leg_quats=state.link_quat_wxyz[_LEG_LINKS[:, 1:]],
+            _ch_com=com, _ch_root_quat=state.root_quat_wxyz.copy(),
         )
 
+
+
+def _add_character_style(lg: TickLog) -> None:
+    """The character's style features (Sec. 5.2), columns ``ch_<feature>``, from the leg links, COM and pelvis
+    recorded at each tick: one batched computation after the run instead of one per control tick."""
+    raw = {k: lg.columns.pop(k, []) for k in ("_ch_legs", "_ch_leg_quats", "_ch_com", "_ch_root_quat")}
+    if not raw["_ch_com"]:
+        return
+    legs, quats = np.asarray(raw["_ch_legs"]), np.asarray(raw["_ch_leg_quats"])  # (n, 2, 3, 3), (n, 2, 2, 4)
+    rows = style_rows(legs[:, :, 0], legs[:, :, 1], legs[:, :, 2], quats[:, :, 0], quats[:, :, 1],
+                      np.asarray(raw["_ch_com"]), np.asarray(raw["_ch_root_quat"]))
+    for k, name in enumerate(_FEATURES):
+        lg.columns[f"ch_{name}"] = rows[:, k].tolist()

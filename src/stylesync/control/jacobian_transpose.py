@@ -25,9 +25,8 @@ class JointFrames:
 
     def __init__(self, state: CharacterState):
         self.origin = state.link_origin_world[_CHILD_LINK]  # (n_joints, 3)
-        self.R = np.array(
-            [rot.matrix_from_quat(state.link_quat_wxyz[i]) @ _R_WORLD_MODEL for i in _CHILD_LINK]
-        )  # (n_joints, 3, 3) child link frame (model axes) in world
+        # (n_joints, 3, 3) child link frame (model axes) in world
+        self.R = rot.batch_matrix_from_quat(state.link_quat_wxyz[_CHILD_LINK]) @ _R_WORLD_MODEL
 
     def torque_from_moment(self, moment_world: np.ndarray) -> np.ndarray:
         """Joint-torque layout (n_joints, 3) of world moments (n_joints, 3) [N·m] applied at each joint."""

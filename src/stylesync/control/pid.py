@@ -17,6 +17,8 @@ from stylesync.config import ControlConfig, pid_group
 from stylesync.sim.character import JOINTS, JointKind
 
 IS_BALL = np.array([j.kind is JointKind.BALL for j in JOINTS])
+_BALL = np.flatnonzero(IS_BALL)
+_HINGE = np.flatnonzero(~IS_BALL)
 
 
 def gain_arrays(cfg: ControlConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -29,8 +31,8 @@ def gain_arrays(cfg: ControlConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray]
 def joint_error(q_current: np.ndarray, q_desired: np.ndarray) -> np.ndarray:
     """(n_joints, 3) error: child-frame rotation vector for ball joints, angle in column 0 for hinges [rad]."""
     e = np.zeros((len(q_current), 3))
-    e[IS_BALL] = rot.batch_rotvec(rot.batch_multiply(rot.batch_conjugate(q_current[IS_BALL]), q_desired[IS_BALL]))
-    e[~IS_BALL, 0] = q_desired[~IS_BALL, 0] - q_current[~IS_BALL, 0]
+    e[_BALL] = rot.batch_rotvec(rot.batch_multiply(rot.batch_conjugate(q_current[_BALL]), q_desired[_BALL]))
+    e[_HINGE, 0] = q_desired[_HINGE, 0] - q_current[_HINGE, 0]
     return e
 
 

@@ -46,8 +46,8 @@ from stylesync.sim.character import (
     SHANK_LENGTH_M,
     THIGH_LENGTH_M,
     JointKind,
+    batch_model_quat_from_canonical,
     canonical_quat_from_model,
-    model_quat_from_canonical,
 )
 
 _MIN_AXIS_SPREAD_M = 0.08
@@ -58,6 +58,8 @@ OPERATOR_SWING_S = 0.4  # the operator's swing time before one has been seen [s]
 SWING_BLEND_S = 0.1  # time constant over which a swing foot moves from its lift-off point onto its target [s]
 ANCHOR_BLEND_S = 0.15  # time constant over which a stance change's jump of the retargeting anchor is taken up
 _SCALE_SMOOTHING = 0.02  # per tick, exponential average of the operator's leg length
+_BALL_JOINTS = [k for k, j in enumerate(JOINTS) if j.kind is JointKind.BALL]
+_HINGE_JOINTS = [k for k, j in enumerate(JOINTS) if j.kind is not JointKind.BALL]
 _VELOCITY_SMOOTHING = 0.2  # per tick, exponential average of the desired COM velocity
 _SIDE_UP = {"left": "LEFT", "right": "RIGHT"}
 _LINK = {n: i for i, n in enumerate(LINK_NAMES)}
@@ -326,11 +328,11 @@ class MotionOptimizer:
             knee_angle[f"{side}_elbow"] = hinge_angle(local_rotation(s.quat, f"{side}_elbow"), f"{side}_elbow")
 
         joint_pos = np.zeros((len(JOINTS), 4))
-        for k, spec in enumerate(JOINTS):
-            if spec.kind is JointKind.BALL:
-                joint_pos[k] = rot.align_sign(model_quat_from_canonical(local[spec.name]), q_cur[k])
-            else:
-                joint_pos[k, 0] = knee_angle[spec.name]
+        joint_pos[_BALL_JOINTS] = rot.batch_align_sign(
+            batch_model_quat_from_canonical(np.array([local[JOINTS[k].name] for k in _BALL_JOINTS])),
+            q_cur[_BALL_JOINTS])
+        for k in _HINGE_JOINTS:
+            joint_pos[k, 0] = knee_angle[JOINTS[k].name]
 
         lipm = None
         if ch_state is not Stance.DS:

@@ -64,3 +64,35 @@ class StyleExtractor:
             P[s] = np.asarray(ankle[s]) - np.asarray(com)
         return StyleFeatures(T["left"], T["right"], N["left"], N["right"], P["left"], P["right"],
                              rot.yaw_from_quat(pelvis_quat))
+
+
+def style_rows(hip: np.ndarray, knee: np.ndarray, ankle: np.ndarray, shank_quat: np.ndarray, foot_quat: np.ndarray,
+               com: np.ndarray, pelvis_quat: np.ndarray) -> np.ndarray:
+    """:class:`StyleExtractor` over many instants at once, as rows in ``ROW_NAMES`` order, (n, 15).
+
+    ``hip``, ``knee``, ``ankle``: (n, 2, 3) world positions [m], left then right; ``shank_quat``, ``foot_quat``:
+    (n, 2, 4) world orientations (wxyz, canonical segment axes); ``com`` (n, 3) [m]; ``pelvis_quat`` (n, 4). Used to
+    fill a run's log after the run, off the control tick."""
+    n = len(com)
+    out = np.empty((n, len(ROW_NAMES)))
+    # T: twist of conj(shank) ⊗ foot about the shank's long axis (z), as rotations.twist_angle.
+    q = rot.batch_multiply(rot.batch_conjugate(shank_quat.reshape(-1, 4)), foot_quat.reshape(-1, 4))
+    w, p = q[:, 0], q[:, 3]
+    sign = np.where(w < 0, -1.0, 1.0)
+    twist = np.where((np.abs(w) < 1e-12) & (np.abs(p) < 1e-12), 0.0, 2.0 * np.arctan2(sign * p, sign * w))
+    out[:, 0:2] = twist.reshape(n, 2)
+    # N: leg plane normals, with the pelvis's left axis as the fallback and hemisphere (leg_plane_normal).
+    left = rot.batch_matrix_from_quat(pelvis_quat)[:, :, 1]  # (n, 3)
+    a, b = knee - hip, ankle - knee
+    normal = rot.cross(a, b)  # (n, 2, 3)
+    s = np.linalg.norm(normal, axis=2)
+    straight = (s < _MIN_PLANE_SINE * np.linalg.norm(a, axis=2) * np.linalg.norm(b, axis=2)) | (s < 1e-9)
+    unit = normal / np.maximum(s, 1e-300)[:, :, None]
+    unit = np.where((np.einsum("nsk,nk->ns", unit, left) >= 0)[:, :, None], unit, -unit)
+    normals = np.where(straight[:, :, None], left[:, None, :], unit)
+    out[:, 2:5], out[:, 5:8] = normals[:, 0], normals[:, 1]
+    # P_c: COM to each ankle; H: the pelvis's yaw (rotations.yaw_from_quat).
+    out[:, 8:11], out[:, 11:14] = ankle[:, 0] - com, ankle[:, 1] - com
+    pw, px, py, pz = pelvis_quat.T
+    out[:, 14] = np.arctan2(2 * (px * py + pw * pz), 1 - 2 * (py * py + pz * pz))
+    return out

@@ -24,6 +24,7 @@ STANDING_ROOT_HEIGHT_M = 0.895  # pelvis origin height with straight legs and fe
 
 # World orientation of the model's frame: +90 deg about x maps the URDF's +y (up) to world +z.
 Q_WORLD_MODEL = rot.quat_from_axis_angle(np.array([1.0, 0.0, 0.0]), np.pi / 2)
+_Q_MODEL_WORLD = rot.conjugate(Q_WORLD_MODEL)
 
 
 class JointKind(Enum):
@@ -117,6 +118,13 @@ def chain_to_root(link: str) -> list[str]:
 def model_quat_from_canonical(q_canonical_wxyz: np.ndarray) -> np.ndarray:
     """Joint rotation in model axes from the same relative rotation in canonical (world-aligned) axes."""
     return rot.multiply(rot.multiply(rot.conjugate(Q_WORLD_MODEL), q_canonical_wxyz), Q_WORLD_MODEL)
+
+
+def batch_model_quat_from_canonical(q_canonical_wxyz: np.ndarray) -> np.ndarray:
+    """:func:`model_quat_from_canonical` of each row, (n, 4)."""
+    n = len(q_canonical_wxyz)
+    return rot.batch_multiply(rot.batch_multiply(np.broadcast_to(_Q_MODEL_WORLD, (n, 4)), q_canonical_wxyz),
+                              np.broadcast_to(Q_WORLD_MODEL, (n, 4)))
 
 
 def canonical_quat_from_model(q_model_wxyz: np.ndarray) -> np.ndarray:
