@@ -167,3 +167,21 @@ def test_torso_hip_gives_the_pelvis_exactly_the_root_torque():
     on_pelvis = -sum(rot.matrix_from_quat(rot.multiply(q_pelvis, q[k])) @ (tau[k] - ctl._ff[k])
                      for k in PELVIS_CHILDREN)
     assert np.allclose(on_pelvis, tau_r, atol=1e-9)
+
+
+def test_a_balance_part_the_controller_cannot_switch_off_is_refused():
+    from stylesync.errors import ConfigError
+
+    with pytest.raises(ConfigError, match="gravity_compensation"):
+        ControlConfig(gravity_compensation=False)  # the default inverse-dynamics balance has no separate term
+    ControlConfig(balance="jacobian_transpose", gravity_compensation=False, com_virtual_force=False)
+    ControlConfig(lipm_time_sync=False)
+
+
+def test_bench_baselines_differ_from_stylesync():
+    from stylesync.metrics.bench import CONTROLLERS
+
+    assert CONTROLLERS["plain-pd"][0].balance == "jacobian_transpose"
+    assert not CONTROLLERS["plain-pd"][0].gravity_compensation
+    assert not CONTROLLERS["no-compensation"][0].lipm_time_sync
+    assert CONTROLLERS["stylesync"][0].lipm_time_sync

@@ -197,6 +197,13 @@ class ControlConfig:
         _positive("ControlConfig.root_yaw_gain_scale", self.root_yaw_gain_scale)
         if self.balance not in BALANCE_METHODS:
             raise ConfigError(f"ControlConfig.balance must be one of {BALANCE_METHODS}, got {self.balance!r}")
+        # The inverse-dynamics controller realises gravity compensation, the COM and root virtual control and the
+        # centre of pressure (IPM) in one problem; only the LIPM force is a separate term there.
+        fixed = [n for n in ("gravity_compensation", "com_virtual_force", "root_virtual_torque",
+                             "ipm_ankle_compensation") if not getattr(self, n)]
+        if self.balance == "inverse_dynamics" and fixed:
+            raise ConfigError(f"ControlConfig: {', '.join(fixed)} can only be switched off with "
+                              f"balance='jacobian_transpose' (the inverse-dynamics balance has no separate term)")
         for n in ("joint_tracking_omega_rad_s", "joint_tracking_damping_ratio", "momentum_moment_weight_per_m",
                   "joint_acceleration_limit_rad_s2"):
             _positive(f"ControlConfig.{n}", getattr(self, n))

@@ -6,8 +6,11 @@ Controllers (same operator stream, same retargeted reference, same engine and ga
 * ``stylesync``: the whole controller of Sec. 5.4 and 6;
 * ``plain-pd``: PD tracking (Eq. 13, Table 3 gains, implicit) of the retargeted reference with no balance control
   at all: no gravity compensation, no COM or root virtual control, no IPM/LIPM compensation, no stance-hip blend
-  (the DeepMimic-style tracker without a learned policy);
-* ``no-compensation``: stylesync without the model-based compensation (IPM ankle torque, LIPM time sync).
+  (the DeepMimic-style tracker without a learned policy). It runs on the Jacobian-transpose controller
+  (controller.py), the realisation in which each of those parts can be switched off;
+* ``no-compensation``: stylesync without the model-based compensation: the LIPM time sync (Eq. 21-23) off. (The
+  IPM ankle torque of Eq. 20 has no separate term in the default controller: its ground-force plan places the
+  centre of pressure.)
 
 The suite is every humanoid3d clip of pybullet_data played by the built-in operator, plus the BVH files of
 ``../shared/mocap/cmu`` when present. The physics-only realtime factor of the same machine, measured in the same
@@ -32,10 +35,10 @@ from stylesync.sim.backend import Torques, make_backend
 
 CONTROLLERS: dict[str, tuple[ControlConfig, MotionConfig]] = {
     "stylesync": (ControlConfig(), MotionConfig()),
-    "plain-pd": (ControlConfig(gravity_compensation=False, com_virtual_force=False, root_virtual_torque=False,
-                               ipm_ankle_compensation=False, lipm_time_sync=False),
+    "plain-pd": (ControlConfig(balance="jacobian_transpose", gravity_compensation=False, com_virtual_force=False,
+                               root_virtual_torque=False, ipm_ankle_compensation=False, lipm_time_sync=False),
                  MotionConfig(stance_hip_weight_w0=1.0)),
-    "no-compensation": (ControlConfig(ipm_ankle_compensation=False, lipm_time_sync=False), MotionConfig()),
+    "no-compensation": (ControlConfig(lipm_time_sync=False), MotionConfig()),
 }
 COLUMNS = ("fall rate", "time to fall [s]", "MPJPE global [mm]", "MPJPE root-rel. [mm]", "skate [mm]",
            "jitter [m/s²]", "lag [s]", "realtime factor")
