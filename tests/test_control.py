@@ -185,3 +185,11 @@ def test_bench_baselines_differ_from_stylesync():
     assert not CONTROLLERS["plain-pd"][0].gravity_compensation
     assert not CONTROLLERS["no-compensation"][0].lipm_time_sync
     assert CONTROLLERS["stylesync"][0].lipm_time_sync
+
+
+def test_joint_error_over_many_ticks_matches_tick_by_tick():
+    q = np.stack([random_pose(k, hinge_rad=0.1 * k) for k in range(6)])
+    q_ref = np.stack([random_pose(10 + k, hinge_rad=0.5) for k in range(6)])
+    batched = joint_error(q, q_ref)
+    for k in range(6):
+        assert np.abs(batched[k] - joint_error(q[k], q_ref[k])).max() < 1e-12

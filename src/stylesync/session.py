@@ -219,7 +219,7 @@ class Session:
                 lag = (t + dt) - (time.perf_counter() - wall0)
                 if lag > 0:
                     time.sleep(lag)
-        _add_character_style(tick_log)
+        _add_after_run_columns(tick_log)
         wall = time.perf_counter() - wall0
         sim_t = (step + 1) * dt if not (self.fell and self.stop_on_fall) else float(fall_time or 0.0)
         return SessionResult(tick_log, self.fell, fall_time, fall_reason, sim_t, wall, step + 1,
@@ -241,7 +241,6 @@ class Session:
         com = self.mass.com(state)
         self.last_com_world = com
         ankles = {s: state.link_origin_world[_LINK[f"{s}_ankle"]] for s in ("left", "right")}
-        err = joint_error(state.joint_pos, ref.joint_pos)
         lg.add(
             t=t, tick_ms=tick_ms,
             op_state=STANCE_CODE[ref.operator_stance], char_state=STANCE_CODE[ref.character_stance],
@@ -257,24 +256,28 @@ class Session:
             ar_x=ankles["right"][0], ar_y=ankles["right"][1], ar_z=ankles["right"][2],
             root_z=state.root_pos_world[2],
             contact_l=state.foot_contact_force_n["left_ankle"], contact_r=state.foot_contact_force_n["right_ankle"],
-            joint_err_deg=float(np.degrees(np.linalg.norm(err, axis=1)).mean()),
             ch_joints=state.link_origin_world[CHARACTER_LINKS].copy(),
             op_joints=np.array([sample.pos[n] for n in OPERATOR_JOINTS]),
             lipm_fx=self.controller.telemetry.lipm_force_n[0], lipm_fy=self.controller.telemetry.lipm_force_n[1],
             **{f"op_{k}": v for k, v in zip(_FEATURES, ref.operator_features.as_row(), strict=True)},
-            # The character's style features are computed from these after the run (_add_character_style).
+            # The joint error and the character's style features are computed from these after the run
+            # (_add_after_run_columns). The arrays are the state's and the reference's own, new at every tick.
+            _q=state.joint_pos, _q_ref=ref.joint_pos,
             _ch_legs=state.link_origin_world[_LEG_LINKS], _ch_leg_quats=state.link_quat_wxyz[_LEG_LINKS[:, 1:]],
             _ch_com=com, _ch_root_quat=state.root_quat_wxyz.copy(),
         )
 
 
 
-def _add_character_style(lg: TickLog) -> None:
-    """The character's style features (Sec. 5.2), columns ``ch_<feature>``, from the leg links, COM and pelvis
-    recorded at each tick: one batched computation after the run instead of one per control tick."""
-    raw = {k: lg.columns.pop(k, []) for k in ("_ch_legs", "_ch_leg_quats", "_ch_com", "_ch_root_quat")}
+def _add_after_run_columns(lg: TickLog) -> None:
+    """Columns derived from what each tick recorded, in one batched computation after the run instead of one per
+    control tick: ``joint_err_deg`` (mean over the joints of the angle between the character's joint and the
+    reference's) and the character's style features (Sec. 5.2), ``ch_<feature>``."""
+    raw = {k: lg.columns.pop(k, []) for k in ("_q", "_q_ref", "_ch_legs", "_ch_leg_quats", "_ch_com", "_ch_root_quat")}
     if not raw["_ch_com"]:
         return
+    err = joint_error(np.asarray(raw["_q"]), np.asarray(raw["_q_ref"]))  # (n, n_joints, 3)
+    lg.columns["joint_err_deg"] = np.degrees(np.linalg.norm(err, axis=2)).mean(axis=1).tolist()
     legs, quats = np.asarray(raw["_ch_legs"]), np.asarray(raw["_ch_leg_quats"])  # (n, 2, 3, 3), (n, 2, 2, 4)
     rows = style_rows(legs[:, :, 0], legs[:, :, 1], legs[:, :, 2], quats[:, :, 0], quats[:, :, 1],
                       np.asarray(raw["_ch_com"]), np.asarray(raw["_ch_root_quat"]))

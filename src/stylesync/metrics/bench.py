@@ -32,6 +32,8 @@ from stylesync.config import ControlConfig, MotionConfig, OperatorConfig, Sessio
 from stylesync.metrics.summary import summarize
 from stylesync.session import Session
 from stylesync.sim.backend import Torques, make_backend
+from stylesync.sources.deepmimic_clip import builtin_clip_names
+from stylesync.sources.registry import open_source
 
 CONTROLLERS: dict[str, tuple[ControlConfig, MotionConfig]] = {
     "stylesync": (ControlConfig(), MotionConfig()),
@@ -61,8 +63,6 @@ def physics_only_rtf(cfg: SessionConfig, sim_s: float) -> float:
 
 def clip_suite(shared: Path | None) -> list[str]:
     """Source specs of the suite."""
-    from stylesync.sources.deepmimic_clip import builtin_clip_names
-
     specs = [f"builtin:{c}" for c in builtin_clip_names()]
     if shared is not None and (shared / "mocap" / "cmu").is_dir():
         specs += [f"bvh:{p}" for p in sorted((shared / "mocap" / "cmu").glob("*.bvh"))]
@@ -70,8 +70,6 @@ def clip_suite(shared: Path | None) -> list[str]:
 
 
 def _run(spec: str, name: str, duration_s: float, seed: int) -> dict:
-    from stylesync.sources.registry import open_source
-
     control, motion = CONTROLLERS[name]
     opened = open_source(spec, seed=seed, duration_s=duration_s)
     length = min(duration_s, float(opened.duration_s or duration_s))

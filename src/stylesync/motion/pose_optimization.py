@@ -62,6 +62,7 @@ _BALL_JOINTS = [k for k, j in enumerate(JOINTS) if j.kind is JointKind.BALL]
 _HINGE_JOINTS = [k for k, j in enumerate(JOINTS) if j.kind is not JointKind.BALL]
 _VELOCITY_SMOOTHING = 0.2  # per tick, exponential average of the desired COM velocity
 _SIDE_UP = {"left": "LEFT", "right": "RIGHT"}
+_OTHER_SIDE = {"left": "right", "right": "left"}
 _LINK = {n: i for i, n in enumerate(LINK_NAMES)}
 CHAR_LEG_LENGTH_M = THIGH_LENGTH_M + SHANK_LENGTH_M
 
@@ -220,7 +221,7 @@ class MotionOptimizer:
         targets: dict[str, np.ndarray] = {}
         foot_yaw: dict[str, float] = {}
         for side in ("left", "right"):
-            other = "left" if side == "right" else "right"
+            other = _OTHER_SIDE[side]
             if side == sw:
                 # Where the operator's foot is, scaled, relative to the character's body ("pelvis": from its
                 # pelvis as his is from his; no balance feedback, as Sec. 7.2's c_d = c_v = 0), or
@@ -295,7 +296,7 @@ class MotionOptimizer:
                 hip_w = state.link_origin_world[_LINK[f"{side}_hip"]].copy()
                 q_root_frame = state.root_quat_wxyz
             N = features.N_l if side == "left" else features.N_r
-            other = "left" if side == "right" else "right"
+            other = _OTHER_SIDE[side]
             target = targets[side]
             ik = solve_leg(hip_w, target, THIGH_LENGTH_M, SHANK_LENGTH_M, N)
             q_thigh = ik.thigh_quat_wxyz

@@ -12,6 +12,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from stylesync.processing.point_cloud_volume import link_volumes, masses_by_volume
+from stylesync.rotations import yaw_from_quat
+
 # (segment, proximal joint, distal joint, mass fraction, COM fraction from the proximal end), Winter Table 4.1.
 # The trunk (0.497) runs from the pelvis to the neck; the forearm includes the hand (0.016 + 0.006).
 WINTER_SEGMENTS: tuple[tuple[str, str, str, float, float], ...] = (
@@ -114,9 +117,6 @@ def measure_operator(frames: list, total_mass_kg: float, point_cloud_world: np.n
         mass = {n: total_mass_kg * f / total for n, f in fractions.items()}
         method = "anthropometric table (Winter 2009)"
     else:
-        from stylesync.processing.point_cloud_volume import link_volumes, masses_by_volume
-        from stylesync.rotations import yaw_from_quat
-
         links = {}
         for row in TABLE2_ROWS:
             for s in (("LEFT", "RIGHT") if "{S}" in row[1] else ("",)):

@@ -62,7 +62,6 @@ def micro_cuboid_volume(points_body: np.ndarray, cell_m: float = 0.003) -> float
     starts = np.flatnonzero(np.r_[True, key_sorted[1:] != key_sorted[:-1]])
     thickness = np.maximum.reduceat(x, starts) - np.minimum.reduceat(x, starts)  # Eq. 3, front minus back
     return float(np.sum(size[0] * size[1] * thickness))  # Eq. 4, summed as Eq. 5
- # Eq. 4 summed as Eq. 5
 
 
 def _distance_to_segments(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
