@@ -5,10 +5,12 @@ from conftest import random_pose
 
 from stylesync import rotations as rot
 from stylesync.config import WorldConfig
+from stylesync.control.contact_forces import sole_corners_world
 from stylesync.control.gravity_compensation import gravity_torques
 from stylesync.control.jacobian_transpose import JointFrames
 from stylesync.control.pid import joint_error
 from stylesync.sim.backend import Torques, make_backend
+from stylesync.sim.character import STANDING_ROOT_HEIGHT_M
 
 
 def test_gravity_compensation_holds_root_fixed_character_5s():
@@ -23,3 +25,19 @@ def test_gravity_compensation_holds_root_fixed_character_5s():
     err = np.degrees(np.linalg.norm(joint_error(b.read_state(5.0).joint_pos, q0), axis=1))
     b.close()
     assert err.max() < 1.0
+
+
+def test_sole_lies_ankle_height_below_the_ankle_joint():
+    """The model's foot box reaches ANKLE_HEIGHT_M below the ankle joint: the straight character touches the ground
+    when its root is lowered 2 mm below STANDING_ROOT_HEIGHT_M and not when raised 2 mm above it."""
+    for dz, touches in ((-0.002, True), (0.002, False)):
+        b = make_backend(WorldConfig(), 600.0, fixed_root=True)
+        b.reset(np.array([0.0, 0.0, STANDING_ROOT_HEIGHT_M + dz]), rot.IDENTITY_WXYZ)
+        b.step()
+        s = b.read_state(1 / 600)
+        b.close()
+        for side in ("left", "right"):
+            i = s.link(f"{side}_ankle")
+            corners = sole_corners_world(s.link_origin_world[i], s.link_quat_wxyz[i])
+            assert np.allclose(corners[:, 2], dz, atol=1e-3)
+        assert s.feet_pressing() == {"left": touches, "right": touches}

@@ -43,11 +43,18 @@ from stylesync.control.stable_pd import flatten_joint_values, unflatten_joint_va
 from stylesync.motion.reference import ReferencePose
 from stylesync.motion.stance_fsm import swing_side
 from stylesync.sim.backend import CharacterState, JointFeedback, MassProperties, Torques
-from stylesync.sim.character import ANKLE_HEIGHT_M, LINK_NAMES, N_DOFS
+from stylesync.sim.character import ANKLE_HEIGHT_M, LINK_NAMES, N_DOFS, ROOT_DOFS
 
 _FOOT_LINK = {s: LINK_NAMES.index(f"{s}_ankle") for s in ("left", "right")}
 GROUND_PRESS_M = 0.02  # a stance foot not yet touching is aimed this far below the ground [m]
 FOOT_TASK_WEIGHT = 100.0  # weight of that foot's height task against a joint's
+# A joint's desired acceleration is saturated at ControlConfig.joint_acceleration_limit_rad_s2 or, where higher, at
+# what this share of its torque limit gives its own inertia: the feet (0.001-0.005 kg·m²) were otherwise held to a
+# fraction of a N·m, and a swing foot whipped by its leg rolled over by up to 115°.
+JOINT_ACCEL_TORQUE_SHARE = 0.1
+# Each DOF's tracking weight M_ii is taken as at least this [kg·m²]: with the feet's own inertia, a swing foot's
+# tracking was the cheapest term to trade for the wrench, and it swung tilted by 20-100° and landed on an edge.
+MIN_TRACKING_INERTIA_KGM2 = 0.05
 
 
 class MomentumBalanceController(ControllerBase):
@@ -96,7 +103,10 @@ class MomentumBalanceController(ControllerBase):
         qdd_joint = kp * e + kd * (self._ref_vel - state.joint_vel)
         # Saturated: a jump of the reference (a stance change, a landing) would otherwise ask for accelerations
         # whose torques exceed the joints' limits, and the clipped torques no longer realise the planned forces.
-        qdd_joint = np.clip(qdd_joint, -cfg.joint_acceleration_limit_rad_s2, cfg.joint_acceleration_limit_rad_s2)
+        m_diag = np.diag(mass_matrix)
+        own = JOINT_ACCEL_TORQUE_SHARE * TORQUE_LIMIT / np.maximum(unflatten_joint_values(m_diag[ROOT_DOFS:]), 1e-6)
+        lim = np.maximum(cfg.joint_acceleration_limit_rad_s2, own)
+        qdd_joint = np.clip(qdd_joint, -lim, lim)
         # The pelvis orientation as a task of its own (the root virtual torque's PD law, per unit inertia): the
         # whole-body moment above leaves it free to turn against the legs. The root's linear acceleration has no
         # target (weight 0): the ground forces decide it.
@@ -104,7 +114,7 @@ class MomentumBalanceController(ControllerBase):
                                          yaw_scale=1.0)
         qdd_des = np.concatenate([np.zeros(3), alpha_root, flatten_joint_values(qdd_joint)])
         # Tracking errors weighed by each DOF's inertia, M_ii Δq̈_i².
-        weights = cfg.joint_tracking_weight * np.diag(mass_matrix)
+        weights = cfg.joint_tracking_weight * np.maximum(m_diag, MIN_TRACKING_INERTIA_KGM2)
         weights[:3] = 0.0
 
         # A stance foot that does not touch yet is lowered onto the ground (a foot no force is planned for would

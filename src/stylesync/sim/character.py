@@ -20,7 +20,7 @@ URDF_PATH_IN_PYBULLET_DATA = "humanoid/humanoid.urdf"
 URDF_GLOBAL_SCALING = 0.25  # the URDF is authored at 4x scale; DeepMimic loads it at 0.25
 CHARACTER_HEIGHT_M = 1.62  # Sec. 7.1
 CHARACTER_MASS_KG = 45.0  # Sec. 7.1
-STANDING_ROOT_HEIGHT_M = 0.895  # pelvis origin height with straight legs and feet flat [m]
+STANDING_ROOT_HEIGHT_M = 0.8814  # pelvis origin height with straight legs and feet flat [m] (hips at its height)
 
 # World orientation of the model's frame: +90 deg about x maps the URDF's +y (up) to world +z.
 Q_WORLD_MODEL = rot.quat_from_axis_angle(np.array([1.0, 0.0, 0.0]), np.pi / 2)
@@ -85,7 +85,8 @@ SIDES: tuple[str, str] = ("left", "right")
 # Segment geometry of the character [m] (joint offsets of the URDF times its 0.25 scaling).
 THIGH_LENGTH_M = 1.686184 * URDF_GLOBAL_SCALING
 SHANK_LENGTH_M = 1.639480 * URDF_GLOBAL_SCALING
-ANKLE_HEIGHT_M = 0.045 + 0.0225  # ankle joint above the sole with the foot flat [m]
+# The foot's box is 0.22 high and centred 0.09 below the ankle joint (model units): its sole is 0.2 below [m].
+ANKLE_HEIGHT_M = (0.09 + 0.22 / 2) * URDF_GLOBAL_SCALING  # ankle joint above the sole with the foot flat [m]
 HIP_HALF_WIDTH_M = 0.339548 * URDF_GLOBAL_SCALING
 FOOT_LENGTH_M = 0.708 * URDF_GLOBAL_SCALING  # Table 2: 0.18
 FOOT_WIDTH_M = 0.36 * URDF_GLOBAL_SCALING  # box x-extent 0.177, z-extent 0.09 (model axes)
