@@ -163,6 +163,9 @@ class MotionOptimizer:
         q_root_d = level_root(heading)
         R_root_d = rot.matrix_from_quat(q_root_d)
         a_h = {k: s.pos[f"ANKLE_{v}"] for k, v in _SIDE_UP.items()}
+        # The operator's feet the horizontal retargeting of Eq. 10 is anchored on: floor-filtered, as his COM
+        # (operator_processing.py).
+        a_hs = s.support_ankle_world
         a_c = {k: state.link_origin_world[_LINK[f"{k}_ankle"]].copy() for k in _SIDE_UP}
         # Planted feet are flat on the (level) ground: their ankle height is the model's, not the measured one,
         # which rises when a foot rolls and would feed back into the pelvis height of Eq. 9.
@@ -178,15 +181,15 @@ class MotionOptimizer:
         # says nothing of where his body is over the ground.
         anchor = ch_state if self.char_fsm.hold_reference else op_state
         if anchor is Stance.DS:
-            pelvis_xy = _heading_frame_fraction(p_h, a_h["left"], a_h["right"], a_c["left"], a_c["right"],
+            pelvis_xy = _heading_frame_fraction(p_h, a_hs["left"], a_hs["right"], a_c["left"], a_c["right"],
                                                 scale, heading)
-            com_xy = _heading_frame_fraction(com_h, a_h["left"], a_h["right"], a_c["left"], a_c["right"],
+            com_xy = _heading_frame_fraction(com_h, a_hs["left"], a_hs["right"], a_c["left"], a_c["right"],
                                              scale, heading)
             ankle_h_z = 0.5 * (a_h["left"][2] + a_h["right"][2])
         else:
             st = "left" if anchor is Stance.LS else "right"
-            pelvis_xy = a_c[st] + scale * (p_h - a_h[st])
-            com_xy = a_c[st] + scale * (com_h - a_h[st])
+            pelvis_xy = a_c[st] + scale * (p_h - a_hs[st])
+            com_xy = a_c[st] + scale * (com_h - a_hs[st])
             ankle_h_z = a_h[st][2]
         # A change of stance changes the anchor of Eq. 10 (the fraction between the feet, or the stance foot); the
         # operator's and the character's feet are never placed exactly alike, so the targets would jump. The jump

@@ -1,4 +1,4 @@
-"""The floor filter for the operator COM (Sec. 4.3).
+"""The floor filter for the operator COM (Sec. 4.3), also used on the ankles the COM is retargeted against.
 
 The paper sets "a threshold value for the floor range" of 0.01 m without defining the filter. We read it as a
 dead band per axis: the output stays put while the input lies within +/- threshold of it, and otherwise follows

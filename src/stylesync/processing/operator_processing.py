@@ -4,6 +4,11 @@ Per mocap frame: joints the sensor lost (confidence 0) keep their last valid val
 is computed from the joints (Eq. 6) and floor-filtered. Per control tick: everything is interpolated (Eq. 7) and
 joint values pass the 1€ filter (Eq. 8). Orientations are filtered component-wise after sign alignment and
 renormalised; positions (needed by the stance FSM and the pose optimisation) pass the same 1€ filter.
+
+The ankles are also floor-filtered, as the COM, into ``support_ankle_world``: the COM target of the balance control
+is the operator's COM placed relative to his feet (Eq. 10), and the feet's 1€-filtered jitter, a millimetre or
+two at a few Hz, would otherwise reach the balance control through them (a standing character then rocked from
+foot to foot by ±100 N at 4 Hz). The 1€-filtered ankles still drive the stance FSM and the swing foot.
 """
 
 from __future__ import annotations
@@ -21,6 +26,8 @@ from stylesync.processing.joint_map import TRACKED_ORIENTATIONS, TRACKED_POSITIO
 from stylesync.processing.one_euro import OneEuroFilter
 from stylesync.sources.frame import OperatorFrame
 
+_ANKLE = {"left": "ANKLE_LEFT", "right": "ANKLE_RIGHT"}
+
 
 @dataclass
 class OperatorSample:
@@ -30,6 +37,7 @@ class OperatorSample:
     quat: dict[str, np.ndarray]  # canonical world segment orientation per tracked joint
     pos: dict[str, np.ndarray]  # world position per tracked joint [m]
     com_world: np.ndarray  # (3,) floor-filtered, interpolated operator COM [m]
+    support_ankle_world: dict[str, np.ndarray]  # "left"/"right": floor-filtered, interpolated ankle [m]
     mocap_time_s: float  # timestamp of the newest mocap frame used
 
 
@@ -43,6 +51,7 @@ class OperatorProcessing:
         self._p_filter = OneEuroFilter(period, filters.one_euro_min_cutoff_hz, filters.one_euro_beta,
                                        filters.one_euro_derivative_cutoff_hz)
         self._floor = FloorFilter(filters.floor_threshold_m)
+        self._ankle_floor = {side: FloorFilter(filters.floor_threshold_m) for side in _ANKLE}
         self._last_q: np.ndarray | None = None
         self._last_p: np.ndarray | None = None
         self._q_prev_out: np.ndarray | None = None
@@ -79,10 +88,12 @@ class OperatorProcessing:
         self._q_prev_out = q
         pc = self._pramp.step()
         p, com = self._p_filter(pc[:-1].reshape(-1)).reshape(-1, 3), pc[-1]
+        pos = dict(zip(TRACKED_POSITIONS, p, strict=True))
         return OperatorSample(
             time_s=time_s,
             quat=dict(zip(TRACKED_ORIENTATIONS, q, strict=True)),
-            pos=dict(zip(TRACKED_POSITIONS, p, strict=True)),
+            pos=pos,
             com_world=com,
+            support_ankle_world={side: self._ankle_floor[side](pos[name]) for side, name in _ANKLE.items()},
             mocap_time_s=self.mocap_time_s,
         )
