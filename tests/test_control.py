@@ -133,8 +133,9 @@ def _standing_run(duration_s: float, **options):
     return com, feet
 
 
-def test_free_character_stands_still_with_a_standing_operator():
-    com, _ = _standing_run(10.0)
+def test_free_character_stands_60_s_within_2_cm_with_a_standing_operator():
+    # The acceptance figure with the default configuration (measured: 1.4 cm).
+    com, _ = _standing_run(60.0)
     assert np.linalg.norm(com - com[0], axis=1).max() < 0.02
 
 
