@@ -5,10 +5,10 @@ is computed from the joints (Eq. 6) and floor-filtered. Per control tick: everyt
 joint values pass the 1€ filter (Eq. 8). Orientations are filtered component-wise after sign alignment and
 renormalised; positions (needed by the stance FSM and the pose optimisation) pass the same 1€ filter.
 
-The ankles are also floor-filtered, as the COM, into ``support_ankle_world``: the COM target of the balance control
-is the operator's COM placed relative to his feet (Eq. 10), and the feet's 1€-filtered jitter, a millimetre or
-two at a few Hz, would otherwise reach the balance control through them (a standing character then rocked from
-foot to foot by ±100 N at 4 Hz). The 1€-filtered ankles still drive the stance FSM and the swing foot.
+The 1€-filtered ankles are also floor-filtered, as the COM, into ``support_ankle_world``: the COM target of the
+balance control is the operator's COM placed relative to his feet (Eq. 10), and the feet's 1€-filtered jitter, a
+millimetre or two at a few Hz, would otherwise reach the balance control through them (a standing character then
+rocked from foot to foot by ±100 N at 4 Hz). The 1€-filtered ankles still drive the stance FSM and the swing foot.
 """
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ class OperatorSample:
     quat: dict[str, np.ndarray]  # canonical world segment orientation per tracked joint
     pos: dict[str, np.ndarray]  # world position per tracked joint [m]
     com_world: np.ndarray  # (3,) floor-filtered, interpolated operator COM [m]
-    support_ankle_world: dict[str, np.ndarray]  # "left"/"right": floor-filtered, interpolated ankle [m]
+    support_ankle_world: dict[str, np.ndarray]  # "left"/"right": the 1€-filtered ankle, then floor-filtered [m]
     mocap_time_s: float  # timestamp of the newest mocap frame used
 
 
