@@ -26,7 +26,7 @@ def ipm_ankle_moments(com_desired: np.ndarray, ankle_pos: dict[str, np.ndarray],
                       mass_kg: float, gravity_mps2: float, foot_yaw_rad: dict[str, float] | None = None) -> np.ndarray:
     """Eq. 20 as world moments on the stance ankle joints, (n_joints, 3) [N·m].
 
-    d_C is taken from each foot's support point (gravity_compensation.support_point) rather than from each ankle:
+    d_C is taken from each foot's support point (support.support_point) rather than from each ankle:
     identical in single stance; in double stance it keeps the two ankles from pushing the body sideways against
     each other (the paper's single-ankle form would put ±m g w/2 lateral torques on feet that already carry
     their share directly below them). With the feet's headings the point is kept on the sole: a larger ankle

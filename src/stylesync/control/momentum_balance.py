@@ -62,6 +62,9 @@ class MomentumBalanceController(ControllerBase):
                  control_dt_s: float, bounds: bnd.BoundsMonitor | None = None, friction: float = 0.9):
         super().__init__(cfg, mass, gravity_mps2, physics_dt_s, control_dt_s, bounds, friction)
         self._tau = Torques.zeros()  # held from one control tick to the next [N·m]
+        self._g_vec = np.array([0.0, 0.0, gravity_mps2])
+        # Weights of the wrench rows (force, moment) in the plan (inverse_dynamics.solve_with_contact_forces).
+        self._wrench_row_weights = np.array([1.0, 1.0, 1.0, *(3 * [cfg.momentum_moment_weight_per_m])])
 
     def update(self, state: CharacterState, ref: ReferencePose, mass_matrix: np.ndarray) -> None:
         cfg = self.cfg
@@ -91,7 +94,6 @@ class MomentumBalanceController(ControllerBase):
             force += f_lipm
         moment = root_virtual_torque(ref.root_quat_wxyz, state.root_quat_wxyz, state.root_ang_vel_world,
                                      cfg.momentum_root_kp, cfg.momentum_root_kd, cfg.root_yaw_gain_scale)
-        g_vec = np.array([0.0, 0.0, self.g])
 
         qd = np.concatenate([state.root_lin_vel_world, state.root_ang_vel_world,
                              flatten_joint_values(state.joint_vel)])
@@ -148,11 +150,10 @@ class MomentumBalanceController(ControllerBase):
             b_force = np.hstack(cols)
         j_c = np.vstack(contact_rows) if contact_rows else np.zeros((0, N_DOFS))
         contact_accel = -cfg.contact_velocity_gain * (j_c @ qd)
-        bias = jac.mass_weighted_linear(state.link_com_world, self.mass.link_mass_kg).T @ g_vec  # gravity
-        row_w = np.array([1.0, 1.0, 1.0, *(3 * [cfg.momentum_moment_weight_per_m])])
+        bias = jac.mass_weighted_linear(state.link_com_world, self.mass.link_mass_kg).T @ self._g_vec  # gravity
         qdd, lam = solve_with_contact_forces(
             mass_matrix, bias, b_force, j_c, contact_accel, qdd_des, weights, wrench,
-            np.concatenate([force + m * g_vec, moment]), row_w, regularisation(corners, w),
+            np.concatenate([force + m * self._g_vec, moment]), self._wrench_row_weights, regularisation(corners, w),
             np.array(task_rows).reshape(-1, N_DOFS), np.array(task_acc), FOOT_TASK_WEIGHT)
         tau = unflatten_joint_values(joint_torques(mass_matrix, bias, b_force @ lam, qdd))
         tau[~IS_BALL, 1:] = 0.0

@@ -67,15 +67,14 @@ _LINK = {n: i for i, n in enumerate(LINK_NAMES)}
 CHAR_LEG_LENGTH_M = THIGH_LENGTH_M + SHANK_LENGTH_M
 
 
-def _heading_frame_fraction(p_h, al_h, ar_h, al_c, ar_c, scale: float, heading: float) -> np.ndarray:
-    """Eq. 10 (fraction reading) in the heading frame, horizontal components only.
+def _heading_frame_fraction(p_h, al_h, ar_h, al_c, ar_c, scale: float, R: np.ndarray) -> np.ndarray:
+    """Eq. 10 (fraction reading) in the heading frame (world rotation ``R``), horizontal components only.
 
     Along an axis where the feet are close together the fraction is ill-defined; there the operator's offset from
     the ankle midpoint, scaled, is used. The two are blended by how far apart the feet are (the lesser of the
     operator's and the character's spread, from _MIN_AXIS_SPREAD_M / 2 to _MIN_AXIS_SPREAD_M * 1.5), so that the
     target does not jump when a swing foot passes the stance foot.
     """
-    R = rot.matrix_from_quat(rot.quat_from_yaw(heading))
     ph, lh, rh = (R.T @ np.asarray(v) for v in (p_h, al_h, ar_h))
     lc, rc = (R.T @ np.asarray(v) for v in (al_c, ar_c))
     out = np.zeros(3)
@@ -120,6 +119,8 @@ class MotionOptimizer:
         self.bounds = bounds if bounds is not None else BoundsMonitor()
         self._anchor_stance: Stance | None = None
         self._anchor_offset = np.zeros((2, 2))  # (pelvis, COM) x (x, y) [m]
+        self._anchor_decay = np.exp(-self.dt_s / ANCHOR_BLEND_S)  # per tick
+        self._swing_decay = np.exp(-self.dt_s / SWING_BLEND_S)  # per tick
         self._last_xy: np.ndarray | None = None
         self._swing: str | None = None
         self._swing_offset = np.zeros(2)  # lift-off foot position minus the first swing target, decaying [m]
@@ -182,9 +183,9 @@ class MotionOptimizer:
         anchor = ch_state if self.char_fsm.hold_reference else op_state
         if anchor is Stance.DS:
             pelvis_xy = _heading_frame_fraction(p_h, a_hs["left"], a_hs["right"], a_c["left"], a_c["right"],
-                                                scale, heading)
+                                                scale, R_root_d)
             com_xy = _heading_frame_fraction(com_h, a_hs["left"], a_hs["right"], a_c["left"], a_c["right"],
-                                             scale, heading)
+                                             scale, R_root_d)
             ankle_h_z = 0.5 * (a_h["left"][2] + a_h["right"][2])
         else:
             st = "left" if anchor is Stance.LS else "right"
@@ -197,7 +198,7 @@ class MotionOptimizer:
         if anchor is not self._anchor_stance and self._last_xy is not None:
             self._anchor_offset += self._last_xy - np.stack([pelvis_xy[:2], com_xy[:2]])
         self._anchor_stance = anchor
-        self._anchor_offset *= np.exp(-self.dt_s / ANCHOR_BLEND_S)
+        self._anchor_offset *= self._anchor_decay
         pelvis_xy = np.array([*(pelvis_xy[:2] + self._anchor_offset[0]), 0.0])
         com_xy = np.array([*(com_xy[:2] + self._anchor_offset[1]), 0.0])
         self._last_xy = np.stack([pelvis_xy[:2], com_xy[:2]])
@@ -270,7 +271,7 @@ class MotionOptimizer:
                 if self._swing != side:
                     self._swing_offset = a_c[side][:2] - target[:2]
                     self._swing_t0_s = state.time_s
-                self._swing_offset *= np.exp(-self.dt_s / SWING_BLEND_S)
+                self._swing_offset *= self._swing_decay
                 target[:2] += self._swing_offset
                 foot_yaw[side] = rot.twist_angle(s.quat[f"ANKLE_{_SIDE_UP[side]}"], _UP)
             else:
