@@ -26,12 +26,9 @@ import numpy as np  # noqa: E402
 from stylesync import rotations as rot  # noqa: E402
 from stylesync.config import OperatorConfig, SessionConfig  # noqa: E402
 from stylesync.experiments.common import run_session  # noqa: E402
-from stylesync.experiments.scripted_operator import (  # noqa: E402
-    pose_frame,
-    smooth_step,
-    standing_ankles,
-)
+from stylesync.experiments.scripted_operator import pose_frame, standing_ankles  # noqa: E402
 from stylesync.metrics.plots import plan_view, save_figure  # noqa: E402
+from stylesync.processing.interpolation import smooth_step  # noqa: E402
 from stylesync.session import Session  # noqa: E402
 from stylesync.sim.disturbance import BALL_MASS_KG, throw_ball_at_chest  # noqa: E402
 from stylesync.sources.builtin_operator import sensed  # noqa: E402

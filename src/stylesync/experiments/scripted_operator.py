@@ -16,13 +16,6 @@ from stylesync.sources.frame import OperatorFrame
 from stylesync.sources.human_model import HumanModel
 
 _Y = np.array([0.0, 1.0, 0.0])
-REACTION_S = 0.0  # the operator sees the ball coming: his response starts when it is thrown [s]
-
-
-def smooth_step(x: float) -> float:
-    """0 -> 1 with zero slope at both ends (x clamped to [0, 1])."""
-    x = min(max(x, 0.0), 1.0)
-    return x * x * (3.0 - 2.0 * x)
 
 
 def sagittal_leg(human: HumanModel, ankle_rel_hip_m: np.ndarray) -> dict[str, float]:

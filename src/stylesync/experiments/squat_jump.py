@@ -22,10 +22,11 @@ import numpy as np  # noqa: E402
 
 from stylesync.config import OperatorConfig, SessionConfig  # noqa: E402
 from stylesync.experiments.common import run_session  # noqa: E402
-from stylesync.experiments.scripted_operator import pose_frame, smooth_step, standing_ankles  # noqa: E402
+from stylesync.experiments.scripted_operator import pose_frame, standing_ankles  # noqa: E402
 from stylesync.metrics.plots import save_figure  # noqa: E402
 from stylesync.metrics.summary import summarize  # noqa: E402
 from stylesync.motion.stance_fsm import Stance  # noqa: E402
+from stylesync.processing.interpolation import smooth_step  # noqa: E402
 from stylesync.session import STANCE_CODE, Session  # noqa: E402
 from stylesync.sources.builtin_operator import builtin_operator, sensed  # noqa: E402
 from stylesync.sources.deepmimic_clip import DeepMimicClip  # noqa: E402

@@ -34,6 +34,7 @@ from stylesync.motion.stance_fsm import (
 )
 from stylesync.motion.style_features import StyleExtractor, StyleFeatures
 from stylesync.processing.body_parameters import leg_length_m
+from stylesync.processing.interpolation import smooth_step
 from stylesync.processing.joint_map import hinge_angle, local_rotation
 from stylesync.processing.operator_processing import OperatorSample
 from stylesync.sim.backend import CharacterState, MassProperties
@@ -247,8 +248,7 @@ class MotionOptimizer:
                     out = 1.0 if side == "left" else -1.0
                     land[1] = out * min(max(out * land[1], cfg.step_outside_capture_point_m[0]),
                                         cfg.step_outside_capture_point_m[1])
-                    u = min((state.time_s - self._swing_t0_s) / self._op_swing_s, 1.0)
-                    progress = u * u * (3.0 - 2.0 * u)
+                    progress = smooth_step((state.time_s - self._swing_t0_s) / self._op_swing_s)
                     target[:2] = (from_stance + progress * (xi_c + R_root_d @ land - from_stance))[:2]
                 else:
                     target[:2] = (state.root_pos_world + scale * (a_h[side] - p_h))[:2]

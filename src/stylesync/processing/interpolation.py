@@ -15,6 +15,12 @@ import numpy as np
 from stylesync import rotations as rot
 
 
+def smooth_step(x: float) -> float:
+    """0 -> 1 with zero slope at both ends (x clamped to [0, 1])."""
+    x = min(max(x, 0.0), 1.0)
+    return x * x * (3.0 - 2.0 * x)
+
+
 class LinearRamp:
     """Eq. 7 for a vector of scalars (positions [m], angles [rad])."""
 
