@@ -41,8 +41,7 @@ def cross(a, b) -> Array:
         ax, ay, az = a.tolist()
         bx, by, bz = b.tolist()
         return np.array([ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx])
-    a, b = np.broadcast_arrays(a, b)
-    out = np.empty(a.shape)
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
     out[..., 0] = a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1]
     out[..., 1] = a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2]
     out[..., 2] = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
@@ -165,14 +164,18 @@ def quat_from_yaw(yaw_rad: float) -> Array:
 
 def swing_twist(q: Array, axis: Array) -> tuple[Array, Array]:
     """Split q = swing ⊗ twist, twist being the rotation of q about ``axis`` (unit, in q's frame)."""
-    axis = np.asarray(axis, dtype=float)
-    p = float(np.dot(q[1:], axis)) * axis
-    twist = np.array([q[0], p[0], p[1], p[2]])
-    if np.linalg.norm(twist) < 1e-12:
-        twist = IDENTITY_WXYZ.copy()
-    twist = normalize(twist)
-    swing = multiply(q, conjugate(twist))
-    return swing, twist
+    w, x, y, z = np.asarray(q, dtype=float).tolist()
+    ax, ay, az = np.asarray(axis, dtype=float).tolist()
+    p = x * ax + y * ay + z * az
+    n = math.sqrt(w * w + p * p * (ax * ax + ay * ay + az * az))
+    if n < 1e-12:
+        tw, tx, ty, tz = 1.0, 0.0, 0.0, 0.0
+    else:
+        tw, tx, ty, tz = w / n, p * ax / n, p * ay / n, p * az / n
+    # swing = q ⊗ conj(twist)
+    swing = np.array([w * tw + x * tx + y * ty + z * tz, -w * tx + x * tw - y * tz + z * ty,
+                      -w * ty + x * tz + y * tw - z * tx, -w * tz - x * ty + y * tx + z * tw])
+    return swing, np.array([tw, tx, ty, tz])
 
 
 def twist_angle(q: Array, axis: Array) -> float:
@@ -242,12 +245,11 @@ def batch_conjugate(q: Array) -> Array:
 
 def batch_rotvec(q: Array) -> Array:
     """Log map of each row (shortest rotation), (n, 4) -> (n, 3) [rad]."""
-    q = np.where(q[:, :1] < 0, -q, q)
-    v = q[:, 1:]
-    s = np.linalg.norm(v, axis=1)
-    angle = 2.0 * np.arctan2(s, q[:, 0])
+    w, v = q[:, 0], q[:, 1:]
+    s = np.sqrt(np.einsum("ij,ij->i", v, v))
+    angle = 2.0 * np.arctan2(s, np.abs(w))  # of q or -q, whichever has w >= 0
     scale = np.where(s > 1e-12, angle / np.maximum(s, 1e-12), 2.0)
-    return v * scale[:, None]
+    return v * np.copysign(scale, w)[:, None]
 
 
 def batch_quat_from_rotvec(v: Array) -> Array:

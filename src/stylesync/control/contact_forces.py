@@ -12,6 +12,8 @@ as its stance weight falls, so that a foot about to lift off is unloaded before 
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from stylesync import rotations as rot
@@ -43,21 +45,35 @@ def sole_touches(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray, pressing: 
     return pressing or (gap_m > 0 and float(sole_corners_world(ankle_world, foot_quat_wxyz)[:, 2].min()) < gap_m)
 
 
-def pyramid_edges(friction: float) -> np.ndarray:
-    """(4, 3) unit edges of the linearised friction cone of a flat ground."""
+@functools.lru_cache(maxsize=8)
+def _pyramid(friction: float) -> tuple[np.ndarray, np.ndarray]:
+    """The pyramid's unit edges (4, 3) and the rows (12, 3) of the map l -> (l × β_e)_e for a lever arm l."""
     mu = FRICTION_MARGIN * friction
     e = np.column_stack([mu * _EDGE_DIRS, np.ones(4)])
-    return e / np.linalg.norm(e, axis=1, keepdims=True)
+    e /= np.linalg.norm(e, axis=1, keepdims=True)
+    # l × β = Σ_i l_i (e_i × β): columns e_i × β, edge by edge
+    moment_rows = np.concatenate([np.cross(np.eye(3), b).T for b in e])
+    e.setflags(write=False)
+    moment_rows.setflags(write=False)
+    return e, moment_rows
+
+
+def pyramid_edges(friction: float) -> np.ndarray:
+    """(4, 3) unit edges of the linearised friction cone of a flat ground."""
+    return _pyramid(friction)[0]
 
 
 def wrench_basis(com_world: np.ndarray, corners_world: dict[str, np.ndarray],
                  friction: float) -> tuple[np.ndarray, np.ndarray]:
     """The pyramid's unit edges (4, 3), the same at every corner, and the wrench about the COM of each edge's unit
     force, A (6, n_λ): n_λ = 16 per foot, feet in ``corners_world`` order, corner by corner, edge by edge."""
-    edges = pyramid_edges(friction)
-    dirs = np.tile(edges, (4 * len(corners_world), 1))
-    points = np.concatenate([np.repeat(c, 4, axis=0) for c in corners_world.values()])
-    return edges, np.concatenate([dirs, rot.cross(points - com_world, dirs)], axis=1).T
+    edges, moment_rows = _pyramid(friction)
+    levers = np.concatenate(list(corners_world.values())) - com_world  # (n_corners, 3)
+    n = 4 * len(levers)
+    out = np.empty((6, n))
+    out[:3] = np.tile(edges.T, len(levers))
+    out[3:] = (levers @ moment_rows.T).reshape(n, 3).T
+    return edges, out
 
 
 def feasible_horizontal_force(force_n: np.ndarray, com_world: np.ndarray, corners_world: dict[str, np.ndarray],

@@ -43,6 +43,12 @@ def _skew(v: np.ndarray) -> np.ndarray:
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 
+# (n_links, 3 + N_JOINT_DOFS): 1 where a rotational column (root ω x, y, z, then the joint DOFs) moves the link.
+_COLUMN_MOVES = np.hstack([np.ones((len(LINK_NAMES), 3)), MOVES.astype(float)])
+_EYE3 = np.eye(3)
+_SKEW_OF = np.array([_skew(e).reshape(9) for e in _EYE3])  # (3, 9): a @ _SKEW_OF is [a]× flattened (linear in a)
+
+
 class FloatingJacobians:
     """The DOF axes and origins of one instant; Jacobians of points, of the COM and the gravity force."""
 
@@ -53,6 +59,14 @@ class FloatingJacobians:
         self.axis_world = axes  # (N_JOINT_DOFS, 3)
         self.origin_world = frames.origin[DOF_JOINT]  # (N_JOINT_DOFS, 3)
         self.root_world = np.asarray(state.root_pos_world, dtype=float)
+        # Every rotational column (the root's angular velocity about x, y, z, then the joint DOFs) is an axis a
+        # about a point o: its skew matrices stacked by rows (3 K, 3) and its a × o (K, 3), for points_linear.
+        a = np.concatenate([_EYE3, axes])
+        o = np.concatenate([np.broadcast_to(self.root_world, (3, 3)), self.origin_world])
+        skew = (a @ _SKEW_OF).reshape(-1, 3, 3)
+        self._skew_rows = skew.reshape(-1, 3)
+        self._rot_axes = a
+        self._a_cross_o = np.einsum("kij,kj->ki", skew, o)
 
     def point_linear(self, link: int, p_world: np.ndarray) -> np.ndarray:
         """(3, N_DOFS) Jacobian of the world velocity of point ``p_world`` fixed on link ``link``."""
@@ -61,28 +75,17 @@ class FloatingJacobians:
     def points_linear(self, link: int, p_world: np.ndarray) -> np.ndarray:
         """(n, 3, N_DOFS) Jacobians of the world velocities of points ``p_world`` (n, 3) fixed on link ``link``."""
         n = p_world.shape[0]
-        j = np.zeros((n, 3, N_DOFS))
-        j[:, :, :3] = np.eye(3)
-        r = p_world - self.root_world  # ω_root × r = -[r]× ω_root
-        j[:, 0, 4], j[:, 0, 5] = r[:, 2], -r[:, 1]
-        j[:, 1, 3], j[:, 1, 5] = -r[:, 2], r[:, 0]
-        j[:, 2, 3], j[:, 2, 4] = r[:, 1], -r[:, 0]
-        m = np.flatnonzero(MOVES[link])
-        axes, origins = self.axis_world[m], self.origin_world[m]  # (k, 3)
-        lx, ly, lz = (p_world[:, None, i] - origins[None, :, i] for i in range(3))  # lever arms, (n, k) each
-        ax, ay, az = axes[:, 0], axes[:, 1], axes[:, 2]
-        cols = ROOT_DOFS + m
-        j[:, 0, cols] = ay * lz - az * ly  # a_d × (p - o_d)
-        j[:, 1, cols] = az * lx - ax * lz
-        j[:, 2, cols] = ax * ly - ay * lx
+        # a × (p - o) = [a]× p - a × o for every rotational column at once, those not moving the link zeroed.
+        rot_cols = (p_world @ self._skew_rows.T).reshape(n, -1, 3) - self._a_cross_o
+        j = np.empty((n, 3, N_DOFS))
+        j[:, :, :3] = _EYE3
+        j[:, :, 3:] = (rot_cols * _COLUMN_MOVES[link][None, :, None]).transpose(0, 2, 1)
         return j
 
     def angular(self, link: int) -> np.ndarray:
         """(3, N_DOFS) Jacobian of link ``link``'s world angular velocity."""
         j = np.zeros((3, N_DOFS))
-        j[:, 3:6] = np.eye(3)
-        m = MOVES[link]
-        j[:, ROOT_DOFS:][:, m] = self.axis_world[m].T
+        j[:, 3:] = self._rot_axes.T * _COLUMN_MOVES[link]
         return j
 
     def mass_weighted_linear(self, link_com_world: np.ndarray, link_mass_kg: np.ndarray) -> np.ndarray:

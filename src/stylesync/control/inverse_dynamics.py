@@ -15,6 +15,7 @@ feedback, as Eq. 14-15 do.
 from __future__ import annotations
 
 import numpy as np
+from scipy.linalg import lapack
 from scipy.optimize import nnls
 
 from stylesync.sim.character import N_DOFS, ROOT_DOFS
@@ -50,16 +51,18 @@ def solve_with_contact_forces(mass_matrix: np.ndarray, bias_force: np.ndarray, f
     kkt[:N_DOFS, N_DOFS:] = a_eq.T
     kkt[N_DOFS:, :N_DOFS] = a_eq
     n_lam = force_basis.shape[1]
-    rhs = np.zeros((N_DOFS + k, 1 + n_lam))
+    # Right-hand sides: the one of λ = 0, and a unit one per root row. λ enters only through the root rows,
+    # (B λ)_root, so P = K⁻¹ [0; B_root; 0] is the solutions of the unit sides times B_root: 7 sides to solve
+    # instead of 1 + n_λ.
+    rhs = np.zeros((N_DOFS + k, 1 + ROOT_DOFS))
     rhs[:N_DOFS, 0] = weights * qdd_desired + task_weight * task_jacobian.T @ task_accel
     rhs[N_DOFS:N_DOFS + ROOT_DOFS, 0] = -bias_force[:ROOT_DOFS]
     rhs[N_DOFS + ROOT_DOFS:, 0] = contact_accel
-    rhs[N_DOFS:N_DOFS + ROOT_DOFS, 1:] = force_basis[:ROOT_DOFS]
-    try:
-        sol = np.linalg.solve(kkt, rhs)
-    except np.linalg.LinAlgError:
+    rhs[N_DOFS:N_DOFS + ROOT_DOFS, 1:] = np.eye(ROOT_DOFS)
+    *_, sol, info = lapack.dgesv(kkt, rhs)  # LAPACK's LU solve without numpy's wrapper (a control-tick cost)
+    if info != 0:  # singular (or a bad argument): the least-squares solution
         sol = np.linalg.lstsq(kkt, rhs, rcond=None)[0]
-    r, p = sol[:N_DOFS, 0], sol[:N_DOFS, 1:]
+    r, p = sol[:N_DOFS, 0], sol[:N_DOFS, 1:] @ force_basis[:ROOT_DOFS]
     if n_lam == 0:  # no support: the accelerations follow from the root's rows alone
         return r, np.zeros(0)
     sw = np.sqrt(weights)

@@ -82,7 +82,7 @@ class MomentumBalanceController(ControllerBase):
         # The pelvis height above the supporting ankles as they are (a loaded sole sinks into the ground's spring
         # by a centimetre or two; a target above the reach of straight legs could only be met by flailing).
         support = [s for s, ws in w.items() if ws > 0]
-        ankle_z = (float(np.mean([state.link_origin_world[_FOOT_LINK[s]][2] for s in support])) if support
+        ankle_z = (sum(float(state.link_origin_world[_FOOT_LINK[s], 2]) for s in support) / len(support) if support
                    else ANKLE_HEIGHT_M)
         pelvis_z_d = ref.pelvis_world[2] - ANKLE_HEIGHT_M + ankle_z
         force[2] = m * (cfg.com_force_kp_npm * (pelvis_z_d - state.root_pos_world[2])
@@ -144,9 +144,11 @@ class MomentumBalanceController(ControllerBase):
             cols = []
             for side, pts in corners.items():
                 link = _FOOT_LINK[side]
+                j_pts = jac.points_linear(link, pts)  # (4, 3, N_DOFS)
                 # B's columns: J(p_c)^T β_e, corner by corner, edge by edge (contact_forces.wrench_basis's order)
-                cols.append(np.einsum("cjd,ej->dce", jac.points_linear(link, pts), edges).reshape(N_DOFS, -1))
-                contact_rows += [jac.point_linear(link, pts.mean(axis=0)), jac.angular(link)]
+                cols.append((edges @ j_pts).transpose(2, 0, 1).reshape(N_DOFS, -1))
+                # The sole centre's Jacobian: the mean of the corners' (a point's Jacobian is affine in the point).
+                contact_rows += [j_pts.mean(axis=0), jac.angular(link)]
             b_force = np.hstack(cols)
         j_c = np.vstack(contact_rows) if contact_rows else np.zeros((0, N_DOFS))
         contact_accel = -cfg.contact_velocity_gain * (j_c @ qd)

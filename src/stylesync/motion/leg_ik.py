@@ -7,6 +7,7 @@ from the distal to the proximal joint and "left" along N; the knee hinge turns a
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -18,6 +19,7 @@ from stylesync import rotations as rot
 # MAX_REACH (knee about 0.2 rad), which keeps the reference smooth and the knee off its lock.
 SOFT_REACH_START = 0.97
 MAX_REACH = 0.995
+_MINUS_LEFT = np.array([0.0, -1.0, 0.0])  # the knee hinge's axis in the thigh's canonical frame
 
 
 def soft_reach(dist_m: float, leg_m: float) -> float:
@@ -25,7 +27,7 @@ def soft_reach(dist_m: float, leg_m: float) -> float:
     d0, d1 = SOFT_REACH_START * leg_m, MAX_REACH * leg_m
     if dist_m <= d0:
         return dist_m
-    return d0 + (d1 - d0) * float(np.tanh((dist_m - d0) / (d1 - d0)))
+    return d0 + (d1 - d0) * math.tanh((dist_m - d0) / (d1 - d0))
 
 
 @dataclass(frozen=True)
@@ -37,33 +39,46 @@ class LegIkSolution:
     ankle_world: np.ndarray  # reached ankle position (the target, moved within reach) [m]
 
 
-def _frame(up: np.ndarray, left: np.ndarray) -> np.ndarray:
-    left = left - np.dot(left, up) * up
-    left /= np.linalg.norm(left)
-    return np.column_stack([rot.cross(left, up), left, up])
+def _quat_of_frame(up: tuple[float, float, float], left: tuple[float, float, float]) -> np.ndarray:
+    """Canonical segment orientation (w, x, y, z) of the frame whose columns are (left × up, left, up), ``left``
+    first made orthogonal to the unit ``up`` and normalised. Python floats: this runs four times per control tick."""
+    ux, uy, uz = up
+    lx, ly, lz = left
+    d = lx * ux + ly * uy + lz * uz
+    lx, ly, lz = lx - d * ux, ly - d * uy, lz - d * uz
+    n = math.sqrt(lx * lx + ly * ly + lz * lz)
+    lx, ly, lz = lx / n, ly / n, lz / n
+    fx, fy, fz = ly * uz - lz * uy, lz * ux - lx * uz, lx * uy - ly * ux
+    return rot.quat_from_matrix(np.array([[fx, lx, ux], [fy, ly, uy], [fz, lz, uz]]))
 
 
 def solve_leg(hip: np.ndarray, ankle_target: np.ndarray, thigh_m: float, shank_m: float,
               plane_normal: np.ndarray) -> LegIkSolution:
-    hip = np.asarray(hip, dtype=float)
-    d = np.asarray(ankle_target, dtype=float) - hip
-    dist = float(np.linalg.norm(d))
+    hx, hy, hz = np.asarray(hip, dtype=float).tolist()
+    tx, ty, tz = np.asarray(ankle_target, dtype=float).tolist()
+    dx, dy, dz = tx - hx, ty - hy, tz - hz
+    dist = math.sqrt(dx * dx + dy * dy + dz * dz)
     lo = abs(thigh_m - shank_m) + 1e-4
-    u = d / dist if dist > 1e-9 else np.array([0.0, 0.0, -1.0])
+    ux, uy, uz = (dx / dist, dy / dist, dz / dist) if dist > 1e-9 else (0.0, 0.0, -1.0)
     dist = max(soft_reach(dist, thigh_m + shank_m), lo)
-    n = np.asarray(plane_normal, dtype=float)
-    n = n - np.dot(n, u) * u
-    if np.linalg.norm(n) < 1e-6:
-        n = rot.cross(u, np.array([1.0, 0.0, 0.0]))
-    n /= np.linalg.norm(n)
-    v = rot.cross(u, n)  # in-plane, forward of the hip-ankle line
+    nx, ny, nz = np.asarray(plane_normal, dtype=float).tolist()
+    d = nx * ux + ny * uy + nz * uz
+    nx, ny, nz = nx - d * ux, ny - d * uy, nz - d * uz
+    n = math.sqrt(nx * nx + ny * ny + nz * nz)
+    if n < 1e-6:  # the plane's normal along the hip-ankle line: any plane through it, u × x̂
+        nx, ny, nz = 0.0, uz, -uy
+        n = math.sqrt(ny * ny + nz * nz)
+    nx, ny, nz = nx / n, ny / n, nz / n
+    vx, vy, vz = uy * nz - uz * ny, uz * nx - ux * nz, ux * ny - uy * nx  # in-plane, forward of the hip-ankle line
     cos_a = (thigh_m**2 + dist**2 - shank_m**2) / (2 * thigh_m * dist)
-    alpha = float(np.arccos(np.clip(cos_a, -1.0, 1.0)))
-    knee = hip + thigh_m * (np.cos(alpha) * u + np.sin(alpha) * v)
-    ankle = hip + dist * u
-    R_thigh = _frame((hip - knee) / thigh_m, n)
-    R_shank = _frame((knee - ankle) / shank_m, n)
-    q_thigh, q_shank = rot.quat_from_matrix(R_thigh), rot.quat_from_matrix(R_shank)
+    alpha = math.acos(min(max(cos_a, -1.0), 1.0))
+    ca, sa = math.cos(alpha), math.sin(alpha)
+    kx, ky, kz = (hx + thigh_m * (ca * ux + sa * vx), hy + thigh_m * (ca * uy + sa * vy),
+                  hz + thigh_m * (ca * uz + sa * vz))
+    ax, ay, az = hx + dist * ux, hy + dist * uy, hz + dist * uz
+    normal = (nx, ny, nz)
+    q_thigh = _quat_of_frame(((hx - kx) / thigh_m, (hy - ky) / thigh_m, (hz - kz) / thigh_m), normal)
+    q_shank = _quat_of_frame(((kx - ax) / shank_m, (ky - ay) / shank_m, (kz - az) / shank_m), normal)
     q_rel = rot.multiply(rot.conjugate(q_thigh), q_shank)
-    knee_angle = rot.twist_angle(q_rel, np.array([0.0, -1.0, 0.0]))
-    return LegIkSolution(q_thigh, q_shank, knee_angle, knee, ankle)
+    knee_angle = rot.twist_angle(q_rel, _MINUS_LEFT)
+    return LegIkSolution(q_thigh, q_shank, knee_angle, np.array([kx, ky, kz]), np.array([ax, ay, az]))

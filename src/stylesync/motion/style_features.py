@@ -10,6 +10,7 @@ The same extractor serves the operator and the character, so their features can 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -39,16 +40,20 @@ ROW_NAMES = ["T_l", "T_r", "N_l_x", "N_l_y", "N_l_z", "N_r_x", "N_r_y", "N_r_z",
 
 
 def leg_plane_normal(hip, knee, ankle, fallback: np.ndarray) -> np.ndarray:
-    a = np.asarray(knee) - np.asarray(hip)
-    b = np.asarray(ankle) - np.asarray(knee)
-    n = rot.cross(a, b)
-    s = np.linalg.norm(n)
-    if s < _MIN_PLANE_SINE * np.linalg.norm(a) * np.linalg.norm(b) or s < 1e-9:
+    hx, hy, hz = np.asarray(hip, dtype=float).tolist()  # Python floats: per control tick, two legs
+    kx, ky, kz = np.asarray(knee, dtype=float).tolist()
+    ax_, ay_, az_ = np.asarray(ankle, dtype=float).tolist()
+    a = (kx - hx, ky - hy, kz - hz)
+    b = (ax_ - kx, ay_ - ky, az_ - kz)
+    nx, ny, nz = a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]
+    s = math.sqrt(nx * nx + ny * ny + nz * nz)
+    if s < _MIN_PLANE_SINE * math.hypot(*a) * math.hypot(*b) or s < 1e-9:
         return np.asarray(fallback, dtype=float)
-    n = n / s
     # A knee bends forward: the normal points to the body's left. A reversed normal is sensor noise on an
     # almost straight leg (or a hyper-extended knee); keep the hemisphere of the fallback (the pelvis's left).
-    return n if float(n @ np.asarray(fallback)) >= 0 else -n
+    fx, fy, fz = np.asarray(fallback, dtype=float).tolist()
+    sign = 1.0 if nx * fx + ny * fy + nz * fz >= 0 else -1.0
+    return np.array([sign * nx / s, sign * ny / s, sign * nz / s])
 
 
 class StyleExtractor:

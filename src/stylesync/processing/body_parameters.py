@@ -8,6 +8,7 @@ Dempster 1955). With a body point cloud, masses come from link volumes by the mi
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -37,7 +38,7 @@ STATURE_PER_LEG_LENGTH = 1.0 / 0.530  # Winter Fig. 4.1: hip joint at 0.530 H
 
 def link_length(p_proximal: np.ndarray, p_distal: np.ndarray) -> float:
     """Eq. 1: L_i = |p_i - p_{i-1}| [m]."""
-    return float(np.linalg.norm(np.asarray(p_distal) - np.asarray(p_proximal)))
+    return math.dist(np.asarray(p_distal, dtype=float).tolist(), np.asarray(p_proximal, dtype=float).tolist())
 
 
 def segment_mass_fractions() -> dict[str, float]:
@@ -58,7 +59,7 @@ def leg_length_m(pos: dict[str, np.ndarray], ankle_height_m: float) -> float:
     """Hip-joint height of a straight leg: thigh + shank (Eq. 1) + ankle height [m], mean of both legs."""
     lengths = [link_length(pos[f"HIP_{s}"], pos[f"KNEE_{s}"]) + link_length(pos[f"KNEE_{s}"], pos[f"ANKLE_{s}"])
                for s in ("LEFT", "RIGHT")]
-    return float(np.mean(lengths)) + ankle_height_m
+    return 0.5 * (lengths[0] + lengths[1]) + ankle_height_m
 
 
 # Table 2 rows: (row, proximal joint, distal joint, Winter mass fraction of one such link). Winter splits the trunk

@@ -59,6 +59,7 @@ class SlerpRamp:
         self.k = mocap_hz / control_hz
         self._start: np.ndarray | None = None
         self._target: np.ndarray | None = None
+        self._rotvec_rad = np.zeros((0, 3))
         self._out: np.ndarray | None = None
         self._i = 0
 
@@ -68,6 +69,8 @@ class SlerpRamp:
             self._out = ref.copy()
         self._start = self._out.copy()
         self._target = rot.batch_align_sign(ref, self._start)
+        # The slerp's rotation vector from start to target (rot.batch_slerp), fixed until the next frame.
+        self._rotvec_rad = rot.batch_rotvec(rot.batch_multiply(rot.batch_conjugate(self._start), self._target))
         self._i = 0
 
     def step(self) -> np.ndarray:
@@ -75,5 +78,6 @@ class SlerpRamp:
             raise ValueError("SlerpRamp.step() before the first push()")
         self._i += 1
         frac = min(self.k * self._i, 1.0)
-        self._out = rot.batch_slerp(self._start, self._target, frac)
+        q = rot.batch_multiply(self._start, rot.batch_quat_from_rotvec(frac * self._rotvec_rad))  # rot.batch_slerp
+        self._out = q / np.linalg.norm(q, axis=1, keepdims=True)
         return self._out.copy()

@@ -82,7 +82,7 @@ class OperatorProcessing:
     def step(self, time_s: float) -> OperatorSample:
         q = self._qramp.step()  # Eq. 7
         if self._q_prev_out is not None:
-            q = np.array([rot.align_sign(a, b) for a, b in zip(q, self._q_prev_out, strict=True)])
+            q = rot.batch_align_sign(q, self._q_prev_out)
         q = self._q_filter(q.reshape(-1)).reshape(q.shape)  # Eq. 8
         q = q / np.linalg.norm(q, axis=1, keepdims=True)
         self._q_prev_out = q

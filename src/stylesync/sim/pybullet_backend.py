@@ -102,6 +102,8 @@ class PyBulletBackend(PhysicsBackend):
         self._link_idx = [index_by_name[n] for n in LINK_NAMES]
         self._foot_idx = {index_by_name[n]: n for n in FOOT_LINKS}
         self._is_ball = np.array([j.kind is JointKind.BALL for j in JOINTS])
+        self._ball_idx = [j for j, b in zip(self._joint_idx, self._is_ball, strict=True) if b]  # PyBullet indices
+        self._hinge_idx = [j for j, b in zip(self._joint_idx, self._is_ball, strict=True) if not b]
         self._last_torque_values: np.ndarray | None = None  # the last torques applied, and their PyBullet form
         self._last_forces: list[list[float]] = []
         for j, spec in zip(self._joint_idx, JOINTS, strict=True):
@@ -192,17 +194,11 @@ class PyBulletBackend(PhysicsBackend):
         base_pos, _, lin_vel, _, _ = self._read_raw()
         links = c.getLinkStates(self.body, self._link_idx, computeLinkVelocity=1, computeForwardKinematics=1)
         n = len(links)
-        com = np.empty((n, 3))
-        com_vel = np.empty((n, 3))
-        origin = np.empty((n, 3))
-        quat_xyzw = np.empty((n, 4))
-        ang = np.empty((n, 3))
-        for i, ls in enumerate(links):
-            com[i] = ls[0]
-            origin[i] = ls[4]
-            quat_xyzw[i] = ls[5]
-            com_vel[i] = ls[6]
-            ang[i] = ls[7]
+        com = np.array([ls[0] for ls in links])
+        origin = np.array([ls[4] for ls in links])
+        quat_xyzw = np.array([ls[5] for ls in links])
+        com_vel = np.array([ls[6] for ls in links])
+        ang = np.array([ls[7] for ls in links])
         quat = rot.batch_multiply(quat_xyzw[:, [3, 0, 1, 2]], np.broadcast_to(_Q_MODEL_WORLD, (n, 4)))
         foot_force = {name: 0.0 for name in FOOT_LINKS}
         non_foot = False
@@ -234,15 +230,12 @@ class PyBulletBackend(PhysicsBackend):
         n = len(self._joint_idx)
         pos = np.zeros((n, 4))
         vel = np.zeros((n, 3))
-        for k, j in enumerate(self._joint_idx):
-            st = all_states[j]
-            if self._is_ball[k]:
-                x, y, z, w = st[0]
-                pos[k] = (w, x, y, z)
-                vel[k] = st[1]
-            else:
-                pos[k, 0] = st[0][0]
-                vel[k, 0] = st[1][0]
+        ball = [all_states[j] for j in self._ball_idx]
+        hinge = [all_states[j] for j in self._hinge_idx]
+        pos[self._is_ball] = np.array([st[0] for st in ball])[:, [3, 0, 1, 2]]  # xyzw -> wxyz
+        vel[self._is_ball] = [st[1] for st in ball]
+        pos[~self._is_ball, 0] = [st[0][0] for st in hinge]
+        vel[~self._is_ball, 0] = [st[1][0] for st in hinge]
         return JointFeedback(pos, vel, _canonical_from_link_xyzw(base_q), np.array(ang_vel))
 
     def apply_torques(self, torques: Torques) -> None:
