@@ -18,6 +18,7 @@ import numpy as np
 from scipy.linalg import lapack
 from scipy.optimize import nnls
 
+from stylesync.control.nnls import nnls_gram
 from stylesync.sim.character import N_DOFS, ROOT_DOFS
 
 
@@ -31,8 +32,8 @@ def solve_with_contact_forces(mass_matrix: np.ndarray, bias_force: np.ndarray, f
                               contact_jacobian: np.ndarray, contact_accel: np.ndarray, qdd_desired: np.ndarray,
                               weights: np.ndarray, wrench_matrix: np.ndarray, wrench_desired: np.ndarray,
                               wrench_row_weights: np.ndarray, force_regularisation: np.ndarray,
-                              task_jacobian: np.ndarray, task_accel: np.ndarray,
-                              task_weight: float) -> tuple[np.ndarray, np.ndarray]:
+                              task_jacobian: np.ndarray, task_accel: np.ndarray, task_weight: float,
+                              free_start: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """q̈ (N_DOFS,) and the contact-force magnitudes λ >= 0 of one problem over both:
 
         min Σ w_d (q̈_d - q̈_d*)² + w_t |J_t q̈ - a_t|² + |W_f (A λ - F*)|² + Σ ε_i λ_i²
@@ -42,6 +43,9 @@ def solve_with_contact_forces(mass_matrix: np.ndarray, bias_force: np.ndarray, f
     accelerations are affine in λ (the KKT system of :func:`solve_accelerations`), q̈ = r + P λ; substituted, the
     problem is a non-negative least squares in λ alone. Joint tracking and the desired wrench are thereby traded
     against each other in one objective: the momentum the soles cannot give is not forced onto the arms.
+
+    ``free_start``: the mask of positive λ of a previous solution of a problem of the same layout, to warm-start
+    the non-negative least squares (nnls.py); None solves it from scratch. Returns q̈, λ and the mask of λ > 0.
     """
     a_eq = np.vstack([mass_matrix[:ROOT_DOFS], contact_jacobian])
     k = a_eq.shape[0]
@@ -64,12 +68,16 @@ def solve_with_contact_forces(mass_matrix: np.ndarray, bias_force: np.ndarray, f
         sol = np.linalg.lstsq(kkt, rhs, rcond=None)[0]
     r, p = sol[:N_DOFS, 0], sol[:N_DOFS, 1:] @ force_basis[:ROOT_DOFS]
     if n_lam == 0:  # no support: the accelerations follow from the root's rows alone
-        return r, np.zeros(0)
+        return r, np.zeros(0), np.zeros(0, dtype=bool)
     sw = np.sqrt(weights)
     st = np.sqrt(task_weight)
     a_rows = np.vstack([sw[:, None] * p, st * task_jacobian @ p, wrench_row_weights[:, None] * wrench_matrix,
                         np.diag(np.sqrt(force_regularisation))])
     b_rows = np.concatenate([sw * (qdd_desired - r), st * (task_accel - task_jacobian @ r),
                              wrench_row_weights * wrench_desired, np.zeros(n_lam)])
-    lam, _ = nnls(a_rows, b_rows, maxiter=50 * n_lam)
-    return r + p @ lam, lam
+    if free_start is None or free_start.shape != (n_lam,):
+        lam, _ = nnls(a_rows, b_rows, maxiter=50 * n_lam)
+        free = lam > 0.0
+    else:
+        lam, free = nnls_gram(a_rows.T @ a_rows, a_rows.T @ b_rows, free_start)
+    return r + p @ lam, lam, free

@@ -65,6 +65,8 @@ class MomentumBalanceController(ControllerBase):
         self._g_vec = np.array([0.0, 0.0, gravity_mps2])
         # Weights of the wrench rows (force, moment) in the plan (inverse_dynamics.solve_with_contact_forces).
         self._wrench_row_weights = np.array([1.0, 1.0, 1.0, *(3 * [cfg.momentum_moment_weight_per_m])])
+        self._free_lam: np.ndarray | None = None  # which ground forces were positive at the last tick
+        self._free_lam_feet: tuple[str, ...] = ()  # for these supporting feet
 
     def update(self, state: CharacterState, ref: ReferencePose, mass_matrix: np.ndarray) -> None:
         cfg = self.cfg
@@ -153,10 +155,13 @@ class MomentumBalanceController(ControllerBase):
         j_c = np.vstack(contact_rows) if contact_rows else np.zeros((0, N_DOFS))
         contact_accel = -cfg.contact_velocity_gain * (j_c @ qd)
         bias = jac.mass_weighted_linear(state.link_com_world, self.mass.link_mass_kg).T @ self._g_vec  # gravity
-        qdd, lam = solve_with_contact_forces(
+        feet = tuple(corners)
+        qdd, lam, free = solve_with_contact_forces(
             mass_matrix, bias, b_force, j_c, contact_accel, qdd_des, weights, wrench,
             np.concatenate([force + m * self._g_vec, moment]), self._wrench_row_weights, regularisation(corners, w),
-            np.array(task_rows).reshape(-1, N_DOFS), np.array(task_acc), FOOT_TASK_WEIGHT)
+            np.array(task_rows).reshape(-1, N_DOFS), np.array(task_acc), FOOT_TASK_WEIGHT,
+            self._free_lam if feet == self._free_lam_feet else None)
+        self._free_lam, self._free_lam_feet = free, feet  # the warm start of the next tick's force plan
         tau = unflatten_joint_values(joint_torques(mass_matrix, bias, b_force @ lam, qdd))
         tau[~IS_BALL, 1:] = 0.0
         self._tau = Torques(np.clip(tau, -TORQUE_LIMIT, TORQUE_LIMIT))

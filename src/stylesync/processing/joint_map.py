@@ -48,7 +48,7 @@ def local_rotation(world_quats: dict[str, np.ndarray], joint: str) -> np.ndarray
 
 def hinge_angle(q_local: np.ndarray, joint: str) -> float:
     lo, hi = HINGE_RANGE_RAD[joint.split("_")[1]]
-    return float(np.clip(rot.twist_angle(q_local, HINGE_AXIS_CANONICAL), lo, hi))
+    return min(max(rot.twist_angle(q_local, HINGE_AXIS_CANONICAL), lo), hi)
 
 
 def tracked_arrays(frame: OperatorFrame) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

@@ -24,7 +24,6 @@ STANDING_ROOT_HEIGHT_M = 0.8814  # pelvis origin height with straight legs and f
 
 # World orientation of the model's frame: +90 deg about x maps the URDF's +y (up) to world +z.
 Q_WORLD_MODEL = rot.quat_from_axis_angle(np.array([1.0, 0.0, 0.0]), np.pi / 2)
-_Q_MODEL_WORLD = rot.conjugate(Q_WORLD_MODEL)
 
 
 class JointKind(Enum):
@@ -121,12 +120,18 @@ def model_quat_from_canonical(q_canonical_wxyz: np.ndarray) -> np.ndarray:
     return rot.multiply(rot.multiply(rot.conjugate(Q_WORLD_MODEL), q_canonical_wxyz), Q_WORLD_MODEL)
 
 
+# The two changes of axes are linear maps of the quaternion (the scalar part kept, the vector part rotated):
+# 4x4 matrices acting on rows, built from the functions above.
+_MODEL_FROM_CANONICAL_T = np.array([model_quat_from_canonical(e) for e in np.eye(4)])
+_CANONICAL_FROM_MODEL_T = np.array([rot.multiply(rot.multiply(Q_WORLD_MODEL, e), rot.conjugate(Q_WORLD_MODEL))
+                                    for e in np.eye(4)])
+
+
 def batch_model_quat_from_canonical(q_canonical_wxyz: np.ndarray) -> np.ndarray:
     """:func:`model_quat_from_canonical` of each row, (n, 4)."""
-    n = len(q_canonical_wxyz)
-    return rot.batch_multiply(rot.batch_multiply(np.broadcast_to(_Q_MODEL_WORLD, (n, 4)), q_canonical_wxyz),
-                              np.broadcast_to(Q_WORLD_MODEL, (n, 4)))
+    return q_canonical_wxyz @ _MODEL_FROM_CANONICAL_T
 
 
 def canonical_quat_from_model(q_model_wxyz: np.ndarray) -> np.ndarray:
-    return rot.multiply(rot.multiply(Q_WORLD_MODEL, q_model_wxyz), rot.conjugate(Q_WORLD_MODEL))
+    """Joint rotation in canonical (world-aligned) axes from the same rotation in model axes."""
+    return np.asarray(q_model_wxyz, dtype=float) @ _CANONICAL_FROM_MODEL_T

@@ -11,6 +11,7 @@ import contextlib
 import itertools
 import os
 import sys
+from typing import Any
 
 import numpy as np
 import pybullet as pb
@@ -71,10 +72,23 @@ def _canonical_from_link_xyzw(q_xyzw) -> np.ndarray:
     return rot.multiply(rot.wxyz_from_xyzw(q_xyzw), _Q_MODEL_WORLD)
 
 
+class _BoundClient:
+    """A BulletClient whose engine calls are bound once: BulletClient makes a new ``functools.partial`` (binding
+    its client id) on every attribute access, a measurable cost for the calls made at every physics step."""
+
+    def __init__(self, client: BulletClient):
+        self._client = client
+
+    def __getattr__(self, name: str) -> Any:
+        attr = getattr(self._client, name)
+        self.__dict__[name] = attr
+        return attr
+
+
 class PyBulletBackend(PhysicsBackend):
     def __init__(self, world: WorldConfig, physics_hz: float, gui: bool = False, fixed_root: bool = False):
         try:
-            self._pb = BulletClient(connection_mode=pb.GUI if gui else pb.DIRECT)
+            self._pb = _BoundClient(BulletClient(connection_mode=pb.GUI if gui else pb.DIRECT))
         except Exception as exc:  # pybullet raises a bare error when no display is available
             raise SimulationError(f"could not start PyBullet ({'GUI' if gui else 'DIRECT'}): {exc}") from exc
         c = self._pb
