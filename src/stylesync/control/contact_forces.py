@@ -58,6 +58,14 @@ def _pyramid(friction: float) -> tuple[np.ndarray, np.ndarray]:
     return e, moment_rows
 
 
+@functools.lru_cache(maxsize=8)
+def _tiled_edges(friction: float, n_corners: int) -> np.ndarray:
+    """(3, 4 n_corners): the pyramid's edges as columns, corner by corner."""
+    out = np.tile(_pyramid(friction)[0].T, n_corners)
+    out.setflags(write=False)
+    return out
+
+
 def pyramid_edges(friction: float) -> np.ndarray:
     """(4, 3) unit edges of the linearised friction cone of a flat ground."""
     return _pyramid(friction)[0]
@@ -71,7 +79,7 @@ def wrench_basis(com_world: np.ndarray, corners_world: dict[str, np.ndarray],
     levers = np.concatenate(list(corners_world.values())) - com_world  # (n_corners, 3)
     n = 4 * len(levers)
     out = np.empty((6, n))
-    out[:3] = np.tile(edges.T, len(levers))
+    out[:3] = _tiled_edges(friction, len(levers))
     out[3:] = (levers @ moment_rows.T).reshape(n, 3).T
     return edges, out
 
@@ -87,17 +95,19 @@ def feasible_horizontal_force(force_n: np.ndarray, com_world: np.ndarray, corner
     if not corners_world:
         return out
     pts = np.concatenate(list(corners_world.values()))
-    h = max(float(com_world[2] - pts[:, 2].mean()), 0.1)
+    h = max(float(com_world[2]) - float(pts[:, 2].sum()) / len(pts), 0.1)
     k = mass_kg * gravity_mps2 / h
-    lo, hi = pts[:, :2].min(axis=0), pts[:, :2].max(axis=0)
-    mid, half = 0.5 * (lo + hi), 0.5 * COP_MARGIN * (hi - lo)
+    lo, hi = pts[:, :2].min(axis=0).tolist(), pts[:, :2].max(axis=0).tolist()
     # The range always holds zero (with the COM beyond the margin the pendulum model would ask for a push
     # outwards), and is widened by MOMENTUM_ACCEL_ALLOWANCE_MPS2: a change of the body's angular momentum (the
     # hip strategy of a squat's leaning trunk) gives some horizontal force the pendulum does not.
     extra = mass_kg * MOMENTUM_ACCEL_ALLOWANCE_MPS2
-    lo_f = np.minimum(k * (com_world[:2] - mid - half), 0.0) - extra
-    hi_f = np.maximum(k * (com_world[:2] - mid + half), 0.0) + extra
-    out[:2] = np.clip(out[:2], lo_f, hi_f)
+    for ax in (0, 1):  # Python floats: two scalars per axis
+        mid, half = 0.5 * (lo[ax] + hi[ax]), 0.5 * COP_MARGIN * (hi[ax] - lo[ax])
+        c = float(com_world[ax])
+        lo_f = min(k * (c - mid - half), 0.0) - extra
+        hi_f = max(k * (c - mid + half), 0.0) + extra
+        out[ax] = min(max(float(out[ax]), lo_f), hi_f)
     return out
 
 

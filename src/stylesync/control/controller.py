@@ -29,7 +29,7 @@ from stylesync.control.crvc import (
 from stylesync.control.gravity_compensation import ANKLE_JOINT, gravity_torques
 from stylesync.control.jacobian_transpose import JointFrames
 from stylesync.control.model_compensation import bounded_lipm_sync_force, ipm_ankle_moments
-from stylesync.control.pid import IS_BALL, JointPid, reference_velocity
+from stylesync.control.pid import IS_BALL, JointPid, joint_error, reference_velocity
 from stylesync.control.stable_pd import (
     flatten_joint_values,
     implicit_gain,
@@ -95,6 +95,17 @@ class ControllerBase(ABC):
 
     def reset(self) -> None:  # noqa: B027 (an optional hook: controllers without accumulated state keep it)
         """Forget accumulated state (integral terms) when the character is stood up again."""
+
+    def _error_and_reference_velocity(self, q_current: np.ndarray, ref: ReferencePose) -> np.ndarray:
+        """The joint error of ``q_current`` to the reference (pid.joint_error), with the reference velocity updated
+        as :meth:`_update_reference_velocity` does: both in one batched evaluation."""
+        if self._prev_ref_pos is None:
+            self._prev_ref_pos = ref.joint_pos.copy()
+            return joint_error(q_current, ref.joint_pos)
+        both = joint_error(np.stack([q_current, self._prev_ref_pos]), np.stack([ref.joint_pos, ref.joint_pos]))
+        self._ref_vel = both[1] / self.control_dt_s  # pid.reference_velocity
+        self._prev_ref_pos = ref.joint_pos.copy()
+        return both[0]
 
     def _update_reference_velocity(self, ref: ReferencePose) -> None:
         """The reference's joint velocity for the derivative terms, from successive references at the control

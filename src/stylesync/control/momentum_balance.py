@@ -38,7 +38,7 @@ from stylesync.control.floating_jacobian import FloatingJacobians
 from stylesync.control.inverse_dynamics import joint_torques, solve_with_contact_forces
 from stylesync.control.jacobian_transpose import JointFrames
 from stylesync.control.model_compensation import bounded_lipm_sync_force
-from stylesync.control.pid import IS_BALL, joint_error
+from stylesync.control.pid import IS_BALL
 from stylesync.control.stable_pd import flatten_joint_values, unflatten_joint_values
 from stylesync.motion.reference import ReferencePose
 from stylesync.motion.stance_fsm import swing_side
@@ -100,10 +100,9 @@ class MomentumBalanceController(ControllerBase):
         qd = np.concatenate([state.root_lin_vel_world, state.root_ang_vel_world,
                              flatten_joint_values(state.joint_vel)])
         # Desired joint accelerations: Eq. 13 per unit inertia.
-        self._update_reference_velocity(ref)
         omega, zeta = cfg.joint_tracking_omega_rad_s, cfg.joint_tracking_damping_ratio
         kp, kd = omega * omega, 2.0 * zeta * omega
-        e = joint_error(state.joint_pos, ref.joint_pos)
+        e = self._error_and_reference_velocity(state.joint_pos, ref)
         qdd_joint = kp * e + kd * (self._ref_vel - state.joint_vel)
         # Saturated: a jump of the reference (a stance change, a landing) would otherwise ask for accelerations
         # whose torques exceed the joints' limits, and the clipped torques no longer realise the planned forces.
@@ -149,8 +148,8 @@ class MomentumBalanceController(ControllerBase):
                 j_pts = jac.points_linear(link, pts)  # (4, 3, N_DOFS)
                 # B's columns: J(p_c)^T β_e, corner by corner, edge by edge (contact_forces.wrench_basis's order)
                 cols.append((edges @ j_pts).transpose(2, 0, 1).reshape(N_DOFS, -1))
-                # The sole centre's Jacobian: the mean of the corners' (a point's Jacobian is affine in the point).
-                contact_rows += [j_pts.mean(axis=0), jac.angular(link)]
+                # The sole centre's Jacobian: the mean of the 4 corners' (a point's Jacobian is affine in the point).
+                contact_rows += [0.25 * j_pts.sum(axis=0), jac.angular(link)]
             b_force = np.hstack(cols)
         j_c = np.vstack(contact_rows) if contact_rows else np.zeros((0, N_DOFS))
         contact_accel = -cfg.contact_velocity_gain * (j_c @ qd)

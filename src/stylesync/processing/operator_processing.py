@@ -46,10 +46,9 @@ class OperatorProcessing:
         period = 1.0 / clocks.control_hz
         self._qramp = SlerpRamp(clocks.mocap_hz, clocks.control_hz)
         self._pramp = LinearRamp(clocks.mocap_hz, clocks.control_hz)
-        self._q_filter = OneEuroFilter(period, filters.one_euro_min_cutoff_hz, filters.one_euro_beta,
-                                       filters.one_euro_derivative_cutoff_hz)
-        self._p_filter = OneEuroFilter(period, filters.one_euro_min_cutoff_hz, filters.one_euro_beta,
-                                       filters.one_euro_derivative_cutoff_hz)
+        # One element-wise 1€ filter over the orientations' components, then the positions' (one call per tick).
+        self._filter = OneEuroFilter(period, filters.one_euro_min_cutoff_hz, filters.one_euro_beta,
+                                     filters.one_euro_derivative_cutoff_hz)
         self._floor = FloorFilter(filters.floor_threshold_m)
         self._ankle_floor = {side: FloorFilter(filters.floor_threshold_m) for side in _ANKLE}
         self._last_q: np.ndarray | None = None
@@ -83,11 +82,12 @@ class OperatorProcessing:
         q = self._qramp.step()  # Eq. 7
         if self._q_prev_out is not None:
             q = rot.batch_align_sign(q, self._q_prev_out)
-        q = self._q_filter(q.reshape(-1)).reshape(q.shape)  # Eq. 8
-        q = q / np.linalg.norm(q, axis=1, keepdims=True)
-        self._q_prev_out = q
         pc = self._pramp.step()
-        p, com = self._p_filter(pc[:-1].reshape(-1)).reshape(-1, 3), pc[-1]
+        filtered = self._filter(np.concatenate([q.reshape(-1), pc[:-1].reshape(-1)]))  # Eq. 8
+        q = filtered[:q.size].reshape(q.shape)
+        q = q / np.sqrt(np.einsum("ij,ij->i", q, q))[:, None]
+        self._q_prev_out = q
+        p, com = filtered[q.size:].reshape(-1, 3), pc[-1]
         pos = dict(zip(TRACKED_POSITIONS, p, strict=True))
         return OperatorSample(
             time_s=time_s,

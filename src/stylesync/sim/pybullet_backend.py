@@ -68,8 +68,13 @@ def _quiet_stdout():
 _SHAPE_KIND = {pb.GEOM_SPHERE: "sphere", pb.GEOM_CAPSULE: "capsule", pb.GEOM_BOX: "box"}
 
 
+# A PyBullet link orientation (x, y, z, w) to our canonical one (w, x, y, z): reordered, then times
+# _Q_MODEL_WORLD on the right, one linear map (4x4, acting on rows).
+_CANONICAL_FROM_LINK_XYZW_T = np.array([rot.multiply(rot.wxyz_from_xyzw(e), _Q_MODEL_WORLD) for e in np.eye(4)])
+
+
 def _canonical_from_link_xyzw(q_xyzw) -> np.ndarray:
-    return rot.multiply(rot.wxyz_from_xyzw(q_xyzw), _Q_MODEL_WORLD)
+    return np.asarray(q_xyzw, dtype=float) @ _CANONICAL_FROM_LINK_XYZW_T
 
 
 class _BoundClient:
@@ -207,13 +212,12 @@ class PyBulletBackend(PhysicsBackend):
         fb = self.read_joint_feedback()
         base_pos, _, lin_vel, _, _ = self._read_raw()
         links = c.getLinkStates(self.body, self._link_idx, computeLinkVelocity=1, computeForwardKinematics=1)
-        n = len(links)
         com = np.array([ls[0] for ls in links])
         origin = np.array([ls[4] for ls in links])
         quat_xyzw = np.array([ls[5] for ls in links])
         com_vel = np.array([ls[6] for ls in links])
         ang = np.array([ls[7] for ls in links])
-        quat = rot.batch_multiply(quat_xyzw[:, [3, 0, 1, 2]], np.broadcast_to(_Q_MODEL_WORLD, (n, 4)))
+        quat = quat_xyzw @ _CANONICAL_FROM_LINK_XYZW_T
         foot_force = {name: 0.0 for name in FOOT_LINKS}
         non_foot = False
         for cp in c.getContactPoints(bodyA=self.body, bodyB=self.plane):
