@@ -70,8 +70,11 @@ def multiply(a: Array, b: Array) -> Array:
     )
 
 
+_CONJUGATE_SIGNS = np.array([1.0, -1.0, -1.0, -1.0])
+
+
 def conjugate(q: Array) -> Array:
-    return np.array([q[0], -q[1], -q[2], -q[3]])
+    return np.asarray(q, dtype=float) * _CONJUGATE_SIGNS
 
 
 def matrix_from_quat(q: Array) -> Array:

@@ -240,26 +240,21 @@ class Session:
     def _log(self, lg: TickLog, t: float, sample, state: CharacterState, ref, tick_ms: float) -> None:
         com = self.mass.com(state)
         self.last_com_world = com
-        ankles = {s: state.link_origin_world[_LINK[f"{s}_ankle"]] for s in ("left", "right")}
+        # Vectors are recorded whole and split into their x, y, z columns after the run (_add_after_run_columns):
+        # the tick pays for one append per vector. The arrays recorded are new at every tick, never changed later.
         lg.add(
             t=t, tick_ms=tick_ms,
             op_state=STANCE_CODE[ref.operator_stance], char_state=STANCE_CODE[ref.character_stance],
             held=float(ref.held), scale=ref.scale,
-            com_x=com[0], com_y=com[1], com_z=com[2],
-            com_d_x=ref.com_world[0], com_d_y=ref.com_world[1], com_d_z=ref.com_world[2],
-            op_com_x=sample.com_world[0], op_com_y=sample.com_world[1], op_com_z=sample.com_world[2],
-            op_al_x=sample.pos["ANKLE_LEFT"][0], op_al_y=sample.pos["ANKLE_LEFT"][1],
-            op_al_z=sample.pos["ANKLE_LEFT"][2],
-            op_ar_x=sample.pos["ANKLE_RIGHT"][0], op_ar_y=sample.pos["ANKLE_RIGHT"][1],
-            op_ar_z=sample.pos["ANKLE_RIGHT"][2],
-            al_x=ankles["left"][0], al_y=ankles["left"][1], al_z=ankles["left"][2],
-            ar_x=ankles["right"][0], ar_y=ankles["right"][1], ar_z=ankles["right"][2],
-            root_z=state.root_pos_world[2],
+            _v_com=com, _v_com_d=ref.com_world, _v_op_com=sample.com_world,
+            _v_op_al=sample.pos["ANKLE_LEFT"], _v_op_ar=sample.pos["ANKLE_RIGHT"],
+            _v_al=state.link_origin_world[_LINK["left_ankle"]], _v_ar=state.link_origin_world[_LINK["right_ankle"]],
+            root_z=float(state.root_pos_world[2]),
             contact_l=state.foot_contact_force_n["left_ankle"], contact_r=state.foot_contact_force_n["right_ankle"],
-            ch_joints=state.link_origin_world[CHARACTER_LINKS].copy(),
+            ch_joints=state.link_origin_world[CHARACTER_LINKS],
             op_joints=np.array([sample.pos[n] for n in OPERATOR_JOINTS]),
-            lipm_fx=self.controller.telemetry.lipm_force_n[0], lipm_fy=self.controller.telemetry.lipm_force_n[1],
-            **{f"op_{k}": v for k, v in zip(_FEATURES, ref.operator_features.as_row(), strict=True)},
+            _v_lipm=self.controller.telemetry.lipm_force_n,
+            _op_features=ref.operator_features.as_row(),
             # The joint error and the character's style features are computed from these after the run
             # (_add_after_run_columns). The arrays are the state's and the reference's own, new at every tick.
             _q=state.joint_pos, _q_ref=ref.joint_pos,
@@ -268,11 +263,27 @@ class Session:
         )
 
 
+# Vector columns recorded whole at each tick: (recorded name, column prefix, axes split off).
+_VECTOR_COLUMNS = (("_v_com", "com", "xyz"), ("_v_com_d", "com_d", "xyz"), ("_v_op_com", "op_com", "xyz"),
+                   ("_v_op_al", "op_al", "xyz"), ("_v_op_ar", "op_ar", "xyz"), ("_v_al", "al", "xyz"),
+                   ("_v_ar", "ar", "xyz"), ("_v_lipm", "lipm_f", "xy"))
+
 
 def _add_after_run_columns(lg: TickLog) -> None:
     """Columns derived from what each tick recorded, in one batched computation after the run instead of one per
     control tick: ``joint_err_deg`` (mean over the joints of the angle between the character's joint and the
     reference's) and the character's style features (Sec. 5.2), ``ch_<feature>``."""
+    for key, prefix, axes in _VECTOR_COLUMNS:
+        values = lg.columns.pop(key, [])
+        if values:
+            arr = np.asarray(values, dtype=float)
+            for k, axis in enumerate(axes):
+                lg.columns[f"{prefix}_{axis}"] = arr[:, k].tolist()
+    features = lg.columns.pop("_op_features", [])
+    if features:
+        arr = np.asarray(features, dtype=float)
+        for k, name in enumerate(_FEATURES):
+            lg.columns[f"op_{name}"] = arr[:, k].tolist()
     raw = {k: lg.columns.pop(k, []) for k in ("_q", "_q_ref", "_ch_legs", "_ch_leg_quats", "_ch_com", "_ch_root_quat")}
     if not raw["_ch_com"]:
         return

@@ -21,6 +21,8 @@ from scipy.optimize import nnls
 from stylesync.control.nnls import nnls_gram
 from stylesync.sim.character import N_DOFS, ROOT_DOFS
 
+_EYE_ROOT = np.eye(ROOT_DOFS)
+
 
 def joint_torques(mass_matrix: np.ndarray, bias_force: np.ndarray, contact_force: np.ndarray,
                   qdd: np.ndarray) -> np.ndarray:
@@ -50,8 +52,9 @@ def solve_with_contact_forces(mass_matrix: np.ndarray, bias_force: np.ndarray, f
     a_eq = np.vstack([mass_matrix[:ROOT_DOFS], contact_jacobian])
     k = a_eq.shape[0]
     kkt = np.zeros((N_DOFS + k, N_DOFS + k))
-    hess = np.diag(weights) + task_weight * task_jacobian.T @ task_jacobian
-    kkt[:N_DOFS, :N_DOFS] = hess
+    kkt[:N_DOFS, :N_DOFS] = np.diag(weights)
+    if task_jacobian.shape[0]:
+        kkt[:N_DOFS, :N_DOFS] += task_weight * task_jacobian.T @ task_jacobian
     kkt[:N_DOFS, N_DOFS:] = a_eq.T
     kkt[N_DOFS:, :N_DOFS] = a_eq
     n_lam = force_basis.shape[1]
@@ -59,10 +62,12 @@ def solve_with_contact_forces(mass_matrix: np.ndarray, bias_force: np.ndarray, f
     # (B λ)_root, so P = K⁻¹ [0; B_root; 0] is the solutions of the unit sides times B_root: 7 sides to solve
     # instead of 1 + n_λ.
     rhs = np.zeros((N_DOFS + k, 1 + ROOT_DOFS))
-    rhs[:N_DOFS, 0] = weights * qdd_desired + task_weight * task_jacobian.T @ task_accel
+    rhs[:N_DOFS, 0] = weights * qdd_desired
+    if task_jacobian.shape[0]:
+        rhs[:N_DOFS, 0] += task_weight * task_jacobian.T @ task_accel
     rhs[N_DOFS:N_DOFS + ROOT_DOFS, 0] = -bias_force[:ROOT_DOFS]
     rhs[N_DOFS + ROOT_DOFS:, 0] = contact_accel
-    rhs[N_DOFS:N_DOFS + ROOT_DOFS, 1:] = np.eye(ROOT_DOFS)
+    rhs[N_DOFS:N_DOFS + ROOT_DOFS, 1:] = _EYE_ROOT
     *_, sol, info = lapack.dgesv(kkt, rhs)  # LAPACK's LU solve without numpy's wrapper (a control-tick cost)
     if info != 0:  # singular (or a bad argument): the least-squares solution
         sol = np.linalg.lstsq(kkt, rhs, rcond=None)[0]
@@ -71,13 +76,16 @@ def solve_with_contact_forces(mass_matrix: np.ndarray, bias_force: np.ndarray, f
         return r, np.zeros(0), np.zeros(0, dtype=bool)
     sw = np.sqrt(weights)
     st = np.sqrt(task_weight)
-    a_rows = np.vstack([sw[:, None] * p, st * task_jacobian @ p, wrench_row_weights[:, None] * wrench_matrix,
-                        np.diag(np.sqrt(force_regularisation))])
+    # The residual rows without the regularisation's (a diagonal, added below as rows or to the Gram matrix).
+    a_rows = np.vstack([sw[:, None] * p, st * task_jacobian @ p, wrench_row_weights[:, None] * wrench_matrix])
     b_rows = np.concatenate([sw * (qdd_desired - r), st * (task_accel - task_jacobian @ r),
-                             wrench_row_weights * wrench_desired, np.zeros(n_lam)])
+                             wrench_row_weights * wrench_desired])
     if free_start is None or free_start.shape != (n_lam,):
-        lam, _ = nnls(a_rows, b_rows, maxiter=50 * n_lam)
+        lam, _ = nnls(np.vstack([a_rows, np.diag(np.sqrt(force_regularisation))]),
+                      np.concatenate([b_rows, np.zeros(n_lam)]), maxiter=50 * n_lam)
         free = lam > 0.0
     else:
-        lam, free = nnls_gram(a_rows.T @ a_rows, a_rows.T @ b_rows, free_start)
+        gram = a_rows.T @ a_rows
+        gram[np.diag_indices(n_lam)] += force_regularisation
+        lam, free = nnls_gram(gram, a_rows.T @ b_rows, free_start)
     return r + p @ lam, lam, free

@@ -45,7 +45,7 @@ def nnls_gram(gram: np.ndarray, rhs: np.ndarray, free_start: np.ndarray | None =
     free = np.zeros(n, dtype=bool) if free_start is None else free_start.copy()
     # Warm start: the free set's minimiser, with variables it drives negative made zero until it is feasible.
     x = _solve_free(gram, rhs, free)
-    while np.any(x[free] <= 0.0):
+    while (x[free] <= 0.0).any():
         free &= x > 0.0
         x = _solve_free(gram, rhs, free)
     for _ in range(max_iter):
@@ -60,7 +60,7 @@ def nnls_gram(gram: np.ndarray, rhs: np.ndarray, free_start: np.ndarray | None =
             free[j] = False
             break
         # Inner loop: step from x towards z only as far as feasibility allows; free variables reaching zero leave.
-        while np.any(z[free] <= 0.0):
+        while (z[free] <= 0.0).any():
             neg = np.flatnonzero(free & (z <= 0.0))
             ratios = x[neg] / (x[neg] - z[neg])
             k = int(np.argmin(ratios))

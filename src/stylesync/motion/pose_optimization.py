@@ -76,9 +76,8 @@ def _heading_frame_fraction(p_h, al_h, ar_h, al_c, ar_c, scale: float, R: np.nda
     operator's and the character's spread, from _MIN_AXIS_SPREAD_M / 2 to _MIN_AXIS_SPREAD_M * 1.5), so that the
     target does not jump when a swing foot passes the stance foot.
     """
-    ph, lh, rh = (R.T @ np.asarray(v) for v in (p_h, al_h, ar_h))
-    lc, rc = (R.T @ np.asarray(v) for v in (al_c, ar_c))
-    out = np.zeros(3)
+    ph, lh, rh, lc, rc = (R.T @ np.stack([p_h, al_h, ar_h, al_c, ar_c]).T).T.tolist()  # heading-frame coordinates
+    out = [0.0, 0.0, 0.0]
     for ax in (0, 1):
         spread_h, spread_c = rh[ax] - lh[ax], rc[ax] - lc[ax]
         offset = 0.5 * (lc[ax] + rc[ax]) + scale * (ph[ax] - 0.5 * (lh[ax] + rh[ax]))
@@ -86,7 +85,7 @@ def _heading_frame_fraction(p_h, al_h, ar_h, al_c, ar_c, scale: float, R: np.nda
         out[ax] = offset
         if w > 0.0:
             out[ax] += w * (lc[ax] + spread_c * (ph[ax] - lh[ax]) / spread_h - offset)
-    return R @ out
+    return R @ np.array(out)
 
 
 class _SmoothedRate:

@@ -212,11 +212,11 @@ class PyBulletBackend(PhysicsBackend):
         fb = self.read_joint_feedback()
         base_pos, _, lin_vel, _, _ = self._read_raw()
         links = c.getLinkStates(self.body, self._link_idx, computeLinkVelocity=1, computeForwardKinematics=1)
-        com = np.array([ls[0] for ls in links])
-        origin = np.array([ls[4] for ls in links])
-        quat_xyzw = np.array([ls[5] for ls in links])
-        com_vel = np.array([ls[6] for ls in links])
-        ang = np.array([ls[7] for ls in links])
+        # One array of each link's COM (3), frame origin (3), orientation xyzw (4), COM velocity (3), angular
+        # velocity (3), split into views.
+        table = np.array([ls[0] + ls[4] + ls[5] + ls[6] + ls[7] for ls in links])
+        com, origin, quat_xyzw = table[:, 0:3], table[:, 3:6], table[:, 6:10]
+        com_vel, ang = table[:, 10:13], table[:, 13:16]
         quat = quat_xyzw @ _CANONICAL_FROM_LINK_XYZW_T
         foot_force = {name: 0.0 for name in FOOT_LINKS}
         non_foot = False
