@@ -139,6 +139,21 @@ def test_free_character_stands_60_s_within_2_cm_with_a_standing_operator():
     assert np.linalg.norm(com - com[0], axis=1).max() < 0.02
 
 
+def test_default_walk_completes_without_a_fall_and_follows_the_operators_steps():
+    # The acceptance run of `stylesync demo` (default clip, seed and configuration): >= 10 s and >= 8 operator
+    # steps, no fall, >= 80 % of the steps taken, state transitions within the paper's 0.172 s.
+    from stylesync.metrics.summary import summarize
+
+    cfg = SessionConfig(duration_s=10.0)
+    source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
+    result = Session(cfg, source).run()
+    metrics = summarize(result)
+    assert not result.fell, result.fall_reason
+    assert metrics["operator_steps"] >= 8
+    assert metrics["character_steps"] >= 0.8 * metrics["operator_steps"]
+    assert metrics["state_transition_delay_s"]["max"] <= 0.172
+
+
 def test_planted_feet_options_keep_a_standing_character_within_2_cm_for_60_s():
     # The acceptance figure (60 s, COM drift < 2 cm) with friction anchors and the sole contact gap.
     com, feet = _standing_run(60.0, world=WorldConfig(friction_anchor=True),

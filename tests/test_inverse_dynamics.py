@@ -136,3 +136,27 @@ def test_a_planted_sole_just_unloaded_still_supports_and_a_lifted_one_does_not()
     tilted = rot.quat_from_axis_angle(np.array([1.0, 0.0, 0.0]), np.radians(10.0))
     assert sole_touches(on_ground + [0, 0, 0.005], tilted, False, gap)
     assert not sole_touches(on_ground, flat, False, 0.0)  # the rule switched off: only pressing counts
+
+
+def test_warm_started_nnls_reaches_the_same_minimiser_as_scipy():
+    # Strictly convex problems (a ridge of 0.01 as in the force plan): the minimiser is unique, so a cold start, a
+    # random warm start and the right warm start must all give SciPy's answer; the right one in one solve.
+    from scipy.optimize import nnls
+
+    from stylesync.control.nnls import nnls_gram
+
+    rng = np.random.default_rng(3)
+    for _ in range(300):
+        m, n = int(rng.integers(20, 80)), int(rng.integers(4, 40))
+        a = np.vstack([rng.normal(size=(m, n)), 0.01 * np.eye(n)])
+        b = np.concatenate([3.0 * rng.normal(size=m), np.zeros(n)])
+        expected, _ = nnls(a, b, maxiter=50 * n)
+        scale = max(1.0, float(np.abs(expected).max()))
+        gram, rhs = a.T @ a, a.T @ b
+        cold, free = nnls_gram(gram, rhs)
+        random_start, _ = nnls_gram(gram, rhs, rng.random(n) < 0.5)
+        warm, _ = nnls_gram(gram, rhs, free, max_iter=1)
+        for x in (cold, random_start, warm):
+            assert np.all(x >= 0.0)
+            np.testing.assert_allclose(x, expected, atol=1e-8 * scale)
+        assert np.array_equal(free, expected > 0.0)
