@@ -58,6 +58,10 @@ def test_momentum_jacobian_matches_the_engines_mass_matrix(moving_character):
     p = mass.link_mass_kg @ s.link_com_vel_world
     np.testing.assert_allclose(jac.mass_weighted_linear(s.link_com_world, mass.link_mass_kg) @ qd, p, atol=1e-5)
     np.testing.assert_allclose((b.joint_space_inertia() @ qd)[:3], p, atol=1e-3)
+    # The gravity force without the Jacobian: its transpose times a vertical g.
+    np.testing.assert_allclose(jac.gravity_force(s.link_com_world, mass.link_mass_kg, 9.8),
+                               jac.mass_weighted_linear(s.link_com_world, mass.link_mass_kg).T @ [0.0, 0.0, 9.8],
+                               rtol=1e-12, atol=1e-9)
 
 
 def test_wrench_basis_forces_stay_in_the_friction_cone_and_on_the_sole():

@@ -88,6 +88,20 @@ class FloatingJacobians:
         j[:, 3:] = self._rot_axes.T * _COLUMN_MOVES[link]
         return j
 
+    def gravity_force(self, link_com_world: np.ndarray, link_mass_kg: np.ndarray, gravity_mps2: float) -> np.ndarray:
+        """(N_DOFS,) generalised force of gravity's reaction, ``mass_weighted_linear(...)^T (0, 0, g)`` [N, N·m],
+        without forming the Jacobian: for a vertical g only its third row is needed."""
+        m_total = link_mass_kg.sum()
+        r = link_mass_kg @ link_com_world / m_total - self.root_world
+        m_sub = _MOVED_BY @ link_mass_kg
+        lever = _MOVED_BY @ (link_mass_kg[:, None] * link_com_world) - m_sub[:, None] * self.origin_world
+        out = np.empty(N_DOFS)
+        out[:3] = (0.0, 0.0, m_total * gravity_mps2)
+        out[3:6] = (m_total * gravity_mps2 * r[1], -m_total * gravity_mps2 * r[0], 0.0)  # m r × g ẑ
+        a = self.axis_world
+        out[ROOT_DOFS:] = gravity_mps2 * (a[:, 0] * lever[:, 1] - a[:, 1] * lever[:, 0])  # (a × L)_z g
+        return out
+
     def mass_weighted_linear(self, link_com_world: np.ndarray, link_mass_kg: np.ndarray) -> np.ndarray:
         """(3, N_DOFS) Σ_i m_i J_i(c_i): the Jacobian of the linear momentum [kg]. Divided by the total mass it is
         the COM Jacobian; its transpose times the gravity vector is the generalised gravity force."""

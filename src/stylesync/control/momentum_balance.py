@@ -153,7 +153,7 @@ class MomentumBalanceController(ControllerBase):
             b_force = np.hstack(cols)
         j_c = np.vstack(contact_rows) if contact_rows else np.zeros((0, N_DOFS))
         contact_accel = -cfg.contact_velocity_gain * (j_c @ qd)
-        bias = jac.mass_weighted_linear(state.link_com_world, self.mass.link_mass_kg).T @ self._g_vec  # gravity
+        bias = jac.gravity_force(state.link_com_world, self.mass.link_mass_kg, self.g)  # gravity
         feet = tuple(corners)
         qdd, lam, free = solve_with_contact_forces(
             mass_matrix, bias, b_force, j_c, contact_accel, qdd_des, weights, wrench,
