@@ -174,6 +174,12 @@ class ControlConfig:
     joint_tracking_damping_ratio: float = 1.0
     joint_acceleration_limit_rad_s2: float = 200.0  # the joint PD's desired acceleration is saturated here
     joint_tracking_weight: float = 10.0  # inverse dynamics: weight of M_ii Δq̈_i² against the wrench error
+    # Inverse dynamics: the COM force of Eq. 16 per unit mass, horizontally (Eq. 16, first line) and vertically (the
+    # pelvis height of Eq. 9). Table 3's 50 and 30 (com_force_*) are used by the Jacobian-transpose controller. These
+    # are the gains of a capture-point (DCM) tracking law with unit gain for this character's pendulum,
+    # kp = ω², kd = 2ω with ω = sqrt(g / h) ≈ 3.4 1/s (docs/decisions.md) [1/s², 1/s].
+    momentum_com_kp: float = 12.0
+    momentum_com_kd: float = 7.0
     momentum_root_kp: float = 200.0  # inverse dynamics: root virtual torque of Eq. 16 about the COM [N·m/rad]
     momentum_root_kd: float = 40.0  # [N·m·s/rad]
     momentum_moment_weight_per_m: float = 2.0  # weight of the moment rows against the force rows [1/m]
@@ -191,7 +197,8 @@ class ControlConfig:
     lipm_force_limit_n: float = 150.0  # clamp of |f_cro| before the bounds check [N]
 
     def __post_init__(self) -> None:
-        for n in ("com_force_kp_npm", "com_force_kd_nspm", "root_torque_kp", "root_torque_kd"):
+        for n in ("com_force_kp_npm", "com_force_kd_nspm", "root_torque_kp", "root_torque_kd", "momentum_com_kp",
+                  "momentum_com_kd"):
             _non_negative(f"ControlConfig.{n}", getattr(self, n))
         _positive("ControlConfig.integral_limit_rad_s", self.integral_limit_rad_s)
         _positive("ControlConfig.root_yaw_gain_scale", self.root_yaw_gain_scale)

@@ -1,8 +1,9 @@
 """The balance and synchronisation controller (Sec. 6) realised by contact-consistent inverse dynamics.
 
-Same parts as controller.py, the same gains where the paper gives them, realised differently:
+Same parts as controller.py, realised differently:
 
-* COM virtual force (Eq. 16, first line, with Eq. 19 errors; Table 3 gains per unit mass) plus the LIPM
+* COM virtual force (Eq. 16, first line, with Eq. 19 errors; per unit mass, with the gains of a capture-point
+  tracking law, ControlConfig.momentum_com_kp/kd, instead of Table 3's: docs/decisions.md) plus the LIPM
   time-sync force (Eq. 21-23, bounded by Eq. 26), and the root virtual torque (Eq. 16, second line) make one
   desired wrench on the body about its COM;
 * the ground forces closest to it that the soles can pass (contact_forces.py) replace the Jacobian-transpose
@@ -79,16 +80,16 @@ class MomentumBalanceController(ControllerBase):
         com, com_vel = self.mass.com(state), self.mass.com_velocity(state)
 
         # Desired force on the body: Eq. 16 (first line) horizontally; vertically the pelvis height of Eq. 9.
-        force = com_virtual_force(ref.com_world, ref.com_vel_world, com, com_vel, m, cfg.com_force_kp_npm,
-                                  cfg.com_force_kd_nspm)
+        force = com_virtual_force(ref.com_world, ref.com_vel_world, com, com_vel, m, cfg.momentum_com_kp,
+                                  cfg.momentum_com_kd)
         # The pelvis height above the supporting ankles as they are (a loaded sole sinks into the ground's spring
         # by a centimetre or two; a target above the reach of straight legs could only be met by flailing).
         support = [s for s, ws in w.items() if ws > 0]
         ankle_z = (sum(float(state.link_origin_world[_FOOT_LINK[s], 2]) for s in support) / len(support) if support
                    else ANKLE_HEIGHT_M)
         pelvis_z_d = ref.pelvis_world[2] - ANKLE_HEIGHT_M + ankle_z
-        force[2] = m * (cfg.com_force_kp_npm * (pelvis_z_d - state.root_pos_world[2])
-                        - cfg.com_force_kd_nspm * state.root_lin_vel_world[2])
+        force[2] = m * (cfg.momentum_com_kp * (pelvis_z_d - state.root_pos_world[2])
+                        - cfg.momentum_com_kd * state.root_lin_vel_world[2])
         f_lipm = np.zeros(3)
         if cfg.lipm_time_sync and ref.lipm is not None:  # Eq. 21-23, bounded by Eq. 26
             f_lipm = bounded_lipm_sync_force(ref.lipm, m, self.g, cfg.lipm_force_limit_n, cfg.enforce_bounds,
