@@ -47,8 +47,10 @@ from stylesync.sim.backend import CharacterState, JointFeedback, MassProperties,
 from stylesync.sim.character import ANKLE_HEIGHT_M, LINK_NAMES, N_DOFS, ROOT_DOFS
 
 _FOOT_LINK = {s: LINK_NAMES.index(f"{s}_ankle") for s in ("left", "right")}
-GROUND_PRESS_M = 0.035  # a stance foot not yet touching is aimed this far below the ground [m]
-FOOT_TASK_WEIGHT = 1000.0  # weight of that foot's height task against a joint's
+# A stance foot not yet touching is aimed this far below the ground [m], with this weight against a joint's: with
+# 2 cm and 100 a landing foot bounced off and slid in double stance (docs/decisions.md, "Landing").
+GROUND_PRESS_M = 0.035
+FOOT_TASK_WEIGHT = 1000.0
 # A joint's desired acceleration is saturated at ControlConfig.joint_acceleration_limit_rad_s2 or, where higher, at
 # what this share of its torque limit gives its own inertia: the feet (0.001-0.005 kg·m²) were otherwise held to a
 # fraction of a N·m, and a swing foot whipped by its leg rolled over by up to 115°.
