@@ -92,3 +92,41 @@ def test_browser_sees_the_character_move_and_pushes_it(tmp_path):
             proc.wait(timeout=10)
         except subprocess.TimeoutExpired:
             proc.kill()
+
+
+def _port_open(port: int) -> bool:
+    import socket
+
+    with socket.socket() as s:
+        s.settimeout(0.5)
+        return s.connect_ex(("127.0.0.1", port)) == 0
+
+
+def _start_viewer_demo(tmp_path: Path) -> tuple[subprocess.Popen, int]:
+    pytest.importorskip("viser", reason="needs viser (pip install -e '.[viewer]')")
+    port = free_port()
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "stylesync.cli", "demo", "--duration", "60", "--viewer", "web", "--viewer-port",
+         str(port), "--out", str(tmp_path / "run")], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    assert proc.stdout is not None
+    for line in proc.stdout:
+        if line.startswith("viewer: "):
+            break
+    else:
+        pytest.fail("the run ended before printing the viewer address")
+    assert _port_open(port)
+    return proc, port
+
+
+@pytest.mark.parametrize("kill", [False, True], ids=["terminated", "killed"])
+def test_viewer_process_ends_with_its_session(tmp_path, kill):
+    # Terminated (SIGTERM), the session ends as with Ctrl-C and closes its viewer; killed (SIGKILL), it cannot,
+    # and the orphaned viewer process must notice and end on its own, freeing its port.
+    proc, port = _start_viewer_demo(tmp_path)
+    (proc.kill if kill else proc.terminate)()
+    code = proc.wait(timeout=20)
+    assert code == (-9 if kill else 130)
+    deadline = time.monotonic() + 10
+    while _port_open(port) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert not _port_open(port), "the viewer process outlived its session"

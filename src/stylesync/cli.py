@@ -6,7 +6,9 @@ import argparse
 import dataclasses
 import json
 import logging
+import signal
 import sys
+import threading
 from pathlib import Path
 
 from stylesync.config import SHARED_DIR, VIEWER_DRAW_HZ, ClockConfig, ControlConfig, OperatorConfig, SessionConfig
@@ -270,6 +272,10 @@ def _add_source_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--bvh-up", help="BVH: up axis x|y|z, optionally signed (default: detected)")
 
 
+def _interrupt(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="stylesync", description="Style-preserving humanoid teleoperation")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -311,6 +317,10 @@ def main(argv: list[str] | None = None) -> int:
     replay.set_defaults(func=_replay)
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+    if threading.current_thread() is threading.main_thread():
+        # A termination request (kill, a supervisor stopping the run) ends the run as Ctrl-C does: the session
+        # stops, the session file is closed and the viewer process shut down.
+        signal.signal(signal.SIGTERM, _interrupt)
     try:
         return int(args.func(args))
     except StylesyncError as exc:

@@ -25,10 +25,11 @@ log = logging.getLogger("stylesync.viewer")
 START_TIMEOUT_S = 60.0
 _STOP = "stop"
 VIEWER_NICENESS = 10  # added to the viewer process's niceness
+PARENT_CHECK_S = 1.0  # how often an idle viewer process checks that the session's process is still there [s]
 
 
 def _serve(shapes: list[LinkShape], host: str, port: int, draw_hz: float, interactive: bool,
-           snapshots: mp.Queue, actions: mp.Queue, ready: Any) -> None:
+           snapshots: mp.Queue, actions: mp.Queue, ready: Any, parent_pid: int) -> None:
     from stylesync.viewer.web_viewer import WebViewer
 
     # The viewer yields to the control loop when they compete for a core: a late frame is harmless, a late
@@ -38,11 +39,18 @@ def _serve(shapes: list[LinkShape], host: str, port: int, draw_hz: float, intera
     ready.set()
     try:
         while True:
-            item = snapshots.get()
+            try:
+                item = snapshots.get(timeout=PARENT_CHECK_S)
+            except queue.Empty:
+                # A session killed by a signal never sends the stop, and multiprocessing only ends daemonic
+                # children at a normal exit: an orphaned viewer (re-parented) would otherwise serve forever.
+                if os.getppid() != parent_pid:
+                    break
+                continue
             if item == _STOP:
                 break
             viewer.publish(item)
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, EOFError, OSError):
         pass
     finally:
         viewer.close()
@@ -65,7 +73,7 @@ class ViewerProcess:
         ready = ctx.Event()
         self._proc = ctx.Process(target=_serve, name="stylesync-viewer", daemon=True,
                                  args=(shapes, host, self.port, draw_hz, on_action is not None, self._snapshots,
-                                       self._actions, ready))
+                                       self._actions, ready, os.getpid()))
         self._proc.start()
         if not ready.wait(START_TIMEOUT_S) or not self._proc.is_alive():
             self._proc.terminate()
