@@ -49,14 +49,15 @@ def solve_with_contact_forces(mass_matrix: np.ndarray, bias_force: np.ndarray, f
     ``free_start``: the mask of positive λ of a previous solution of a problem of the same layout, to warm-start
     the non-negative least squares (nnls.py); None solves it from scratch. Returns q̈, λ and the mask of λ > 0.
     """
-    a_eq = np.vstack([mass_matrix[:ROOT_DOFS], contact_jacobian])
-    k = a_eq.shape[0]
-    kkt = np.zeros((N_DOFS + k, N_DOFS + k))
-    kkt[:N_DOFS, :N_DOFS] = np.diag(weights)
+    k = ROOT_DOFS + contact_jacobian.shape[0]  # equality rows: the root's, then the contacts'
+    n = N_DOFS + k
+    kkt = np.zeros((n, n))
+    kkt.flat[:N_DOFS * (n + 1):n + 1] = weights  # the Hessian's diagonal
     if task_jacobian.shape[0]:
         kkt[:N_DOFS, :N_DOFS] += task_weight * task_jacobian.T @ task_jacobian
-    kkt[:N_DOFS, N_DOFS:] = a_eq.T
-    kkt[N_DOFS:, :N_DOFS] = a_eq
+    kkt[N_DOFS:N_DOFS + ROOT_DOFS, :N_DOFS] = mass_matrix[:ROOT_DOFS]
+    kkt[N_DOFS + ROOT_DOFS:, :N_DOFS] = contact_jacobian
+    kkt[:N_DOFS, N_DOFS:] = kkt[N_DOFS:, :N_DOFS].T
     n_lam = force_basis.shape[1]
     # Right-hand sides: the one of λ = 0, and a unit one per root row. λ enters only through the root rows,
     # (B λ)_root, so P = K⁻¹ [0; B_root; 0] is the solutions of the unit sides times B_root: 7 sides to solve
@@ -77,15 +78,22 @@ def solve_with_contact_forces(mass_matrix: np.ndarray, bias_force: np.ndarray, f
     sw = np.sqrt(weights)
     st = np.sqrt(task_weight)
     # The residual rows without the regularisation's (a diagonal, added below as rows or to the Gram matrix).
-    a_rows = np.vstack([sw[:, None] * p, st * task_jacobian @ p, wrench_row_weights[:, None] * wrench_matrix])
-    b_rows = np.concatenate([sw * (qdd_desired - r), st * (task_accel - task_jacobian @ r),
-                             wrench_row_weights * wrench_desired])
+    n_task = task_jacobian.shape[0]
+    a_rows = np.empty((N_DOFS + n_task + len(wrench_desired), n_lam))
+    b_rows = np.empty(len(a_rows))
+    a_rows[:N_DOFS] = sw[:, None] * p
+    b_rows[:N_DOFS] = sw * (qdd_desired - r)
+    if n_task:
+        a_rows[N_DOFS:N_DOFS + n_task] = st * task_jacobian @ p
+        b_rows[N_DOFS:N_DOFS + n_task] = st * (task_accel - task_jacobian @ r)
+    a_rows[N_DOFS + n_task:] = wrench_row_weights[:, None] * wrench_matrix
+    b_rows[N_DOFS + n_task:] = wrench_row_weights * wrench_desired
     if free_start is None or free_start.shape != (n_lam,):
         lam, _ = nnls(np.vstack([a_rows, np.diag(np.sqrt(force_regularisation))]),
                       np.concatenate([b_rows, np.zeros(n_lam)]), maxiter=50 * n_lam)
         free = lam > 0.0
     else:
         gram = a_rows.T @ a_rows
-        gram[np.diag_indices(n_lam)] += force_regularisation
+        gram.flat[::n_lam + 1] += force_regularisation  # the diagonal
         lam, free = nnls_gram(gram, a_rows.T @ b_rows, free_start)
     return r + p @ lam, lam, free

@@ -25,9 +25,10 @@ def _solve_free(gram: np.ndarray, rhs: np.ndarray, free: np.ndarray) -> np.ndarr
     z = np.zeros(len(rhs))
     idx = np.flatnonzero(free)
     if idx.size:
-        _, sol, info = lapack.dposv(gram[np.ix_(idx, idx)], rhs[idx])
+        block = gram.take(idx, 0).take(idx, 1)
+        _, sol, info = lapack.dposv(block, rhs.take(idx))
         if info != 0:  # not positive definite to working precision: the least-squares solution
-            sol = np.linalg.lstsq(gram[np.ix_(idx, idx)], rhs[idx], rcond=None)[0]
+            sol = np.linalg.lstsq(block, rhs.take(idx), rcond=None)[0]
         z[idx] = sol
     return z
 
@@ -51,7 +52,7 @@ def nnls_gram(gram: np.ndarray, rhs: np.ndarray, free_start: np.ndarray | None =
     for _ in range(max_iter):
         grad = rhs - gram @ x  # minus half the gradient: positive where increasing x_j lowers the objective
         candidates = np.where(free, -np.inf, grad)
-        j = int(np.argmax(candidates))
+        j = int(candidates.argmax())
         if candidates[j] <= tol:
             break
         free[j] = True

@@ -35,7 +35,7 @@ from stylesync.motion.stance_fsm import (
 from stylesync.motion.style_features import StyleExtractor, StyleFeatures
 from stylesync.processing.body_parameters import leg_length_m
 from stylesync.processing.interpolation import smooth_step
-from stylesync.processing.joint_map import hinge_angle, local_rotation
+from stylesync.processing.joint_map import JOINT_MAP, hinge_angle
 from stylesync.processing.operator_processing import OperatorSample
 from stylesync.sim.backend import CharacterState, MassProperties
 from stylesync.sim.character import (
@@ -65,6 +65,7 @@ _VELOCITY_SMOOTHING = 0.2  # per tick, exponential average of the desired COM ve
 _SIDE_UP = {"left": "LEFT", "right": "RIGHT"}
 _OTHER_SIDE = {"left": "right", "right": "left"}
 _LINK = {n: i for i, n in enumerate(LINK_NAMES)}
+_UPPER_JOINTS = ("neck", "left_shoulder", "right_shoulder", "left_elbow", "right_elbow")  # from the joint map
 CHAR_LEG_LENGTH_M = THIGH_LENGTH_M + SHANK_LENGTH_M
 
 
@@ -325,11 +326,16 @@ class MotionOptimizer:
             local[f"{side}_ankle"] = rot.multiply(swing_ik, twist_now)
 
         # Upper body from the joint map; the chest keeps the operator's torso orientation in the world.
-        local["chest"] = rot.multiply(rot.conjugate(q_root_d), s.quat["SPINE_CHEST"])
-        local["neck"] = local_rotation(s.quat, "neck")
-        for side in ("left", "right"):
-            local[f"{side}_shoulder"] = local_rotation(s.quat, f"{side}_shoulder")
-            knee_angle[f"{side}_elbow"] = hinge_angle(local_rotation(s.quat, f"{side}_elbow"), f"{side}_elbow")
+        # (joint_map.local_rotation of each, in one batched product; the chest relative to the level root.)
+        parents = np.stack([q_root_d, *(s.quat[JOINT_MAP[j][1]] for j in _UPPER_JOINTS)])
+        children = np.stack([s.quat["SPINE_CHEST"], *(s.quat[JOINT_MAP[j][0]] for j in _UPPER_JOINTS)])
+        upper = rot.batch_multiply(rot.batch_conjugate(parents), children)
+        local["chest"] = upper[0]
+        for j, q in zip(_UPPER_JOINTS, upper[1:], strict=True):
+            if j.endswith("elbow"):
+                knee_angle[j] = hinge_angle(q, j)
+            else:
+                local[j] = q
 
         joint_pos = np.zeros((len(JOINTS), 4))
         joint_pos[_BALL_JOINTS] = rot.batch_align_sign(

@@ -7,6 +7,7 @@ the joint's child link frame (model axes); hinge values are scalars about the hi
 
 from __future__ import annotations
 
+import functools
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 
@@ -49,16 +50,20 @@ class CharacterState:
 class MassProperties:
     link_mass_kg: np.ndarray  # (n_links,)
 
-    @property
+    @functools.cached_property
     def total_kg(self) -> float:
         return float(self.link_mass_kg.sum())
 
+    @functools.cached_property
+    def _weights(self) -> np.ndarray:
+        return self.link_mass_kg / self.total_kg
+
     def com(self, state: CharacterState) -> np.ndarray:
         """Whole-body centre of mass [m] (world)."""
-        return self.link_mass_kg @ state.link_com_world / self.total_kg
+        return self._weights @ state.link_com_world
 
     def com_velocity(self, state: CharacterState) -> np.ndarray:
-        return self.link_mass_kg @ state.link_com_vel_world / self.total_kg
+        return self._weights @ state.link_com_vel_world
 
 
 @dataclass
