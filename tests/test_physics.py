@@ -41,3 +41,21 @@ def test_sole_lies_ankle_height_below_the_ankle_joint():
             corners = sole_corners_world(s.link_origin_world[i], s.link_quat_wxyz[i])
             assert np.allclose(corners[:, 2], dz, atol=1e-3)
         assert s.feet_pressing() == {"left": touches, "right": touches}
+
+
+def test_a_diverged_motion_counts_as_a_fall_even_in_the_air():
+    # A controller that runs away can whip the body into the air (in the bench, one run was launched 50 m: the
+    # engine clamps joint speeds at 100 rad/s, which does not conserve momentum). Neither fall test (pelvis low, a
+    # non-foot contact) sees a body in the air; a link faster than any human limb, or a pelvis above any jump, does.
+    from stylesync.session import DIVERGED_LINK_SPEED_MPS, DIVERGED_ROOT_HEIGHT_M, Session
+
+    b = make_backend(WorldConfig(), 600.0)
+    b.reset(np.array([0.0, 0.0, STANDING_ROOT_HEIGHT_M]), np.array([1.0, 0.0, 0.0, 0.0]))
+    s = b.read_state(0.0)
+    b.close()
+    assert Session._fall_reason(s) == ""
+    s.link_com_vel_world[5] = [0.0, DIVERGED_LINK_SPEED_MPS + 1.0, 0.0]
+    assert "diverged" in Session._fall_reason(s)
+    s.link_com_vel_world[5] = 0.0
+    s.root_pos_world[2] = DIVERGED_ROOT_HEIGHT_M + 0.1
+    assert "diverged" in Session._fall_reason(s)

@@ -35,6 +35,10 @@ from stylesync.sources.base import OperatorSource
 
 log = logging.getLogger("stylesync.session")
 FALL_ROOT_HEIGHT_M = 0.5  # a fall: pelvis below this height, or a non-foot link on the ground
+# A diverged motion, counted as a fall: a link faster than a human limb ever moves (a trained kick's foot reaches
+# about 15-20 m/s), or the pelvis higher than a jump can lift it (0.88 m standing).
+DIVERGED_LINK_SPEED_MPS = 25.0
+DIVERGED_ROOT_HEIGHT_M = 2.5
 SILENT_STREAM_TIMEOUT_S = 2.0
 FIRST_FRAME_TIMEOUT_S = 10.0
 _LINK = {n: i for i, n in enumerate(LINK_NAMES)}
@@ -235,6 +239,11 @@ class Session:
             return f"pelvis at {state.root_pos_world[2]:.2f} m < {FALL_ROOT_HEIGHT_M} m"
         if state.non_foot_ground_contact:
             return "a link other than a foot touched the ground"
+        # A run-away controller (or simulation) is a failure too, even while the body is in the air.
+        speed = float(np.sqrt(np.einsum("ij,ij->i", state.link_com_vel_world, state.link_com_vel_world).max()))
+        if speed > DIVERGED_LINK_SPEED_MPS or state.root_pos_world[2] > DIVERGED_ROOT_HEIGHT_M:
+            return (f"the motion diverged (a link at {speed:.0f} m/s, pelvis at {state.root_pos_world[2]:.1f} m; "
+                    f"limits {DIVERGED_LINK_SPEED_MPS:.0f} m/s, {DIVERGED_ROOT_HEIGHT_M:.1f} m)")
         return ""
 
     def _log(self, lg: TickLog, t: float, sample, state: CharacterState, ref, tick_ms: float) -> None:
