@@ -326,7 +326,8 @@ class MotionOptimizer:
             local[f"{side}_ankle"] = rot.multiply(swing_ik, twist_now)
 
         # Upper body from the joint map; the chest keeps the operator's torso orientation in the world.
-        # (joint_map.local_rotation of each, in one batched product; the chest relative to the level root.)
+        # Local rotations conj(q_parent) ⊗ q_child of the joint map's pairs, in one batched product; the chest relative
+        # to the level root.
         parents = np.stack([q_root_d, *(s.quat[JOINT_MAP[j][1]] for j in _UPPER_JOINTS)])
         children = np.stack([s.quat["SPINE_CHEST"], *(s.quat[JOINT_MAP[j][0]] for j in _UPPER_JOINTS)])
         upper = rot.batch_multiply(rot.batch_conjugate(parents), children)

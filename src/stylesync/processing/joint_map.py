@@ -41,11 +41,6 @@ HINGE_AXIS_CANONICAL = np.array([0.0, -1.0, 0.0])  # knee and elbow axis (model 
 HINGE_RANGE_RAD = {"knee": (-np.pi, 0.0), "elbow": (0.0, np.pi)}  # URDF joint limits
 
 
-def local_rotation(world_quats: dict[str, np.ndarray], joint: str) -> np.ndarray:
-    child, parent = JOINT_MAP[joint]
-    return rot.multiply(rot.conjugate(world_quats[parent]), world_quats[child])
-
-
 def hinge_angle(q_local: np.ndarray, joint: str) -> float:
     lo, hi = HINGE_RANGE_RAD[joint.split("_")[1]]
     return min(max(rot.twist_angle(q_local, HINGE_AXIS_CANONICAL), lo), hi)
