@@ -261,9 +261,9 @@ class Session:
             root_z=float(state.root_pos_world[2]),
             contact_l=state.foot_contact_force_n["left_ankle"], contact_r=state.foot_contact_force_n["right_ankle"],
             ch_joints=state.link_origin_world[CHARACTER_LINKS],
-            op_joints=np.array([sample.pos[n] for n in OPERATOR_JOINTS]),
+            _op_pos=sample.pos,
             _v_lipm=self.controller.telemetry.lipm_force_n,
-            _op_features=ref.operator_features.as_row(),
+            _op_features=ref.operator_features,
             # The joint error and the character's style features are computed from these after the run
             # (_add_after_run_columns). The arrays are the state's and the reference's own, new at every tick.
             _q=state.joint_pos, _q_ref=ref.joint_pos,
@@ -288,9 +288,12 @@ def _add_after_run_columns(lg: TickLog) -> None:
             arr = np.asarray(values, dtype=float)
             for k, axis in enumerate(axes):
                 lg.columns[f"{prefix}_{axis}"] = arr[:, k].tolist()
+    op_pos = lg.columns.pop("_op_pos", [])
+    if op_pos:
+        lg.columns["op_joints"] = [np.array([pos[n] for n in OPERATOR_JOINTS]) for pos in op_pos]
     features = lg.columns.pop("_op_features", [])
     if features:
-        arr = np.asarray(features, dtype=float)
+        arr = np.asarray([f.as_row() for f in features], dtype=float)
         for k, name in enumerate(_FEATURES):
             lg.columns[f"op_{name}"] = arr[:, k].tolist()
     raw = {k: lg.columns.pop(k, []) for k in ("_q", "_q_ref", "_ch_legs", "_ch_leg_quats", "_ch_com", "_ch_root_quat")}

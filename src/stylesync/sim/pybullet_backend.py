@@ -121,8 +121,7 @@ class PyBulletBackend(PhysicsBackend):
         self._link_idx = [index_by_name[n] for n in LINK_NAMES]
         self._foot_idx = {index_by_name[n]: n for n in FOOT_LINKS}
         self._is_ball = np.array([j.kind is JointKind.BALL for j in JOINTS])
-        self._ball_idx = [j for j, b in zip(self._joint_idx, self._is_ball, strict=True) if b]  # PyBullet indices
-        self._hinge_idx = [j for j, b in zip(self._joint_idx, self._is_ball, strict=True) if not b]
+        self._pos_flat, self._vel_flat = self._feedback_maps()
         self._last_torque_values: np.ndarray | None = None  # the last torques applied, and their PyBullet form
         self._last_forces: list[list[float]] = []
         for j, spec in zip(self._joint_idx, JOINTS, strict=True):
@@ -245,16 +244,24 @@ class PyBulletBackend(PhysicsBackend):
 
     def read_joint_feedback(self) -> JointFeedback:
         _, base_q, _, ang_vel, all_states = self._read_raw()
-        n = len(self._joint_idx)
-        pos = np.zeros((n, 4))
-        vel = np.zeros((n, 3))
-        ball = [all_states[j] for j in self._ball_idx]
-        hinge = [all_states[j] for j in self._hinge_idx]
-        pos[self._is_ball] = np.array([st[0] for st in ball])[:, [3, 0, 1, 2]]  # xyzw -> wxyz
-        vel[self._is_ball] = [st[1] for st in ball]
-        pos[~self._is_ball, 0] = [st[0][0] for st in hinge]
-        vel[~self._is_ball, 0] = [st[1][0] for st in hinge]
+        states = [all_states[j] for j in self._joint_idx]
+        # The engine's values in joint order (ball: x, y, z, w and 3 rates; hinge: 1 and 1), scattered into the
+        # (n, 4) wxyz / (n, 3) layout by index maps built once (_feedback_maps).
+        pos = np.zeros((len(states), 4))
+        vel = np.zeros((len(states), 3))
+        pos.flat[self._pos_flat] = np.fromiter(itertools.chain.from_iterable(st[0] for st in states), float,
+                                               len(self._pos_flat))
+        vel.flat[self._vel_flat] = np.fromiter(itertools.chain.from_iterable(st[1] for st in states), float,
+                                               len(self._vel_flat))
         return JointFeedback(pos, vel, _canonical_from_link_xyzw(base_q), np.array(ang_vel))
+
+    def _feedback_maps(self) -> tuple[np.ndarray, np.ndarray]:
+        """Flat indices into (n, 4) positions and (n, 3) velocities of the engine's per-joint values, in order."""
+        pos, vel = [], []
+        for k, ball in enumerate(self._is_ball):
+            pos += [4 * k + 1, 4 * k + 2, 4 * k + 3, 4 * k] if ball else [4 * k]  # x, y, z, w -> w, x, y, z
+            vel += [3 * k, 3 * k + 1, 3 * k + 2] if ball else [3 * k]
+        return np.array(pos), np.array(vel)
 
     def apply_torques(self, torques: Torques) -> None:
         v = torques.values
