@@ -62,3 +62,20 @@ def test_batched_style_features_match_the_extractor():
         f = StyleExtractor()(*({s: x[i, k] for k, s in enumerate(sides)} for x in (hip, knee, ankle, shank, foot)),
                              com[i], pelvis[i])
         assert np.abs(rows[i] - np.array(f.as_row())).max() < 1e-12
+
+
+def test_joint_map_local_rotations_are_each_pairs_relative_rotation():
+    from stylesync.processing.joint_map import JOINT_MAP, local_rotations
+
+    rng = np.random.default_rng(7)
+    names = {n for pair in JOINT_MAP.values() for n in pair}
+    world = {n: rot.normalize(rng.normal(size=4)) for n in names}
+    level = rot.normalize(rng.normal(size=4))
+    joints = tuple(JOINT_MAP)
+    out = local_rotations(world, joints, {"chest": level})
+    for j, q in zip(joints, out, strict=True):
+        child, parent = JOINT_MAP[j]
+        q_parent = level if j == "chest" else world[parent]
+        # q_parent ⊗ local = q_child
+        np.testing.assert_allclose(rot.multiply(q_parent, q), world[child], atol=1e-12)
+    np.testing.assert_allclose(rot.batch_slerp(out, out[::-1], 1.0), rot.batch_align_sign(out[::-1], out), atol=1e-12)

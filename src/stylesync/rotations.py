@@ -269,12 +269,20 @@ def batch_align_sign(q: Array, reference: Array) -> Array:
     return np.where(np.einsum("ij,ij->i", q, reference)[:, None] < 0, -q, q)
 
 
+def batch_slerp_rotvec(q0: Array, q1: Array) -> Array:
+    """(n, 3) rotation vectors [rad] that take each row of q0 to q1 along the shorter arc (the slerp's path)."""
+    return batch_rotvec(batch_multiply(batch_conjugate(q0), batch_align_sign(q1, q0)))
+
+
+def batch_slerp_along(q0: Array, rotvec: Array, t: float) -> Array:
+    """Each row of q0 turned by the fraction t of its :func:`batch_slerp_rotvec`, (n, 4)."""
+    q = batch_multiply(q0, batch_quat_from_rotvec(t * rotvec))
+    return q / np.linalg.norm(q, axis=1, keepdims=True)
+
+
 def batch_slerp(q0: Array, q1: Array, t: float) -> Array:
     """:func:`slerp` of each row, (n, 4)."""
-    q1 = batch_align_sign(q1, q0)
-    d = batch_multiply(batch_conjugate(q0), q1)
-    q = batch_multiply(q0, batch_quat_from_rotvec(t * batch_rotvec(d)))
-    return q / np.linalg.norm(q, axis=1, keepdims=True)
+    return batch_slerp_along(q0, batch_slerp_rotvec(q0, q1), t)
 
 
 def batch_matrix_from_quat(q: Array) -> Array:

@@ -268,7 +268,7 @@ class Session:
             # (_add_after_run_columns). The arrays are the state's and the reference's own, new at every tick.
             _q=state.joint_pos, _q_ref=ref.joint_pos,
             _ch_legs=state.link_origin_world[_LEG_LINKS], _ch_leg_quats=state.link_quat_wxyz[_LEG_LINKS[:, 1:]],
-            _ch_com=com, _ch_root_quat=state.root_quat_wxyz.copy(),
+            _ch_root_quat=state.root_quat_wxyz.copy(),
         )
 
 
@@ -282,6 +282,7 @@ def _add_after_run_columns(lg: TickLog) -> None:
     """Columns derived from what each tick recorded, in one batched computation after the run instead of one per
     control tick: ``joint_err_deg`` (mean over the joints of the angle between the character's joint and the
     reference's) and the character's style features (Sec. 5.2), ``ch_<feature>``."""
+    ch_com = lg.columns.get("_v_com", [])  # the character's COM, for its style features below
     for key, prefix, axes in _VECTOR_COLUMNS:
         values = lg.columns.pop(key, [])
         if values:
@@ -296,13 +297,13 @@ def _add_after_run_columns(lg: TickLog) -> None:
         arr = np.asarray([f.as_row() for f in features], dtype=float)
         for k, name in enumerate(_FEATURES):
             lg.columns[f"op_{name}"] = arr[:, k].tolist()
-    raw = {k: lg.columns.pop(k, []) for k in ("_q", "_q_ref", "_ch_legs", "_ch_leg_quats", "_ch_com", "_ch_root_quat")}
-    if not raw["_ch_com"]:
+    raw = {k: lg.columns.pop(k, []) for k in ("_q", "_q_ref", "_ch_legs", "_ch_leg_quats", "_ch_root_quat")}
+    if not ch_com:
         return
     err = joint_error(np.asarray(raw["_q"]), np.asarray(raw["_q_ref"]))  # (n, n_joints, 3)
     lg.columns["joint_err_deg"] = np.degrees(np.linalg.norm(err, axis=2)).mean(axis=1).tolist()
     legs, quats = np.asarray(raw["_ch_legs"]), np.asarray(raw["_ch_leg_quats"])  # (n, 2, 3, 3), (n, 2, 2, 4)
     rows = style_rows(legs[:, :, 0], legs[:, :, 1], legs[:, :, 2], quats[:, :, 0], quats[:, :, 1],
-                      np.asarray(raw["_ch_com"]), np.asarray(raw["_ch_root_quat"]))
+                      np.asarray(ch_com), np.asarray(raw["_ch_root_quat"]))
     for k, name in enumerate(_FEATURES):
         lg.columns[f"ch_{name}"] = rows[:, k].tolist()

@@ -35,7 +35,7 @@ from stylesync.motion.stance_fsm import (
 from stylesync.motion.style_features import StyleExtractor, StyleFeatures
 from stylesync.processing.body_parameters import leg_length_m
 from stylesync.processing.interpolation import smooth_step
-from stylesync.processing.joint_map import JOINT_MAP, hinge_angle
+from stylesync.processing.joint_map import hinge_angle, local_rotations
 from stylesync.processing.operator_processing import OperatorSample
 from stylesync.sim.backend import CharacterState, MassProperties
 from stylesync.sim.character import (
@@ -65,7 +65,7 @@ _VELOCITY_SMOOTHING = 0.2  # per tick, exponential average of the desired COM ve
 _SIDE_UP = {"left": "LEFT", "right": "RIGHT"}
 _OTHER_SIDE = {"left": "right", "right": "left"}
 _LINK = {n: i for i, n in enumerate(LINK_NAMES)}
-_UPPER_JOINTS = ("neck", "left_shoulder", "right_shoulder", "left_elbow", "right_elbow")  # from the joint map
+_UPPER_JOINTS = ("chest", "neck", "left_shoulder", "right_shoulder", "left_elbow", "right_elbow")  # joint map
 CHAR_LEG_LENGTH_M = THIGH_LENGTH_M + SHANK_LENGTH_M
 
 
@@ -326,13 +326,7 @@ class MotionOptimizer:
             local[f"{side}_ankle"] = rot.multiply(swing_ik, twist_now)
 
         # Upper body from the joint map; the chest keeps the operator's torso orientation in the world.
-        # Local rotations conj(q_parent) ⊗ q_child of the joint map's pairs, in one batched product; the chest relative
-        # to the level root.
-        parents = np.stack([q_root_d, *(s.quat[JOINT_MAP[j][1]] for j in _UPPER_JOINTS)])
-        children = np.stack([s.quat["SPINE_CHEST"], *(s.quat[JOINT_MAP[j][0]] for j in _UPPER_JOINTS)])
-        upper = rot.batch_multiply(rot.batch_conjugate(parents), children)
-        local["chest"] = upper[0]
-        for j, q in zip(_UPPER_JOINTS, upper[1:], strict=True):
+        for j, q in zip(_UPPER_JOINTS, local_rotations(s.quat, _UPPER_JOINTS, {"chest": q_root_d}), strict=True):
             if j.endswith("elbow"):
                 knee_angle[j] = hinge_angle(q, j)
             else:

@@ -69,8 +69,7 @@ class SlerpRamp:
             self._out = ref.copy()
         self._start = self._out.copy()
         self._target = rot.batch_align_sign(ref, self._start)
-        # The slerp's rotation vector from start to target (rot.batch_slerp), fixed until the next frame.
-        self._rotvec_rad = rot.batch_rotvec(rot.batch_multiply(rot.batch_conjugate(self._start), self._target))
+        self._rotvec_rad = rot.batch_slerp_rotvec(self._start, self._target)  # fixed until the next frame
         self._i = 0
 
     def step(self) -> np.ndarray:
@@ -78,6 +77,5 @@ class SlerpRamp:
             raise ValueError("SlerpRamp.step() before the first push()")
         self._i += 1
         frac = min(self.k * self._i, 1.0)
-        q = rot.batch_multiply(self._start, rot.batch_quat_from_rotvec(frac * self._rotvec_rad))  # rot.batch_slerp
-        self._out = q / np.linalg.norm(q, axis=1, keepdims=True)
+        self._out = rot.batch_slerp_along(self._start, self._rotvec_rad, frac)
         return self._out.copy()

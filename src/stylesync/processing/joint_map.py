@@ -41,6 +41,16 @@ HINGE_AXIS_CANONICAL = np.array([0.0, -1.0, 0.0])  # knee and elbow axis (model 
 HINGE_RANGE_RAD = {"knee": (-np.pi, 0.0), "elbow": (0.0, np.pi)}  # URDF joint limits
 
 
+def local_rotations(world_quats: dict[str, np.ndarray], joints: tuple[str, ...],
+                    parents: dict[str, np.ndarray] | None = None) -> np.ndarray:
+    """(len(joints), 4) local rotations conj(q_parent) ⊗ q_child of the joint map's pairs, in one batched product.
+    ``parents``: world orientations to use instead of a joint's mapped parent (e.g. the chest against a level root)."""
+    parents = parents or {}
+    q_parent = np.stack([parents[j] if j in parents else world_quats[JOINT_MAP[j][1]] for j in joints])
+    q_child = np.stack([world_quats[JOINT_MAP[j][0]] for j in joints])
+    return rot.batch_multiply(rot.batch_conjugate(q_parent), q_child)
+
+
 def hinge_angle(q_local: np.ndarray, joint: str) -> float:
     lo, hi = HINGE_RANGE_RAD[joint.split("_")[1]]
     return min(max(rot.twist_angle(q_local, HINGE_AXIS_CANONICAL), lo), hi)
