@@ -4,9 +4,10 @@
 
 Physics alone: the same world and character stepped at the physics rate with zero joint torques (the character
 simply falls and lies; contact work is comparable). Whole pipeline: source -> processing -> motion -> control ->
-physics, headless, as fast as possible. Both are timed in this process, alternately (--repeat times each), and their
-medians and per-pair ratios are printed: the ratio is meaningful on a noisy machine even when the absolute figures
-are not.
+physics, headless, as fast as possible, as `stylesync demo` runs it: the operator side (source, processing, style
+features) computed ahead in a second process (prefetch.py). The pipeline is also timed with everything in one
+process. All are timed alternately (--repeat times each), and their medians and per-round ratios are printed: the
+ratio is meaningful on a noisy machine even when the absolute figures are not.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ import numpy as np
 
 from stylesync.config import OperatorConfig, SessionConfig
 from stylesync.metrics.bench import physics_only_rtf
-from stylesync.session import Session
+from stylesync.session import Session, SessionResult
 from stylesync.sources.builtin_operator import builtin_operator
 
 
@@ -30,26 +31,39 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args()
     cfg = SessionConfig(duration_s=args.duration, seed=args.seed, operator=OperatorConfig(clip=args.clip))
-    phys_rtfs, rtfs = [], []
+    phys_rtfs, rtfs, one_rtfs = [], [], []
     result = None
-    for _ in range(max(args.repeat, 1)):  # alternated, so that both see the machine's slow and fast spells alike
-        phys_rtfs.append(physics_only_rtf(cfg, args.duration))
+
+    def pipeline(prefetch: bool) -> SessionResult:
         source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
-        result = Session(cfg, source).run()
+        session = Session(cfg, source)
+        session.prefetch_operator = prefetch
+        return session.run()
+
+    for _ in range(max(args.repeat, 1)):  # alternated, so that all see the machine's slow and fast spells alike
+        phys_rtfs.append(physics_only_rtf(cfg, args.duration))
+        one = pipeline(prefetch=False)
+        one_rtfs.append(one.sim_duration_s / one.wall_duration_s)
+        result = pipeline(prefetch=True)
         rtfs.append(result.sim_duration_s / result.wall_duration_s)
     assert result is not None
-    phys, rtf = float(np.median(phys_rtfs)), float(np.median(rtfs))
+    phys, rtf, one_rtf = float(np.median(phys_rtfs)), float(np.median(rtfs)), float(np.median(one_rtfs))
     ratios = [r / p for r, p in zip(rtfs, phys_rtfs, strict=True)]
+    one_ratios = [r / p for r, p in zip(one_rtfs, phys_rtfs, strict=True)]
     ticks = len(result.stage_ms["motion"])
     steps = len(result.stage_ms["physics"])
     print(f"clip {args.clip}, simulated {result.sim_duration_s:.2f} s"
           f"{f' (fell at {result.fall_time_s:.2f} s)' if result.fell else ''}, {ticks} control ticks, "
           f"{steps} physics steps, {len(rtfs)} alternating measurements of each")
     print(f"realtime factor, physics alone:  {phys:6.2f}x median   ({', '.join(f'{x:.2f}' for x in phys_rtfs)})")
-    print(f"realtime factor, whole pipeline: {rtf:6.2f}x median   ({', '.join(f'{x:.2f}' for x in rtfs)})")
+    print(f"realtime factor, whole pipeline: {rtf:6.2f}x median   ({', '.join(f'{x:.2f}' for x in rtfs)})"
+          f"{'' if result.operator_prefetched else '   (operator side NOT prefetched: see prefetch.py)'}")
+    print(f"  ... in one process:            {one_rtf:6.2f}x median   ({', '.join(f'{x:.2f}' for x in one_rtfs)})")
     print(f"ratio pipeline / physics alone:  {float(np.median(ratios)):6.2f} median   "
           f"({', '.join(f'{x:.2f}' for x in ratios)})")
-    print("time per control tick [ms], mean / p99 (last pipeline measurement):")
+    print(f"  ... in one process:            {float(np.median(one_ratios)):6.2f} median   "
+          f"({', '.join(f'{x:.2f}' for x in one_ratios)})")
+    print("time per control tick in the main process [ms], mean / p99 (last pipeline measurement):")
     per_tick = {k: np.asarray(v) for k, v in result.stage_ms.items()}
     steps_per_tick = steps / max(ticks, 1)
     for name, values in per_tick.items():

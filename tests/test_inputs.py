@@ -236,6 +236,7 @@ for k in range(int(5.0 * 60)):
         result = Session(SessionConfig(duration_s=3.0, realtime=True), source).run()
     finally:
         sender.wait(timeout=30)
+        source.close()
     assert not result.fell
     assert source.frames_received > 120 and source.rejected_frames == 0
     assert len(result.input_latency_ms) > 100

@@ -28,6 +28,7 @@ from stylesync.motion.pose_optimization import MotionOptimizer
 from stylesync.motion.stance_fsm import Stance
 from stylesync.motion.style_features import ROW_NAMES as _FEATURES
 from stylesync.motion.style_features import style_rows
+from stylesync.prefetch import OperatorInline, OperatorPrefetch
 from stylesync.processing.operator_processing import OperatorProcessing, OperatorSample
 from stylesync.sim.backend import CharacterState, PhysicsBackend, make_backend
 from stylesync.sim.character import LINK_NAMES, STANDING_ROOT_HEIGHT_M
@@ -75,6 +76,17 @@ class SessionResult:
     bound_counts: dict[str, int]
     stage_ms: dict[str, list[float]]
     input_latency_ms: list[float] = field(default_factory=list)  # live frames: arrival -> first control tick using it
+    operator_prefetched: bool = False  # the operator side ran ahead in a second process (prefetch.py)
+
+
+def control_tick_steps(n_steps: int, physics_dt_s: float, control_dt_s: float) -> list[int]:
+    """The physics steps a control tick runs on: the first step at or after each control period's due time."""
+    steps, next_control = [], 0.0
+    for step in range(n_steps):
+        if step * physics_dt_s + 1e-12 >= next_control:
+            next_control += control_dt_s
+            steps.append(step)
+    return steps
 
 
 class Session:
@@ -103,6 +115,9 @@ class Session:
         self.commands: queue.SimpleQueue[Callable[[Session], None]] = queue.SimpleQueue()
         self.paused = False
         self.stop_on_fall = True
+        # An offline run of a recorded operator computes the operator side ahead in a second process
+        # (prefetch.py; the same results). False keeps it in this process.
+        self.prefetch_operator = True
         self.closed = False
         self.fell = False  # the run has recorded a fall (viewers show it)
 
@@ -153,82 +168,89 @@ class Session:
         tick_log = TickLog()
         stage_ms: dict[str, list[float]] = {"processing": [], "motion": [], "control_update": [], "torques": [],
                                             "physics": []}
-        next_control = 0.0
         next_render = 0.0
         last_frame_sim = 0.0
         self.fell, fall_time, fall_reason = False, None, ""
         latency_ms: list[float] = []
         wall0 = time.perf_counter()
         step = 0
-        for step in range(n_steps):
-            t = step * dt
-            if t + 1e-12 >= next_control:
-                next_control += control_dt
-                self._service_commands()
-                if self.paused:
-                    p0 = time.perf_counter()
-                    while self.paused and not self.closed:
-                        time.sleep(0.02)
-                        self._service_commands()
-                    wall0 += time.perf_counter() - p0  # a pause is neither simulated nor wall time of the run
-                c0 = time.perf_counter()
-                frames = self.source.poll(t)
-                for f in frames:
-                    self.processing.push(f)
-                    if "arrival_wall_s" in f.extras:
-                        latency_ms.append((c0 - f.extras["arrival_wall_s"]) * 1e3)
-                if frames:
-                    last_frame_sim = t
-                elif t - last_frame_sim > SILENT_STREAM_TIMEOUT_S and self._source_is_live():
-                    raise SourceError(f"operator stream silent for more than {SILENT_STREAM_TIMEOUT_S:.0f} s")
-                sample = self.processing.step(t)
-                self.last_sample = sample
-                c1 = time.perf_counter()
-                state = self.backend.read_state(t)
-                ref = self.motion.update(sample, state, self.mass)
-                c2 = time.perf_counter()
-                self.controller.update(state, ref, self.backend.joint_space_inertia())
-                c3 = time.perf_counter()
-                stage_ms["processing"].append((c1 - c0) * 1e3)
-                stage_ms["motion"].append((c2 - c1) * 1e3)
-                stage_ms["control_update"].append((c3 - c2) * 1e3)
-                self._log(tick_log, t, sample, state, ref, (c3 - c0) * 1e3)
-                if self.on_tick is not None:
-                    self.on_tick(state, ref)
-                reason = self._fall_reason(state)
-                if reason and not self.fell:
-                    self.fell, fall_time, fall_reason = True, t, reason
-                    log.warning("character fell at t=%.2f s (%s)", t, reason)
-                if self.fell and self.stop_on_fall:
-                    break
-                if self.closed:
-                    break
-                if render_every_s is not None and t >= next_render and hasattr(self.backend, "render_rgb"):
-                    next_render += render_every_s
-                    com = self.mass.com(state)
-                    self.renders.append((t, self.backend.render_rgb([com[0], com[1], 0.8])))  # type: ignore[attr-defined]
-                if progress is not None:
-                    progress(t, time.perf_counter() - wall0)
-            p0 = time.perf_counter()
-            fb = self.backend.read_joint_feedback() if self.controller.needs_joint_feedback else None
-            torques = self.controller.torques(fb)
-            self.last_torques = torques.values
-            self.backend.apply_torques(torques)
-            p1 = time.perf_counter()
-            self.backend.step()
-            p2 = time.perf_counter()
-            stage_ms["torques"].append((p1 - p0) * 1e3)
-            stage_ms["physics"].append((p2 - p1) * 1e3)
-            if cfg.realtime:
-                lag = (t + dt) - (time.perf_counter() - wall0)
-                if lag > 0:
-                    time.sleep(lag)
+        tick_steps = control_tick_steps(n_steps, dt, control_dt)
+        is_tick = np.zeros(n_steps, dtype=bool)
+        is_tick[tick_steps] = True
+        operator: OperatorInline | OperatorPrefetch = OperatorInline(self.source, self.processing)
+        if self.prefetch_operator and OperatorPrefetch.usable(self.source, cfg.realtime, cfg.gui):
+            operator = OperatorPrefetch(self.source, self.processing, [k * dt for k in tick_steps])
+        try:
+            for step in range(n_steps):
+                t = step * dt
+                if is_tick[step]:
+                    self._service_commands()
+                    if self.paused:
+                        p0 = time.perf_counter()
+                        while self.paused and not self.closed:
+                            time.sleep(0.02)
+                            self._service_commands()
+                        wall0 += time.perf_counter() - p0  # a pause is neither simulated nor wall time of the run
+                    c0 = time.perf_counter()
+                    frames = operator.poll(t)
+                    for f in frames:
+                        if "arrival_wall_s" in f.extras:
+                            latency_ms.append((c0 - f.extras["arrival_wall_s"]) * 1e3)
+                    if frames:
+                        last_frame_sim = t
+                    elif t - last_frame_sim > SILENT_STREAM_TIMEOUT_S and self._source_is_live():
+                        raise SourceError(f"operator stream silent for more than {SILENT_STREAM_TIMEOUT_S:.0f} s")
+                    sample, analysis = operator.tick(t)
+                    self.last_sample = sample
+                    c1 = time.perf_counter()
+                    state = self.backend.read_state(t)
+                    ref = self.motion.update(sample, state, self.mass, analysis)
+                    c2 = time.perf_counter()
+                    self.controller.update(state, ref, self.backend.joint_space_inertia())
+                    c3 = time.perf_counter()
+                    stage_ms["processing"].append((c1 - c0) * 1e3)
+                    stage_ms["motion"].append((c2 - c1) * 1e3)
+                    stage_ms["control_update"].append((c3 - c2) * 1e3)
+                    self._log(tick_log, t, sample, state, ref, (c3 - c0) * 1e3)
+                    if self.on_tick is not None:
+                        self.on_tick(state, ref)
+                    reason = self._fall_reason(state)
+                    if reason and not self.fell:
+                        self.fell, fall_time, fall_reason = True, t, reason
+                        log.warning("character fell at t=%.2f s (%s)", t, reason)
+                    if self.fell and self.stop_on_fall:
+                        break
+                    if self.closed:
+                        break
+                    if render_every_s is not None and t >= next_render and hasattr(self.backend, "render_rgb"):
+                        next_render += render_every_s
+                        com = self.mass.com(state)
+                        self.renders.append((t, self.backend.render_rgb([com[0], com[1], 0.8])))  # type: ignore[attr-defined]
+                    if progress is not None:
+                        progress(t, time.perf_counter() - wall0)
+                p0 = time.perf_counter()
+                fb = self.backend.read_joint_feedback() if self.controller.needs_joint_feedback else None
+                torques = self.controller.torques(fb)
+                self.last_torques = torques.values
+                self.backend.apply_torques(torques)
+                p1 = time.perf_counter()
+                self.backend.step()
+                p2 = time.perf_counter()
+                stage_ms["torques"].append((p1 - p0) * 1e3)
+                stage_ms["physics"].append((p2 - p1) * 1e3)
+                if cfg.realtime:
+                    lag = (t + dt) - (time.perf_counter() - wall0)
+                    if lag > 0:
+                        time.sleep(lag)
+        finally:
+            operator.close()
         _add_after_run_columns(tick_log)
         wall = time.perf_counter() - wall0
         sim_t = (step + 1) * dt if not (self.fell and self.stop_on_fall) else float(fall_time or 0.0)
         return SessionResult(tick_log, self.fell, fall_time, fall_reason, sim_t, wall, step + 1,
-                             getattr(self.source, "rejected_frames", 0), self.processing.dropped_joint_values,
-                             dict(self.bounds.counts), stage_ms, latency_ms)
+                             operator.rejected_frames, operator.dropped_joint_values,
+                             dict(self.bounds.counts), stage_ms, latency_ms,
+                             isinstance(operator, OperatorPrefetch))
 
     def _source_is_live(self) -> bool:
         return bool(getattr(self.source, "live", False))

@@ -53,6 +53,7 @@ def summarize(result: SessionResult) -> dict:
         "operator_steps": int(len(touchdowns(op))),
         "character_steps": int(len(touchdowns(ch))),
         "realtime_factor": round(result.sim_duration_s / max(result.wall_duration_s, 1e-9), 3),
+        "operator_prefetched": result.operator_prefetched,  # operator side in a second process (prefetch.py)
         "control_tick_ms": {"p50": float(np.percentile(tick, 50)), "p99": float(np.percentile(tick, 99))},
         "state_transition_delay_s": {
             "mean": float(np.mean(delays)) if delays else 0.0,

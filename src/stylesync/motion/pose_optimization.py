@@ -17,6 +17,8 @@ Per control tick, from the smoothed operator sample and the character's current 
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from stylesync import rotations as rot
@@ -65,8 +67,9 @@ _VELOCITY_SMOOTHING = 0.2  # per tick, exponential average of the desired COM ve
 _SIDE_UP = {"left": "LEFT", "right": "RIGHT"}
 _OTHER_SIDE = {"left": "right", "right": "left"}
 _LINK = {n: i for i, n in enumerate(LINK_NAMES)}
-_UPPER_JOINTS = ("chest", "neck", "left_shoulder", "right_shoulder", "left_elbow", "right_elbow")  # joint map
+UPPER_JOINTS = ("chest", "neck", "left_shoulder", "right_shoulder", "left_elbow", "right_elbow")  # joint map
 CHAR_LEG_LENGTH_M = THIGH_LENGTH_M + SHANK_LENGTH_M
+_STYLE = StyleExtractor()  # stateless
 
 
 def _heading_frame_fraction(p_h, al_h, ar_h, al_c, ar_c, scale: float, R: np.ndarray) -> np.ndarray:
@@ -104,6 +107,38 @@ class _SmoothedRate:
         return self._rate.copy()
 
 
+@dataclass(frozen=True)
+class OperatorAnalysis:
+    """What the motion stage reads from one operator sample alone, without the character: it can be computed
+    ahead of the control tick (prefetch.py) and is the same wherever it is computed."""
+
+    features: StyleFeatures  # Sec. 5.2
+    root_quat_wxyz: np.ndarray  # the level root with the operator's heading H (Sec. 5.4)
+    upper_local_wxyz: np.ndarray  # (len(UPPER_JOINTS), 4) joint-map local rotations, chest against that root
+    leg_m: float  # the operator's leg length, Eq. 1 [m]
+
+
+def operator_features(s: OperatorSample) -> StyleFeatures:
+    """The style features F of Sec. 5.2 of one operator sample."""
+    hip = {k: s.pos[f"HIP_{v}"] for k, v in _SIDE_UP.items()}
+    knee = {k: s.pos[f"KNEE_{v}"] for k, v in _SIDE_UP.items()}
+    ankle = {k: s.pos[f"ANKLE_{v}"] for k, v in _SIDE_UP.items()}
+    shank = {k: s.quat[f"KNEE_{v}"] for k, v in _SIDE_UP.items()}
+    foot = {k: s.quat[f"ANKLE_{v}"] for k, v in _SIDE_UP.items()}
+    return _STYLE(hip, knee, ankle, shank, foot, s.com_world, s.quat["PELVIS"])
+
+
+def _upper_local(s: OperatorSample, root_quat_wxyz: np.ndarray) -> np.ndarray:
+    """The upper body's joint-map rotations; the chest keeps the operator's torso orientation in the world."""
+    return local_rotations(s.quat, UPPER_JOINTS, {"chest": root_quat_wxyz})
+
+
+def analyse_operator(s: OperatorSample) -> OperatorAnalysis:
+    features = operator_features(s)
+    q_root = level_root(features.H)
+    return OperatorAnalysis(features, q_root, _upper_local(s, q_root), leg_length_m(s.pos, ankle_height_m=0.0))
+
+
 class MotionOptimizer:
     def __init__(self, cfg: MotionConfig, control_hz: float, bounds: BoundsMonitor | None = None,
                  gravity_mps2: float = 9.8):
@@ -112,7 +147,6 @@ class MotionOptimizer:
         self.dt_s = 1.0 / control_hz
         self.op_fsm = OperatorStanceFsm(cfg.stance_height_threshold_m, cfg.stance_hysteresis_m)
         self.char_fsm = CharacterStanceFsm(cfg.late_contact_timeout_s, cfg.min_swing_s)
-        self.op_style = StyleExtractor()
         self._op_leg_m: float | None = None
         self._held: OperatorSample | None = None
         self._com_d_rate = _SmoothedRate(self.dt_s)  # desired COM velocity [m/s]
@@ -130,17 +164,14 @@ class MotionOptimizer:
         self._op_state: Stance | None = None
         self._op_state_t0_s = 0.0
 
-    def operator_features(self, s: OperatorSample) -> StyleFeatures:
-        hip = {k: s.pos[f"HIP_{v}"] for k, v in _SIDE_UP.items()}
-        knee = {k: s.pos[f"KNEE_{v}"] for k, v in _SIDE_UP.items()}
-        ankle = {k: s.pos[f"ANKLE_{v}"] for k, v in _SIDE_UP.items()}
-        shank = {k: s.quat[f"KNEE_{v}"] for k, v in _SIDE_UP.items()}
-        foot = {k: s.quat[f"ANKLE_{v}"] for k, v in _SIDE_UP.items()}
-        return self.op_style(hip, knee, ankle, shank, foot, s.com_world, s.quat["PELVIS"])
-
-    def update(self, sample: OperatorSample, state: CharacterState, mass: MassProperties) -> ReferencePose:
+    def update(self, sample: OperatorSample, state: CharacterState, mass: MassProperties,
+               analysis: OperatorAnalysis | None = None) -> ReferencePose:
+        """The reference pose of one control tick. ``analysis``: :func:`analyse_operator` of ``sample`` if it was
+        computed ahead (prefetch.py); None computes it here."""
         cfg = self.cfg
-        features = self.operator_features(sample)
+        if analysis is None:
+            analysis = analyse_operator(sample)
+        features = analysis.features
         op_state = self.op_fsm.update(sample.pos["ANKLE_LEFT"][2], sample.pos["ANKLE_RIGHT"][2])
         contact = state.feet_pressing()
         ch_state = self.char_fsm.update(op_state, contact, state.time_s)
@@ -156,13 +187,13 @@ class MotionOptimizer:
             self._held = sample
 
         # Operator size: leg length by Eq. 1, smoothed; scale = h_C / h_H (Eq. 9).
-        leg = leg_length_m(s.pos, ankle_height_m=0.0)
+        leg = analysis.leg_m if s is sample else leg_length_m(s.pos, ankle_height_m=0.0)
         op_leg_m = leg if self._op_leg_m is None else self._op_leg_m + _SCALE_SMOOTHING * (leg - self._op_leg_m)
         self._op_leg_m = op_leg_m
         scale = CHAR_LEG_LENGTH_M / op_leg_m
 
         heading = features.H
-        q_root_d = level_root(heading)
+        q_root_d = analysis.root_quat_wxyz
         R_root_d = rot.matrix_from_quat(q_root_d)
         a_h = {k: s.pos[f"ANKLE_{v}"] for k, v in _SIDE_UP.items()}
         # The operator's feet the horizontal retargeting of Eq. 10 is anchored on: floor-filtered, as his COM
@@ -326,7 +357,8 @@ class MotionOptimizer:
             local[f"{side}_ankle"] = rot.multiply(swing_ik, twist_now)
 
         # Upper body from the joint map; the chest keeps the operator's torso orientation in the world.
-        for j, q in zip(_UPPER_JOINTS, local_rotations(s.quat, _UPPER_JOINTS, {"chest": q_root_d}), strict=True):
+        upper = analysis.upper_local_wxyz if s is sample else _upper_local(s, q_root_d)
+        for j, q in zip(UPPER_JOINTS, upper, strict=True):
             if j.endswith("elbow"):
                 knee_angle[j] = hinge_angle(q, j)
             else:

@@ -214,6 +214,7 @@ class VmcSource(QueuedLiveSource):
     def close(self) -> None:
         self._server.shutdown()
         self._server.server_close()
+        self._thread.join(timeout=1.0)
 
 
 class VmcSender:

@@ -1,0 +1,212 @@
+"""The operator side of the pipeline, run ahead of the control ticks in a second process (offline runs).
+
+Polling the source, the interpolation to the control rate (Eq. 7), the 1€ filter (Eq. 8), the floor filters and the
+operator's style features (Sec. 5.2, with the joint-map rotations of the upper body) depend on the operator stream
+alone, never on the character. In an offline run of a recorded operator the control ticks' times are known in
+advance, so a forked worker can compute all of it ahead of the physics loop, on the second core, and hand each
+control tick its operator sample; the main process spends its ticks on the character (motion, control, physics).
+
+The worker runs the same code on the same inputs as the in-line path (``OperatorInline``): the samples are
+bit-identical (a test checks it), and so is the simulation. Values cross the pipe as float64 rows, packed and
+unpacked by field (pickling ~40 small arrays per tick would cost more than computing them).
+
+Used only when nothing else can touch the operator side during the run: not paced to the wall clock, a recorded
+source (not live), and no other thread in the process (forking a threaded process is unsafe).
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import signal
+import threading
+from collections.abc import Sequence
+from multiprocessing.connection import Connection
+
+import numpy as np
+
+from stylesync.errors import SourceError
+from stylesync.motion.pose_optimization import UPPER_JOINTS, OperatorAnalysis, analyse_operator
+from stylesync.motion.style_features import ROW_NAMES, StyleFeatures
+from stylesync.processing.joint_map import TRACKED_ORIENTATIONS, TRACKED_POSITIONS
+from stylesync.processing.operator_processing import OperatorProcessing, OperatorSample
+from stylesync.sources.base import OperatorSource
+
+BATCH_TICKS = 32  # control ticks per message from the worker (about 35 kB)
+WORKER_EXIT_TIMEOUT_S = 2.0
+
+# Row layout: time, mocap time, rejected frames, dropped joint values (the last two cumulative), then the sample's
+# and the analysis's arrays.
+_SIDES = ("left", "right")
+_FIELDS: list[tuple[str, int]] = [("time_s", 1), ("mocap_time_s", 1), ("rejected", 1), ("dropped", 1),
+                                  ("quat", 4 * len(TRACKED_ORIENTATIONS)), ("pos", 3 * len(TRACKED_POSITIONS)),
+                                  ("com", 3), ("support", 3 * len(_SIDES)), ("features", len(ROW_NAMES)),
+                                  ("root", 4), ("upper", 4 * len(UPPER_JOINTS)), ("leg", 1)]
+_SLICE: dict[str, slice] = {}
+_offset = 0
+for _name, _size in _FIELDS:
+    _SLICE[_name] = slice(_offset, _offset + _size)
+    _offset += _size
+ROW_WIDTH = _offset
+
+
+def _features_from_row(r: np.ndarray) -> StyleFeatures:
+    """StyleFeatures from its ``as_row`` (ROW_NAMES order)."""
+    return StyleFeatures(float(r[0]), float(r[1]), r[2:5], r[5:8], r[8:11], r[11:14], float(r[14]))
+
+
+def pack(sample: OperatorSample, analysis: OperatorAnalysis, rejected: int, dropped: int) -> np.ndarray:
+    """(ROW_WIDTH,) float64 row of one control tick's operator side."""
+    row = np.empty(ROW_WIDTH)
+    row[_SLICE["time_s"]] = sample.time_s
+    row[_SLICE["mocap_time_s"]] = sample.mocap_time_s
+    row[_SLICE["rejected"]] = rejected
+    row[_SLICE["dropped"]] = dropped
+    row[_SLICE["quat"]] = np.concatenate([sample.quat[n] for n in TRACKED_ORIENTATIONS])
+    row[_SLICE["pos"]] = np.concatenate([sample.pos[n] for n in TRACKED_POSITIONS])
+    row[_SLICE["com"]] = sample.com_world
+    row[_SLICE["support"]] = np.concatenate([sample.support_ankle_world[s] for s in _SIDES])
+    row[_SLICE["features"]] = analysis.features.as_row()
+    row[_SLICE["root"]] = analysis.root_quat_wxyz
+    row[_SLICE["upper"]] = analysis.upper_local_wxyz.reshape(-1)
+    row[_SLICE["leg"]] = analysis.leg_m
+    return row
+
+
+def unpack(row: np.ndarray) -> tuple[OperatorSample, OperatorAnalysis, int, int]:
+    """The inverse of :func:`pack`: the sample, its analysis, rejected frames and dropped joint values."""
+    sample = OperatorSample(
+        time_s=float(row[0]),
+        quat=dict(zip(TRACKED_ORIENTATIONS, row[_SLICE["quat"]].reshape(-1, 4), strict=True)),
+        pos=dict(zip(TRACKED_POSITIONS, row[_SLICE["pos"]].reshape(-1, 3), strict=True)),
+        com_world=row[_SLICE["com"]],
+        support_ankle_world=dict(zip(_SIDES, row[_SLICE["support"]].reshape(-1, 3), strict=True)),
+        mocap_time_s=float(row[1]),
+    )
+    analysis = OperatorAnalysis(_features_from_row(row[_SLICE["features"]]), row[_SLICE["root"]],
+                                row[_SLICE["upper"]].reshape(-1, 4), float(row[_SLICE["leg"]][0]))
+    return sample, analysis, int(row[2]), int(row[3])
+
+
+class OperatorInline:
+    """The operator side computed at each control tick, in this process (live sources, paced runs, viewers)."""
+
+    def __init__(self, source: OperatorSource, processing: OperatorProcessing):
+        self.source = source
+        self.processing = processing
+
+    def poll(self, time_s: float) -> list:
+        """Frames of the source due by ``time_s``, pushed into the processing; returned for the caller's checks."""
+        frames = self.source.poll(time_s)
+        for f in frames:
+            self.processing.push(f)
+        return frames
+
+    def tick(self, time_s: float) -> tuple[OperatorSample, OperatorAnalysis | None]:
+        return self.processing.step(time_s), None
+
+    @property
+    def rejected_frames(self) -> int:
+        return int(getattr(self.source, "rejected_frames", 0))
+
+    @property
+    def dropped_joint_values(self) -> int:
+        return self.processing.dropped_joint_values
+
+    def close(self) -> None:
+        """Nothing to release (the session closes the source)."""
+
+
+def _worker(conn: Connection, source: OperatorSource, processing: OperatorProcessing,
+            tick_times_s: Sequence[float]) -> None:
+    """The forked process: every control tick's operator side, in batches, then ("end",) or ("error", exception)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the session ends the worker; a terminal's Ctrl-C is its own
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    rows: list[np.ndarray] = []
+    try:
+        try:
+            for t in tick_times_s:
+                for f in source.poll(t):
+                    processing.push(f)
+                sample = processing.step(t)
+                rows.append(pack(sample, analyse_operator(sample), int(getattr(source, "rejected_frames", 0)),
+                                 processing.dropped_joint_values))
+                if len(rows) == BATCH_TICKS:
+                    conn.send(("rows", np.stack(rows).tobytes()))
+                    rows = []
+        except Exception as exc:  # delivered at the tick where it happened, raised there by the session
+            if rows:
+                conn.send(("rows", np.stack(rows).tobytes()))
+            conn.send(("error", SourceError(f"operator side: {exc}") if not isinstance(exc, SourceError) else exc))
+            return
+        if rows:
+            conn.send(("rows", np.stack(rows).tobytes()))
+        conn.send(("end", None))
+    except (BrokenPipeError, EOFError, OSError):  # the session has gone: nothing to deliver to
+        return
+
+
+class OperatorPrefetch:
+    """The operator side of the listed control ticks, computed ahead by a forked worker (see the module's notes).
+
+    ``tick(t)`` must be called for those times in order. The worker starts from the current state of ``source``
+    and ``processing`` (copied by the fork); they are not advanced in this process.
+    """
+
+    def __init__(self, source: OperatorSource, processing: OperatorProcessing, tick_times_s: Sequence[float]):
+        ctx = multiprocessing.get_context("fork")
+        self._conn, child = ctx.Pipe(duplex=False)
+        self._proc = ctx.Process(target=_worker, args=(child, source, processing, list(tick_times_s)),
+                                 name="stylesync-operator", daemon=True)
+        self._proc.start()
+        child.close()
+        self._rows = np.zeros((0, ROW_WIDTH))
+        self._next = 0
+        self._rejected = int(getattr(source, "rejected_frames", 0))
+        self._dropped = processing.dropped_joint_values
+
+    @staticmethod
+    def usable(source: OperatorSource, realtime: bool, gui: bool) -> bool:
+        """Whether a run may prefetch: offline, headless, a recorded source, no other thread, fork available."""
+        return (not realtime and not gui and not getattr(source, "live", False) and threading.active_count() == 1
+                and "fork" in multiprocessing.get_all_start_methods())
+
+    def poll(self, time_s: float) -> list:
+        """The worker polls the source; nothing to do here."""
+        return []
+
+    def tick(self, time_s: float) -> tuple[OperatorSample, OperatorAnalysis | None]:
+        if self._next == len(self._rows):
+            self._receive()
+        row = self._rows[self._next]
+        self._next += 1
+        sample, analysis, self._rejected, self._dropped = unpack(row)
+        if sample.time_s != time_s:
+            raise RuntimeError(f"operator prefetch out of step: sample for t={sample.time_s} at t={time_s}")
+        return sample, analysis
+
+    def _receive(self) -> None:
+        try:
+            kind, payload = self._conn.recv()
+        except (EOFError, OSError):
+            raise SourceError("the operator-side process ended unexpectedly") from None
+        if kind == "error":
+            raise payload
+        if kind != "rows":
+            raise SourceError("the operator stream ended before the run (the operator side delivered no more ticks)")
+        self._rows = np.frombuffer(payload).reshape(-1, ROW_WIDTH)
+        self._next = 0
+
+    @property
+    def rejected_frames(self) -> int:
+        return self._rejected
+
+    @property
+    def dropped_joint_values(self) -> int:
+        return self._dropped
+
+    def close(self) -> None:
+        """End the worker (it may still be computing ticks the run did not reach) and release the pipe."""
+        self._conn.close()
+        if self._proc.is_alive():
+            self._proc.terminate()
+        self._proc.join(WORKER_EXIT_TIMEOUT_S)
