@@ -113,4 +113,4 @@ def feasible_horizontal_force(force_n: np.ndarray, com_world: np.ndarray, corner
 
 def regularisation(corners_world: dict[str, np.ndarray], stance_weight: dict[str, float]) -> np.ndarray:
     """ε per λ (see the module): larger on a foot with a small stance weight."""
-    return np.repeat([REGULARISATION / max(stance_weight.get(s, 0.0), MIN_WEIGHT) for s in corners_world], 16)
+    return np.array([REGULARISATION / max(stance_weight.get(s, 0.0), MIN_WEIGHT) for s in corners_world]).repeat(16)

@@ -102,7 +102,7 @@ class ControllerBase(ABC):
         if self._prev_ref_pos is None:
             self._prev_ref_pos = ref.joint_pos.copy()
             return joint_error(q_current, ref.joint_pos)
-        both = joint_error(np.stack([q_current, self._prev_ref_pos]), np.stack([ref.joint_pos, ref.joint_pos]))
+        both = joint_error(np.array([q_current, self._prev_ref_pos]), np.array([ref.joint_pos, ref.joint_pos]))
         self._ref_vel = both[1] / self.control_dt_s  # pid.reference_velocity
         self._prev_ref_pos = ref.joint_pos.copy()
         return both[0]

@@ -61,8 +61,10 @@ class FloatingJacobians:
         self.root_world = np.asarray(state.root_pos_world, dtype=float)
         # Every rotational column (the root's angular velocity about x, y, z, then the joint DOFs) is an axis a
         # about a point o: its skew matrices stacked by rows (3 K, 3) and its a × o (K, 3), for points_linear.
-        a = np.concatenate([_EYE3, axes])
-        o = np.concatenate([np.broadcast_to(self.root_world, (3, 3)), self.origin_world])
+        a = np.empty((3 + N_JOINT_DOFS, 3))
+        a[:3], a[3:] = _EYE3, axes
+        o = np.empty((3 + N_JOINT_DOFS, 3))
+        o[:3], o[3:] = self.root_world, self.origin_world
         skew = (a @ _SKEW_OF).reshape(-1, 3, 3)
         self._skew_rows = skew.reshape(-1, 3)
         self._rot_axes = a

@@ -109,10 +109,10 @@ class MomentumBalanceController(ControllerBase):
         qdd_joint = kp * e + kd * (self._ref_vel - state.joint_vel)
         # Saturated: a jump of the reference (a stance change, a landing) would otherwise ask for accelerations
         # whose torques exceed the joints' limits, and the clipped torques no longer realise the planned forces.
-        m_diag = np.diag(mass_matrix)
+        m_diag = mass_matrix.diagonal()
         own = JOINT_ACCEL_TORQUE_SHARE * TORQUE_LIMIT / np.maximum(unflatten_joint_values(m_diag[ROOT_DOFS:]), 1e-6)
         lim = np.maximum(cfg.joint_acceleration_limit_rad_s2, own)
-        qdd_joint = np.clip(qdd_joint, -lim, lim)
+        qdd_joint = np.minimum(np.maximum(qdd_joint, -lim), lim)  # np.clip's checks cost more than this
         # The pelvis orientation as a task of its own (the root virtual torque's PD law, per unit inertia): the
         # whole-body moment above leaves it free to turn against the legs. The root's linear acceleration has no
         # target (weight 0): the ground forces decide it.
@@ -166,7 +166,7 @@ class MomentumBalanceController(ControllerBase):
         self._free_lam, self._free_lam_feet = free, feet  # the warm start of the next tick's force plan
         tau = unflatten_joint_values(joint_torques(mass_matrix, bias, b_force @ lam, qdd))
         tau[~IS_BALL, 1:] = 0.0
-        self._tau = Torques(np.clip(tau, -TORQUE_LIMIT, TORQUE_LIMIT))
+        self._tau = Torques(np.minimum(np.maximum(tau, -TORQUE_LIMIT), TORQUE_LIMIT))
         self.telemetry = ControlTelemetry(force, f_lipm, moment)
 
     needs_joint_feedback = False

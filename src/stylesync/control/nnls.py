@@ -23,7 +23,7 @@ GRADIENT_TOL = 1e-10  # a zero variable whose gradient is below this times max|c
 def _solve_free(gram: np.ndarray, rhs: np.ndarray, free: np.ndarray) -> np.ndarray:
     """The unconstrained minimiser on the free variables (others zero)."""
     z = np.zeros(len(rhs))
-    idx = np.flatnonzero(free)
+    idx = free.nonzero()[0]
     if idx.size:
         block = gram.take(idx, 0).take(idx, 1)
         _, sol, info = lapack.dposv(block, rhs.take(idx))

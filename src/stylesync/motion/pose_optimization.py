@@ -80,7 +80,7 @@ def _heading_frame_fraction(p_h, al_h, ar_h, al_c, ar_c, scale: float, R: np.nda
     operator's and the character's spread, from _MIN_AXIS_SPREAD_M / 2 to _MIN_AXIS_SPREAD_M * 1.5), so that the
     target does not jump when a swing foot passes the stance foot.
     """
-    ph, lh, rh, lc, rc = (R.T @ np.stack([p_h, al_h, ar_h, al_c, ar_c]).T).T.tolist()  # heading-frame coordinates
+    ph, lh, rh, lc, rc = (R.T @ np.array([p_h, al_h, ar_h, al_c, ar_c]).T).T.tolist()  # heading-frame coordinates
     out = [0.0, 0.0, 0.0]
     for ax in (0, 1):
         spread_h, spread_c = rh[ax] - lh[ax], rc[ax] - lc[ax]
@@ -228,12 +228,12 @@ class MotionOptimizer:
         # operator's and the character's feet are never placed exactly alike, so the targets would jump. The jump
         # is taken up as an offset that decays with ANCHOR_BLEND_S.
         if anchor is not self._anchor_stance and self._last_xy is not None:
-            self._anchor_offset += self._last_xy - np.stack([pelvis_xy[:2], com_xy[:2]])
+            self._anchor_offset += self._last_xy - np.array([pelvis_xy[:2], com_xy[:2]])
         self._anchor_stance = anchor
         self._anchor_offset *= self._anchor_decay
         pelvis_xy = np.array([*(pelvis_xy[:2] + self._anchor_offset[0]), 0.0])
         com_xy = np.array([*(com_xy[:2] + self._anchor_offset[1]), 0.0])
-        self._last_xy = np.stack([pelvis_xy[:2], com_xy[:2]])
+        self._last_xy = np.array([pelvis_xy[:2], com_xy[:2]])
         pelvis_d = np.array([pelvis_xy[0], pelvis_xy[1], ankle_c_z + scale * (p_h[2] - ankle_h_z)])  # Eq. 9
         # The operator's COM height reflects his own mass distribution, not the character's: the vertical is left
         # to the pelvis height (Eq. 9) through the leg IK, and the COM target keeps the character's own height.

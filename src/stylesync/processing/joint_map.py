@@ -46,8 +46,8 @@ def local_rotations(world_quats: dict[str, np.ndarray], joints: tuple[str, ...],
     """(len(joints), 4) local rotations conj(q_parent) ⊗ q_child of the joint map's pairs, in one batched product.
     ``parents``: world orientations to use instead of a joint's mapped parent (e.g. the chest against a level root)."""
     parents = parents or {}
-    q_parent = np.stack([parents[j] if j in parents else world_quats[JOINT_MAP[j][1]] for j in joints])
-    q_child = np.stack([world_quats[JOINT_MAP[j][0]] for j in joints])
+    q_parent = np.array([parents[j] if j in parents else world_quats[JOINT_MAP[j][1]] for j in joints])
+    q_child = np.array([world_quats[JOINT_MAP[j][0]] for j in joints])
     return rot.batch_multiply(rot.batch_conjugate(q_parent), q_child)
 
 
