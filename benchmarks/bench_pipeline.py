@@ -13,6 +13,7 @@ ratio is meaningful on a noisy machine even when the absolute figures are not.
 from __future__ import annotations
 
 import argparse
+import logging
 
 import numpy as np
 
@@ -30,6 +31,7 @@ def main() -> None:
                     help="alternating measurements of each (physics alone, pipeline); medians are reported")
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args()
+    logging.getLogger("stylesync").setLevel(logging.ERROR)  # the runs' warnings (movement bounds) are not measured here
     cfg = SessionConfig(duration_s=args.duration, seed=args.seed, operator=OperatorConfig(clip=args.clip))
     phys_rtfs, rtfs, one_rtfs = [], [], []
     result = None

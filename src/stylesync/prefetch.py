@@ -122,6 +122,7 @@ def _worker(conn: Connection, source: OperatorSource, processing: OperatorProces
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the session ends the worker; a terminal's Ctrl-C is its own
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     rows: list[np.ndarray] = []
+    batch = 1  # the first tick at once, so that the run starts without waiting for a whole batch
     try:
         try:
             for t in tick_times_s:
@@ -130,9 +131,9 @@ def _worker(conn: Connection, source: OperatorSource, processing: OperatorProces
                 sample = processing.step(t)
                 rows.append(pack(sample, analyse_operator(sample), int(getattr(source, "rejected_frames", 0)),
                                  processing.dropped_joint_values))
-                if len(rows) == BATCH_TICKS:
+                if len(rows) == batch:
                     conn.send(("rows", np.stack(rows).tobytes()))
-                    rows = []
+                    rows, batch = [], BATCH_TICKS
         except Exception as exc:  # delivered at the tick where it happened, raised there by the session
             if rows:
                 conn.send(("rows", np.stack(rows).tobytes()))

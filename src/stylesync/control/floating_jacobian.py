@@ -68,7 +68,7 @@ class FloatingJacobians:
         skew = (a @ _SKEW_OF).reshape(-1, 3, 3)
         self._skew_rows = skew.reshape(-1, 3)
         self._rot_axes = a
-        self._a_cross_o = np.einsum("kij,kj->ki", skew, o)
+        self._a_cross_o = rot.cross(a, o)
 
     def point_linear(self, link: int, p_world: np.ndarray) -> np.ndarray:
         """(3, N_DOFS) Jacobian of the world velocity of point ``p_world`` fixed on link ``link``."""
