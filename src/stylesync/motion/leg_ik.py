@@ -49,7 +49,7 @@ def _quat_of_frame(up: tuple[float, float, float], left: tuple[float, float, flo
     n = math.sqrt(lx * lx + ly * ly + lz * lz)
     lx, ly, lz = lx / n, ly / n, lz / n
     fx, fy, fz = ly * uz - lz * uy, lz * ux - lx * uz, lx * uy - ly * ux
-    return rot.quat_from_matrix(np.array([[fx, lx, ux], [fy, ly, uy], [fz, lz, uz]]))
+    return rot.quat_from_matrix_rows((fx, lx, ux), (fy, ly, uy), (fz, lz, uz))
 
 
 def solve_leg(hip: np.ndarray, ankle_target: np.ndarray, thigh_m: float, shank_m: float,
