@@ -1,7 +1,10 @@
 """The operator side computed ahead in a second process (prefetch.py) gives exactly what the in-line path gives."""
 
 import multiprocessing
+import subprocess
+import sys
 import threading
+import time
 
 import numpy as np
 import pytest
@@ -143,3 +146,45 @@ def test_a_worker_that_dies_is_reported_as_a_source_error():
                 prefetch.tick(t)
     finally:
         prefetch.close()
+
+
+def _process_running(pid: int) -> bool:
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().rsplit(")", 1)[1].split()[0] != "Z"  # a zombie has ended
+    except FileNotFoundError:
+        return False
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_the_worker_ends_when_its_session_is_killed():
+    # Killed (SIGKILL), the session cannot end its worker: the worker must notice (its pipe has no reader left).
+    script = """
+import multiprocessing, sys
+from stylesync.config import SessionConfig
+from stylesync.session import Session
+from stylesync.sources.builtin_operator import builtin_operator
+cfg = SessionConfig(duration_s=60.0, seed=0)
+source, _ = builtin_operator(cfg.operator, cfg.clocks, 61.0, 0)
+told = []
+def on_tick(state, ref):
+    if not told:
+        told.append(1)
+        print("workers:", *(p.pid for p in multiprocessing.active_children()), flush=True)
+Session(cfg, source, on_tick=on_tick).run()
+"""
+    proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout is not None
+        line = next((ln for ln in proc.stdout if ln.startswith("workers:")), "")  # the engine prints too
+        workers = [int(p) for p in line.split()[1:]]
+        assert len(workers) == 1, "the session did not start its operator-side worker"
+        proc.kill()
+        proc.wait(timeout=10)
+        deadline = time.monotonic() + 5.0
+        while _process_running(workers[0]) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert not _process_running(workers[0]), "the worker outlived its killed session"
+    finally:
+        if proc.poll() is None:
+            proc.kill()

@@ -116,9 +116,12 @@ class OperatorInline:
         """Nothing to release (the session closes the source)."""
 
 
-def _worker(conn: Connection, source: OperatorSource, processing: OperatorProcessing,
+def _worker(conn: Connection, session_end: Connection, source: OperatorSource, processing: OperatorProcessing,
             tick_times_s: Sequence[float]) -> None:
     """The forked process: every control tick's operator side, in batches, then ("end",) or ("error", exception)."""
+    # The fork copied the session's end of the pipe too: closed here, a session that dies (even killed) leaves no
+    # reader, and the next send fails instead of waiting forever.
+    session_end.close()
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the session ends the worker; a terminal's Ctrl-C is its own
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     rows: list[np.ndarray] = []
@@ -156,7 +159,7 @@ class OperatorPrefetch:
     def __init__(self, source: OperatorSource, processing: OperatorProcessing, tick_times_s: Sequence[float]):
         ctx = multiprocessing.get_context("fork")
         self._conn, child = ctx.Pipe(duplex=False)
-        self._proc = ctx.Process(target=_worker, args=(child, source, processing, list(tick_times_s)),
+        self._proc = ctx.Process(target=_worker, args=(child, self._conn, source, processing, list(tick_times_s)),
                                  name="stylesync-operator", daemon=True)
         self._proc.start()
         child.close()
