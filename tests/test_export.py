@@ -34,6 +34,20 @@ def recorded(tmp_path_factory):
     return path, states
 
 
+def test_a_deferred_session_file_has_the_same_lines(recorded, tmp_path):
+    # Written when the run ends instead of tick by tick: the same file (the run is deterministic).
+    path, _ = recorded
+    cfg = SessionConfig(duration_s=1.5)
+    source, _ = builtin_operator(cfg.operator, cfg.clocks, 2.5, 0)
+    session = Session(cfg, source)
+    rec = SessionRecorder(tmp_path / "deferred.jsonl", cfg, session, deferred=True)
+    session.on_tick = rec.tick
+    result = session.run()
+    assert (tmp_path / "deferred.jsonl").read_text().count("\n") == 1  # only the header until the end
+    rec.close({"fell": result.fell})
+    assert (tmp_path / "deferred.jsonl").read_bytes() == path.read_bytes()
+
+
 def test_session_file_replays_identical_states(recorded):
     path, states = recorded
     s = read_session(path)

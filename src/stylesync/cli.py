@@ -45,7 +45,8 @@ def _run_session(cfg: SessionConfig, source, out: Path, extra: dict, args: argpa
     out.mkdir(parents=True, exist_ok=True)
     session = Session(cfg, source)
     record = Path(args.record) if args.record else out / "session.jsonl"
-    recorder = SessionRecorder(record, cfg, session)
+    # A run as fast as possible writes its session file when it ends (session_file.py): not in the control loop.
+    recorder = SessionRecorder(record, cfg, session, deferred=not cfg.realtime)
     session.on_tick = recorder.tick
     viewer = None
     if args.viewer != "none":

@@ -10,6 +10,11 @@ model axes, hinge angle first; with the root pose they fix every link), ``link_q
 last line, when the run ends, is ``{"metrics": {...}}``. Floats are written with Python's shortest exact
 representation, so a replay reads back identical states. Units: m, s, rad, N·m; world frame z up. Lines are
 flushed every 50 ticks, so a run cut short leaves a readable file.
+
+A recorder may defer the writing (``deferred=True``, for runs as fast as possible): each tick then keeps references
+to its values (arrays the session never changes once made), and the lines are written when the run ends, the
+same lines. Formatting a line costs about 0.2 ms, a sixth of the control tick; an offline run can be run again if
+it is cut short. At most MAX_DEFERRED_TICKS are held; beyond, the lines are written as they come.
 """
 
 from __future__ import annotations
@@ -29,39 +34,58 @@ from stylesync.sim.character import JOINTS, LINK_NAMES
 FORMAT = "stylesync-session"
 VERSION = 1
 FLUSH_EVERY_TICKS = 50
+MAX_DEFERRED_TICKS = 100_000  # about 12 minutes at 133 Hz, some 100 MB of references
 
 
 class SessionRecorder:
     """Writes a session file; ``tick`` is the session's ``on_tick`` hook."""
 
-    def __init__(self, path: str | Path, config: Any, session: Any = None):
+    def __init__(self, path: str | Path, config: Any, session: Any = None, deferred: bool = False):
         self.path = Path(path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._f: IO[str] = self.path.open("w", encoding="utf-8")
         self._session = session
         self._n = 0
+        self.deferred = deferred
+        self._held: list[tuple] = []  # deferred ticks' values
         header = {"format": FORMAT, "version": VERSION,
                   "config": _config_dict(config),
                   "joints": [j.name for j in JOINTS], "links": list(LINK_NAMES),
                   "operator_joints": list(TRACKED_POSITIONS), "stance_codes": {"LS": 0, "DS": 1, "RS": 2}}
         self._write(header)
+        self._f.flush()
 
     def _write(self, obj: dict) -> None:
         self._f.write(json.dumps(obj, default=_jsonable) + "\n")
 
     def tick(self, state: Any, ref: Any) -> None:
         sess = self._session
-        torques = getattr(sess, "last_torques", None)
-        sample = getattr(sess, "last_sample", None)
+        values = (state.time_s, state.root_pos_world, state.root_quat_wxyz, state.joint_pos, state.link_quat_wxyz,
+                  getattr(sess, "last_torques", None), ref.scale, ref.operator_stance, ref.character_stance,
+                  ref.operator_features, getattr(sess, "last_com_world", None), getattr(sess, "last_sample", None))
+        if self.deferred and len(self._held) < MAX_DEFERRED_TICKS:
+            self._held.append(values)
+            return
+        self._write_held()
+        self._write_tick(values)
+
+    def _write_held(self) -> None:
+        for values in self._held:
+            self._write_tick(values)
+        self._held = []
+
+    def _write_tick(self, values: tuple) -> None:
+        (t, root_pos, root_quat, joint_pos, link_quat, torques, scale, op_stance, ch_stance, features, com,
+         sample) = values
         self._write({
-            "t": state.time_s, "root_pos_world": state.root_pos_world.tolist(),
-            "root_quat_wxyz": state.root_quat_wxyz.tolist(), "joint_pos": state.joint_pos.tolist(),
-            "link_quat_wxyz": state.link_quat_wxyz.tolist(),
+            "t": t, "root_pos_world": root_pos.tolist(),
+            "root_quat_wxyz": root_quat.tolist(), "joint_pos": joint_pos.tolist(),
+            "link_quat_wxyz": link_quat.tolist(),
             "torques_nm": None if torques is None else np.asarray(torques).tolist(),
-            "scale": ref.scale, "operator_stance": ref.operator_stance.value,
-            "character_stance": ref.character_stance.value,
-            "operator_features": list(ref.operator_features.as_row()),
-            "character_com_world": getattr(sess, "last_com_world", None),
+            "scale": scale, "operator_stance": op_stance.value,
+            "character_stance": ch_stance.value,
+            "operator_features": list(features.as_row()),
+            "character_com_world": com,
             "operator_pos": None if sample is None else [sample.pos[n].tolist() for n in TRACKED_POSITIONS],
         })
         self._n += 1
@@ -71,6 +95,7 @@ class SessionRecorder:
     def close(self, metrics: dict | None = None) -> None:
         if self._f.closed:
             return
+        self._write_held()
         if metrics is not None:
             self._write({"metrics": metrics})
         self._f.close()
