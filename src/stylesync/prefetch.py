@@ -10,14 +10,15 @@ The worker runs the same code on the same inputs as the in-line path (``Operator
 bit-identical (a test checks it), and so is the simulation. Values cross the pipe as float64 rows, packed and
 unpacked by field (pickling ~40 small arrays per tick would cost more than computing them).
 
-Used only when nothing else can touch the operator side during the run: not paced to the wall clock, a recorded
-source (not live), and no other thread in the process (forking a threaded process is unsafe).
+Used only when nothing else can touch the operator side during the run and forking is safe: not paced to the wall
+clock, headless, a recorded source (not live), no other thread in the process, on Linux.
 """
 
 from __future__ import annotations
 
 import multiprocessing
 import signal
+import sys
 import threading
 from collections.abc import Sequence
 from multiprocessing.connection import Connection
@@ -140,7 +141,10 @@ def _worker(conn: Connection, session_end: Connection, source: OperatorSource, p
         except Exception as exc:  # delivered at the tick where it happened, raised there by the session
             if rows:
                 conn.send(("rows", np.stack(rows).tobytes()))
-            conn.send(("error", SourceError(f"operator side: {exc}") if not isinstance(exc, SourceError) else exc))
+            try:
+                conn.send(("error", exc))
+            except Exception:  # an exception that cannot be pickled: its type and message
+                conn.send(("error", SourceError(f"operator side: {type(exc).__name__}: {exc}")))
             return
         if rows:
             conn.send(("rows", np.stack(rows).tobytes()))
@@ -170,9 +174,10 @@ class OperatorPrefetch:
 
     @staticmethod
     def usable(source: OperatorSource, realtime: bool, gui: bool) -> bool:
-        """Whether a run may prefetch: offline, headless, a recorded source, no other thread, fork available."""
+        """Whether a run may prefetch: offline, headless, a recorded source, no other thread, and Linux (where
+        forking a process that has used numpy's BLAS and the engine is safe)."""
         return (not realtime and not gui and not getattr(source, "live", False) and threading.active_count() == 1
-                and "fork" in multiprocessing.get_all_start_methods())
+                and sys.platform.startswith("linux"))
 
     def poll(self, time_s: float) -> list:
         """The worker polls the source; nothing to do here."""
