@@ -27,6 +27,9 @@ def run_once(cfg: SessionConfig, with_viewer: bool, browser, draw_hz: float,
              viewer_cpus: set[int] | None = None) -> tuple[float, int]:
     source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
     session = Session(cfg, source)
+    # Both arms compute the operator side in the loop's process: a run with a viewer has a thread, and so never
+    # forks it (prefetch.py). This measures the viewer's own cost; a run without a viewer is faster still.
+    session.prefetch_operator = False
     viewer, page = None, None
     if with_viewer:
         viewer = open_viewer("web", session, draw_hz=draw_hz)
