@@ -50,11 +50,6 @@ for _name, _size in _FIELDS:
 ROW_WIDTH = _offset
 
 
-def _features_from_row(r: np.ndarray) -> StyleFeatures:
-    """StyleFeatures from its ``as_row`` (ROW_NAMES order)."""
-    return StyleFeatures(float(r[0]), float(r[1]), r[2:5], r[5:8], r[8:11], r[11:14], float(r[14]))
-
-
 def pack(sample: OperatorSample, analysis: OperatorAnalysis, rejected: int, dropped: int) -> np.ndarray:
     """(ROW_WIDTH,) float64 row of one control tick's operator side."""
     row = np.empty(ROW_WIDTH)
@@ -83,7 +78,7 @@ def unpack(row: np.ndarray) -> tuple[OperatorSample, OperatorAnalysis, int, int]
         support_ankle_world=dict(zip(_SIDES, row[_SLICE["support"]].reshape(-1, 3), strict=True)),
         mocap_time_s=float(row[1]),
     )
-    analysis = OperatorAnalysis(_features_from_row(row[_SLICE["features"]]), row[_SLICE["root"]],
+    analysis = OperatorAnalysis(StyleFeatures.from_row(row[_SLICE["features"]]), row[_SLICE["root"]],
                                 row[_SLICE["upper"]].reshape(-1, 4), float(row[_SLICE["leg"]][0]))
     return sample, analysis, int(row[2]), int(row[3])
 

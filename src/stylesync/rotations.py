@@ -49,10 +49,16 @@ def cross(a, b) -> Array:
 
 
 def normalize(q: Array) -> Array:
-    w, x, y, z = np.asarray(q, dtype=float).tolist()
+    return _normalized(*np.asarray(q, dtype=float).tolist())
+
+
+def _normalized(w: float, x: float, y: float, z: float, positive_w: bool = False) -> Array:
+    """(w, x, y, z) divided by its norm (the identity if it has none), negated to w >= 0 if ``positive_w``."""
     n = math.sqrt(w * w + x * x + y * y + z * z)
     if not math.isfinite(n) or n < 1e-12:
         return IDENTITY_WXYZ.copy()
+    if positive_w and w < 0:  # -(w / n) is w / -n exactly
+        n = -n
     return np.array([w / n, x / n, y / n, z / n])
 
 
@@ -112,13 +118,7 @@ def quat_from_matrix_rows(r0, r1, r2) -> Array:
     else:
         s = 2.0 * math.sqrt(1.0 + m22 - m00 - m11)
         q = ((m10 - m01) / s, (m02 + m20) / s, (m12 + m21) / s, 0.25 * s)
-    w, x, y, z = q
-    n = math.sqrt(w * w + x * x + y * y + z * z)
-    if not math.isfinite(n) or n < 1e-12:
-        return IDENTITY_WXYZ.copy()
-    if w < 0:  # w >= 0 (the sign of w / n is the sign of w)
-        n = -n
-    return np.array([w / n, x / n, y / n, z / n])
+    return _normalized(*q, positive_w=True)
 
 
 def rotate(q: Array, v: Array) -> Array:

@@ -292,7 +292,7 @@ class Session:
             # (_add_after_run_columns). The arrays are the state's and the reference's own, new at every tick.
             _q=state.joint_pos, _q_ref=ref.joint_pos,
             _ch_legs=state.link_origin_world[_LEG_LINKS], _ch_leg_quats=state.link_quat_wxyz[_LEG_LINKS[:, 1:]],
-            _ch_root_quat=state.root_quat_wxyz.copy(),
+            _ch_root_quat=state.root_quat_wxyz,
         )
 
 

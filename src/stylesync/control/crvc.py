@@ -63,9 +63,19 @@ def root_virtual_torque(q_root_desired, q_root, ang_vel_world, kp: float, kd: fl
                         predict_dt_s: float = 0.0) -> np.ndarray:
     """Eq. 16 (second line): world-frame PD torque [N·m] on the pelvis orientation. With ``predict_dt_s`` the
     orientation error is taken one step ahead (the explicit part of the stable PD, stable_pd.py)."""
+    return root_pd(root_orientation_error(q_root_desired, q_root), ang_vel_world, kp, kd, yaw_scale, predict_dt_s)
+
+
+def root_orientation_error(q_root_desired, q_root) -> np.ndarray:
+    """World-frame rotation vector [rad] from the pelvis orientation to the desired one (Eq. 16's error)."""
+    return rot.rotvec_from_quat(rot.multiply(q_root_desired, rot.conjugate(q_root)))
+
+
+def root_pd(error_rotvec: np.ndarray, ang_vel_world, kp: float, kd: float, yaw_scale: float,
+            predict_dt_s: float = 0.0) -> np.ndarray:
+    """Eq. 16's PD law on a root orientation error (:func:`root_orientation_error`) [gains' units times rad]."""
     omega = np.asarray(ang_vel_world, dtype=float)
-    e = rot.rotvec_from_quat(rot.multiply(q_root_desired, rot.conjugate(q_root)))  # world-frame error
-    return root_gain_scale(yaw_scale) * (kp * (e - predict_dt_s * omega) - kd * omega)
+    return root_gain_scale(yaw_scale) * (kp * (error_rotvec - predict_dt_s * omega) - kd * omega)
 
 
 def root_gain_scale(yaw_scale: float) -> np.ndarray:

@@ -34,7 +34,7 @@ from stylesync.control.contact_forces import (
     wrench_basis,
 )
 from stylesync.control.controller import TORQUE_LIMIT, ControllerBase, ControlTelemetry, supporting_weights
-from stylesync.control.crvc import com_virtual_force, root_virtual_torque
+from stylesync.control.crvc import com_virtual_force, root_orientation_error, root_pd
 from stylesync.control.floating_jacobian import FloatingJacobians
 from stylesync.control.inverse_dynamics import joint_torques, solve_with_contact_forces
 from stylesync.control.jacobian_transpose import JointFrames
@@ -97,8 +97,9 @@ class MomentumBalanceController(ControllerBase):
             f_lipm = bounded_lipm_sync_force(ref.lipm, m, self.g, cfg.lipm_force_limit_n, cfg.enforce_bounds,
                                              self.bounds, state.time_s)
             force += f_lipm
-        moment = root_virtual_torque(ref.root_quat_wxyz, state.root_quat_wxyz, state.root_ang_vel_world,
-                                     cfg.momentum_root_kp, cfg.momentum_root_kd, cfg.root_yaw_gain_scale)
+        e_root = root_orientation_error(ref.root_quat_wxyz, state.root_quat_wxyz)  # for the moment and the task
+        moment = root_pd(e_root, state.root_ang_vel_world, cfg.momentum_root_kp, cfg.momentum_root_kd,
+                         cfg.root_yaw_gain_scale)
 
         qd = np.concatenate([state.root_lin_vel_world, state.root_ang_vel_world,
                              flatten_joint_values(state.joint_vel)])
@@ -116,8 +117,7 @@ class MomentumBalanceController(ControllerBase):
         # The pelvis orientation as a task of its own (the root virtual torque's PD law, per unit inertia): the
         # whole-body moment above leaves it free to turn against the legs. The root's linear acceleration has no
         # target (weight 0): the ground forces decide it.
-        alpha_root = root_virtual_torque(ref.root_quat_wxyz, state.root_quat_wxyz, state.root_ang_vel_world, kp, kd,
-                                         yaw_scale=1.0)
+        alpha_root = root_pd(e_root, state.root_ang_vel_world, kp, kd, yaw_scale=1.0)
         qdd_des = np.concatenate([np.zeros(3), alpha_root, flatten_joint_values(qdd_joint)])
         # Tracking errors weighed by each DOF's inertia, M_ii Δq̈_i².
         weights = cfg.joint_tracking_weight * np.maximum(m_diag, MIN_TRACKING_INERTIA_KGM2)

@@ -23,7 +23,7 @@ import dataclasses
 import json
 from collections.abc import Iterator
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, Any, NamedTuple
 
 import numpy as np
 
@@ -37,6 +37,23 @@ FLUSH_EVERY_TICKS = 50
 MAX_DEFERRED_TICKS = 100_000  # about 12 minutes at 133 Hz, some 100 MB of references
 
 
+class _TickValues(NamedTuple):
+    """What one tick's line is written from: references to values the session never changes once made."""
+
+    t: float
+    root_pos_world: np.ndarray
+    root_quat_wxyz: np.ndarray
+    joint_pos: np.ndarray
+    link_quat_wxyz: np.ndarray
+    torques_nm: np.ndarray | None
+    scale: float
+    operator_stance: Any
+    character_stance: Any
+    operator_features: Any
+    character_com_world: np.ndarray | None
+    sample: Any  # the operator sample, for its joint positions
+
+
 class SessionRecorder:
     """Writes a session file; ``tick`` is the session's ``on_tick`` hook."""
 
@@ -47,7 +64,7 @@ class SessionRecorder:
         self._session = session
         self._n = 0
         self.deferred = deferred
-        self._held: list[tuple] = []  # deferred ticks' values
+        self._held: list[_TickValues] = []  # deferred ticks' values
         header = {"format": FORMAT, "version": VERSION,
                   "config": _config_dict(config),
                   "joints": [j.name for j in JOINTS], "links": list(LINK_NAMES),
@@ -60,9 +77,10 @@ class SessionRecorder:
 
     def tick(self, state: Any, ref: Any) -> None:
         sess = self._session
-        values = (state.time_s, state.root_pos_world, state.root_quat_wxyz, state.joint_pos, state.link_quat_wxyz,
-                  getattr(sess, "last_torques", None), ref.scale, ref.operator_stance, ref.character_stance,
-                  ref.operator_features, getattr(sess, "last_com_world", None), getattr(sess, "last_sample", None))
+        values = _TickValues(state.time_s, state.root_pos_world, state.root_quat_wxyz, state.joint_pos,
+                             state.link_quat_wxyz, getattr(sess, "last_torques", None), ref.scale,
+                             ref.operator_stance, ref.character_stance, ref.operator_features,
+                             getattr(sess, "last_com_world", None), getattr(sess, "last_sample", None))
         if self.deferred and len(self._held) < MAX_DEFERRED_TICKS:
             self._held.append(values)
             return
@@ -74,19 +92,17 @@ class SessionRecorder:
             self._write_tick(values)
         self._held = []
 
-    def _write_tick(self, values: tuple) -> None:
-        (t, root_pos, root_quat, joint_pos, link_quat, torques, scale, op_stance, ch_stance, features, com,
-         sample) = values
+    def _write_tick(self, v: _TickValues) -> None:
         self._write({
-            "t": t, "root_pos_world": root_pos.tolist(),
-            "root_quat_wxyz": root_quat.tolist(), "joint_pos": joint_pos.tolist(),
-            "link_quat_wxyz": link_quat.tolist(),
-            "torques_nm": None if torques is None else np.asarray(torques).tolist(),
-            "scale": scale, "operator_stance": op_stance.value,
-            "character_stance": ch_stance.value,
-            "operator_features": list(features.as_row()),
-            "character_com_world": com,
-            "operator_pos": None if sample is None else [sample.pos[n].tolist() for n in TRACKED_POSITIONS],
+            "t": v.t, "root_pos_world": v.root_pos_world.tolist(),
+            "root_quat_wxyz": v.root_quat_wxyz.tolist(), "joint_pos": v.joint_pos.tolist(),
+            "link_quat_wxyz": v.link_quat_wxyz.tolist(),
+            "torques_nm": None if v.torques_nm is None else np.asarray(v.torques_nm).tolist(),
+            "scale": v.scale, "operator_stance": v.operator_stance.value,
+            "character_stance": v.character_stance.value,
+            "operator_features": list(v.operator_features.as_row()),
+            "character_com_world": v.character_com_world,
+            "operator_pos": None if v.sample is None else [v.sample.pos[n].tolist() for n in TRACKED_POSITIONS],
         })
         self._n += 1
         if self._n % FLUSH_EVERY_TICKS == 0:

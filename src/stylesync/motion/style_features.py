@@ -34,6 +34,11 @@ class StyleFeatures:
     def as_row(self) -> list[float]:
         return [self.T_l, self.T_r, *self.N_l, *self.N_r, *self.P_cl, *self.P_cr, self.H]
 
+    @staticmethod
+    def from_row(row: np.ndarray) -> StyleFeatures:
+        """The inverse of :meth:`as_row` (ROW_NAMES order); the vectors are views of ``row``."""
+        return StyleFeatures(float(row[0]), float(row[1]), row[2:5], row[5:8], row[8:11], row[11:14], float(row[14]))
+
 
 ROW_NAMES = ["T_l", "T_r", "N_l_x", "N_l_y", "N_l_z", "N_r_x", "N_r_y", "N_r_z", "P_cl_x", "P_cl_y", "P_cl_z",
              "P_cr_x", "P_cr_y", "P_cr_z", "H"]

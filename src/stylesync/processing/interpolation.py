@@ -58,7 +58,6 @@ class SlerpRamp:
     def __init__(self, mocap_hz: float, control_hz: float):
         self.k = mocap_hz / control_hz
         self._start: np.ndarray | None = None
-        self._target: np.ndarray | None = None
         self._rotvec_rad = np.zeros((0, 3))
         self._out: np.ndarray | None = None
         self._i = 0
@@ -68,12 +67,11 @@ class SlerpRamp:
         if self._out is None:
             self._out = ref.copy()
         self._start = self._out.copy()
-        self._target = rot.batch_align_sign(ref, self._start)
-        self._rotvec_rad = rot.batch_slerp_rotvec(self._start, self._target)  # fixed until the next frame
+        self._rotvec_rad = rot.batch_slerp_rotvec(self._start, ref)  # towards ref, fixed until the next frame
         self._i = 0
 
     def step(self) -> np.ndarray:
-        if self._out is None or self._start is None or self._target is None:
+        if self._out is None or self._start is None:
             raise ValueError("SlerpRamp.step() before the first push()")
         self._i += 1
         frac = min(self.k * self._i, 1.0)
