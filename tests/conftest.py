@@ -1,7 +1,7 @@
 import numpy as np
 
 from stylesync import rotations as rot
-from stylesync.sim.character import JOINTS, JointKind
+from stylesync.model.character import JOINTS, JointKind
 
 
 def random_pose(seed: int, ball_sigma_rad: float = 0.3, hinge_rad: float = 0.6) -> np.ndarray:

@@ -16,8 +16,8 @@ from stylesync.control.stable_pd import (
 )
 from stylesync.control.support import limit_ankle_moment, support_point
 from stylesync.session import Session
-from stylesync.sim.backend import make_backend
-from stylesync.sim.character import N_JOINT_DOFS, ROOT_DOFS, STANDING_ROOT_HEIGHT_M
+from stylesync.sim.factory import make_backend
+from stylesync.model.character import N_JOINT_DOFS, ROOT_DOFS, STANDING_ROOT_HEIGHT_M
 from stylesync.sources.builtin_operator import builtin_operator
 
 
@@ -97,7 +97,7 @@ def test_ankle_moment_is_limited_to_the_sole():
 def test_table3_gains_stay_stable_on_a_root_fixed_character():
     # Table 3's gains without the implicit evaluation diverge at 600 Hz on the feet; with it they track.
     from stylesync.control.pid import JointPid
-    from stylesync.sim.backend import Torques
+    from stylesync.model.state import Torques
 
     b = make_backend(WorldConfig(), 600.0, fixed_root=True)
     b.reset(np.array([0.0, 0.0, 1.5]), rot.IDENTITY_WXYZ)
@@ -174,8 +174,8 @@ def test_torso_hip_gives_the_pelvis_exactly_the_root_torque():
     # Eq. 18 realised as SIMBICON's torso control: the pelvis's joints' feedback torques add up to -τ_r on it.
     from stylesync.control.controller import PELVIS_CHILDREN, BalanceController
     from stylesync.control.crvc import HIP_JOINT
-    from stylesync.sim.backend import JointFeedback, MassProperties
-    from stylesync.sim.character import LINK_NAMES, Q_WORLD_MODEL
+    from stylesync.model.state import JointFeedback, MassProperties
+    from stylesync.model.character import LINK_NAMES, Q_WORLD_MODEL
 
     rng = np.random.default_rng(4)
     ctl = BalanceController(ControlConfig(stance_hip_torso=True), MassProperties(np.ones(len(LINK_NAMES))), 9.8,

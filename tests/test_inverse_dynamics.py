@@ -14,8 +14,8 @@ from stylesync.control.contact_forces import (
 from stylesync.control.floating_jacobian import FloatingJacobians
 from stylesync.control.jacobian_transpose import JointFrames
 from stylesync.control.stable_pd import flatten_joint_values
-from stylesync.sim.backend import make_backend
-from stylesync.sim.character import ANKLE_HEIGHT_M, JOINTS, JointKind
+from stylesync.sim.factory import make_backend
+from stylesync.model.character import ANKLE_HEIGHT_M, JOINTS, JointKind
 
 
 @pytest.fixture(scope="module")

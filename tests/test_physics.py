@@ -9,8 +9,9 @@ from stylesync.control.contact_forces import sole_corners_world
 from stylesync.control.gravity_compensation import gravity_torques
 from stylesync.control.jacobian_transpose import JointFrames
 from stylesync.control.pid import joint_error
-from stylesync.sim.backend import Torques, make_backend
-from stylesync.sim.character import STANDING_ROOT_HEIGHT_M
+from stylesync.sim.factory import make_backend
+from stylesync.model.state import Torques
+from stylesync.model.character import STANDING_ROOT_HEIGHT_M
 
 
 def test_gravity_compensation_holds_root_fixed_character_5s():

@@ -30,8 +30,10 @@ from stylesync.motion.style_features import ROW_NAMES as _FEATURES
 from stylesync.motion.style_features import style_rows
 from stylesync.prefetch import OperatorInline, OperatorPrefetch
 from stylesync.processing.operator_processing import OperatorProcessing, OperatorSample
-from stylesync.sim.backend import CharacterState, PhysicsBackend, make_backend
-from stylesync.sim.character import LINK_NAMES, STANDING_ROOT_HEIGHT_M
+from stylesync.sim.factory import make_backend
+from stylesync.sim.backend import PhysicsBackend
+from stylesync.model.state import CharacterState
+from stylesync.model.character import LINK_NAMES, STANDING_ROOT_HEIGHT_M
 from stylesync.sources.base import OperatorSource
 
 log = logging.getLogger("stylesync.session")

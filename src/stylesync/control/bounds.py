@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from stylesync.sim.character import FOOT_LENGTH_M, FOOT_WIDTH_M
+from stylesync.model.character import FOOT_LENGTH_M, FOOT_WIDTH_M
 
 log = logging.getLogger("stylesync.bounds")
 FOOT_MIN_DIMENSION_M = min(FOOT_LENGTH_M, FOOT_WIDTH_M)  # d_f of Eq. 27 [m]

@@ -17,7 +17,7 @@ import functools
 import numpy as np
 
 from stylesync import rotations as rot
-from stylesync.sim.character import ANKLE_HEIGHT_M, FOOT_CENTER_AHEAD_OF_ANKLE_M, FOOT_LENGTH_M, FOOT_WIDTH_M
+from stylesync.model.character import ANKLE_HEIGHT_M, FOOT_CENTER_AHEAD_OF_ANKLE_M, FOOT_LENGTH_M, FOOT_WIDTH_M
 
 SOLE_MARGIN = 0.9  # fraction of the sole's length and width the corner forces may use
 FRICTION_MARGIN = 0.8  # fraction of the friction coefficient the pyramid uses

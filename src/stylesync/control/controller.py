@@ -39,8 +39,8 @@ from stylesync.control.stable_pd import (
 from stylesync.control.support import limit_ankle_moment
 from stylesync.motion.reference import ReferencePose
 from stylesync.motion.stance_fsm import Stance
-from stylesync.sim.backend import CharacterState, JointFeedback, MassProperties, Torques
-from stylesync.sim.character import JOINT_DOF_START, JOINTS, N_DOFS, Q_WORLD_MODEL, ROOT_DOFS
+from stylesync.model.state import CharacterState, JointFeedback, MassProperties, Torques
+from stylesync.model.character import JOINT_DOF_START, JOINTS, N_DOFS, Q_WORLD_MODEL, ROOT_DOFS
 
 TORQUE_LIMIT = np.array([j.torque_limit_nm for j in JOINTS])[:, None]
 PELVIS_CHILDREN = tuple(k for k, j in enumerate(JOINTS) if j.parent == "root")  # chest and both hips

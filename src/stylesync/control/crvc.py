@@ -19,7 +19,7 @@ import numpy as np
 from stylesync import rotations as rot
 from stylesync.control.gravity_compensation import LEG_JOINTS, SUBTREE_MASK
 from stylesync.control.jacobian_transpose import JointFrames
-from stylesync.sim.character import JOINT_DOF_START, JOINTS, N_JOINT_DOFS, Q_WORLD_MODEL
+from stylesync.model.character import JOINT_DOF_START, JOINTS, N_JOINT_DOFS, Q_WORLD_MODEL
 
 HIP_JOINT = {side: next(k for k, j in enumerate(JOINTS) if j.name == f"{side}_hip") for side in ("left", "right")}
 

@@ -16,8 +16,8 @@ import numpy as np
 
 from stylesync import rotations as rot
 from stylesync.control.jacobian_transpose import JointFrames
-from stylesync.sim.backend import CharacterState
-from stylesync.sim.character import (
+from stylesync.model.state import CharacterState
+from stylesync.model.character import (
     JOINT_DOF_COUNT,
     JOINTS,
     LINK_NAMES,

@@ -19,7 +19,7 @@ from scipy.linalg import lapack
 from scipy.optimize import nnls
 
 from stylesync.control.nnls import nnls_gram
-from stylesync.sim.character import N_DOFS, ROOT_DOFS
+from stylesync.model.character import N_DOFS, ROOT_DOFS
 
 _EYE_ROOT = np.eye(ROOT_DOFS)
 

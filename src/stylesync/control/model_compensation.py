@@ -19,7 +19,7 @@ from stylesync.control.bounds import BoundsMonitor, lipm_force_bound_n
 from stylesync.control.gravity_compensation import ANKLE_JOINT
 from stylesync.control.support import support_point
 from stylesync.motion.reference import LipmMap
-from stylesync.sim.character import JOINTS
+from stylesync.model.character import JOINTS
 
 
 def ipm_ankle_moments(com_desired: np.ndarray, ankle_pos: dict[str, np.ndarray], stance_weight: dict[str, float],

@@ -43,8 +43,8 @@ from stylesync.control.pid import IS_BALL
 from stylesync.control.stable_pd import flatten_joint_values, unflatten_joint_values
 from stylesync.motion.reference import ReferencePose
 from stylesync.motion.stance_fsm import swing_side
-from stylesync.sim.backend import CharacterState, JointFeedback, MassProperties, Torques
-from stylesync.sim.character import ANKLE_HEIGHT_M, LINK_NAMES, N_DOFS, ROOT_DOFS
+from stylesync.model.state import CharacterState, JointFeedback, MassProperties, Torques
+from stylesync.model.character import ANKLE_HEIGHT_M, LINK_NAMES, N_DOFS, ROOT_DOFS
 
 _FOOT_LINK = {s: LINK_NAMES.index(f"{s}_ankle") for s in ("left", "right")}
 # A stance foot not yet touching is aimed this far below the ground [m], with this weight against a joint's: with

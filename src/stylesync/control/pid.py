@@ -14,7 +14,7 @@ import numpy as np
 
 from stylesync import rotations as rot
 from stylesync.config import ControlConfig, pid_group
-from stylesync.sim.character import JOINTS, JointKind
+from stylesync.model.character import JOINTS, JointKind
 
 IS_BALL = np.array([j.kind is JointKind.BALL for j in JOINTS])
 _BALL = np.flatnonzero(IS_BALL)

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from stylesync.sim.character import JOINT_DOF_COUNT, JOINT_DOF_START, JOINTS, N_DOFS, N_JOINT_DOFS, ROOT_DOFS
+from stylesync.model.character import JOINT_DOF_COUNT, JOINT_DOF_START, JOINTS, N_DOFS, N_JOINT_DOFS, ROOT_DOFS
 
 _ROWS = np.array([k for k in range(len(JOINTS)) for _ in range(JOINT_DOF_COUNT[k])])
 _COLS = np.array([a for k in range(len(JOINTS)) for a in range(JOINT_DOF_COUNT[k])])

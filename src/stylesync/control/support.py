@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from stylesync.sim.character import FOOT_CENTER_AHEAD_OF_ANKLE_M, FOOT_LENGTH_M, FOOT_WIDTH_M
+from stylesync.model.character import FOOT_CENTER_AHEAD_OF_ANKLE_M, FOOT_LENGTH_M, FOOT_WIDTH_M
 
 SOLE_MARGIN = 0.8  # fraction of the sole's length and width a centre of pressure may use
 # Effective arm of the friction torque a flat sole resists twisting with (about a third of its half-diagonal) [m].

@@ -29,8 +29,9 @@ from stylesync.control.jacobian_transpose import JointFrames
 from stylesync.control.pid import IS_BALL, JointPid, joint_error
 from stylesync.control.stable_pd import flatten_joint_values, implicit_gain, joint_damping, unflatten_joint_values
 from stylesync.processing.joint_map import hinge_angle
-from stylesync.sim.backend import Torques, make_backend
-from stylesync.sim.character import JOINT_NAMES, JOINTS, N_JOINT_DOFS, ROOT_DOFS, model_quat_from_canonical
+from stylesync.sim.factory import make_backend
+from stylesync.model.state import Torques
+from stylesync.model.character import JOINT_NAMES, JOINTS, N_JOINT_DOFS, ROOT_DOFS, model_quat_from_canonical
 from stylesync.sources.deepmimic_clip import DeepMimicClip
 
 GROUPS = ("chest", "neck", "hip", "knee", "ankle", "shoulder", "elbow")

@@ -15,7 +15,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from stylesync import rotations as rot
-from stylesync.sim.character import LINK_NAMES, LINK_PARENT
+from stylesync.model.character import LINK_NAMES, LINK_PARENT
 
 # ours (x forward, y left, z up) -> BVH (X left, Y up, Z forward): a cyclic permutation, a proper rotation.
 R_BVH_OURS = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])

@@ -29,7 +29,7 @@ import numpy as np
 
 from stylesync.errors import SourceError
 from stylesync.processing.joint_map import TRACKED_POSITIONS
-from stylesync.sim.character import JOINTS, LINK_NAMES
+from stylesync.model.character import JOINTS, LINK_NAMES
 
 FORMAT = "stylesync-session"
 VERSION = 1

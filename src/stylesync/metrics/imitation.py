@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from stylesync.sim.character import LINK_NAMES
+from stylesync.model.character import LINK_NAMES
 
 # Character links whose frame origin is the joint of the same name on the operator (canonical joints).
 JOINT_PAIRS: tuple[tuple[str, str], ...] = (

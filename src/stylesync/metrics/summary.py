@@ -7,7 +7,7 @@ import numpy as np
 from stylesync.metrics import imitation as im
 from stylesync.motion.stance_fsm import Stance
 from stylesync.session import STANCE_CODE, SessionResult
-from stylesync.sim.backend import CONTACT_FORCE_N
+from stylesync.model.state import CONTACT_FORCE_N
 
 _DS = STANCE_CODE[Stance.DS]
 

@@ -39,8 +39,8 @@ from stylesync.processing.body_parameters import leg_length_m
 from stylesync.processing.interpolation import smooth_step
 from stylesync.processing.joint_map import hinge_angle, local_rotations
 from stylesync.processing.operator_processing import OperatorSample
-from stylesync.sim.backend import CharacterState, MassProperties
-from stylesync.sim.character import (
+from stylesync.model.state import CharacterState, MassProperties
+from stylesync.model.character import (
     ANKLE_HEIGHT_M,
     HIP_HALF_WIDTH_M,
     JOINT_NAMES,

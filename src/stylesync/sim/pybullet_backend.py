@@ -21,15 +21,10 @@ from pybullet_utils.bullet_client import BulletClient
 from stylesync import rotations as rot
 from stylesync.config import WorldConfig
 from stylesync.errors import SimulationError
-from stylesync.sim.backend import (
-    CharacterState,
-    JointFeedback,
-    LinkShape,
-    MassProperties,
-    PhysicsBackend,
-    Torques,
-)
-from stylesync.sim.character import (
+from stylesync.model.body_description import BodyDescription, BodyJointKind, LinkDescription
+from stylesync.sim.backend import PhysicsBackend
+from stylesync.model.state import CharacterState, JointFeedback, LinkShape, MassProperties, Torques
+from stylesync.model.character import (
     FOOT_LINKS,
     JOINT_DOF_COUNT,
     JOINT_DOF_START,
@@ -195,6 +190,29 @@ class PyBulletBackend(PhysicsBackend):
 
     def mass_properties(self) -> MassProperties:
         return self._mass
+
+    def body_description(self) -> BodyDescription:
+        c = self._pb
+        kinds = {pb.JOINT_FIXED: BodyJointKind.FIXED, pb.JOINT_SPHERICAL: BodyJointKind.SPHERICAL,
+                 pb.JOINT_REVOLUTE: BodyJointKind.REVOLUTE}
+        links = []
+        for j in range(c.getNumJoints(self.body)):
+            info, dyn = c.getJointInfo(self.body, j), c.getDynamicsInfo(self.body, j)
+            if info[2] not in kinds:
+                raise SimulationError(f"character joint '{info[1].decode()}' has an unsupported type {info[2]}")
+            links.append(LinkDescription(
+                name=info[12].decode(), parent=int(info[16]), joint_kind=kinds[info[2]],
+                joint_axis=np.array(info[13], dtype=float),
+                joint_pos_in_parent_inertial=np.array(info[14], dtype=float),
+                joint_quat_in_parent_inertial_wxyz=rot.wxyz_from_xyzw(np.array(info[15], dtype=float)),
+                mass_kg=float(dyn[0]), inertia_diag_kgm2=np.array(dyn[2], dtype=float),
+                inertial_pos_in_link=np.array(dyn[3], dtype=float),
+                inertial_quat_in_link_wxyz=rot.wxyz_from_xyzw(np.array(dyn[4], dtype=float)),
+                joint_limits_rad=(float(info[8]), float(info[9])) if info[8] < info[9] else None))
+        base = c.getDynamicsInfo(self.body, -1)
+        if np.any(np.abs(base[3]) > 0) or np.any(np.abs(np.array(base[4]) - (0, 0, 0, 1)) > 0):
+            raise SimulationError("the character's base must have its inertial frame at its link frame")
+        return BodyDescription(float(base[0]), np.array(base[2], dtype=float), tuple(links))
 
     def _read_raw(self) -> tuple:
         """Base pose and velocity and every joint's state, read once per engine state: the joint feedback, the

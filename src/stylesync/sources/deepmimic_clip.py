@@ -16,7 +16,7 @@ import numpy as np
 
 from stylesync import rotations as rot
 from stylesync.errors import SourceError
-from stylesync.sim.character import Q_WORLD_MODEL, canonical_quat_from_model
+from stylesync.model.character import Q_WORLD_MODEL, canonical_quat_from_model
 from stylesync.sources.base import read_json_file
 
 FRAME_WIDTH = 44

@@ -17,7 +17,7 @@ import numpy as np
 from stylesync.config import VIEWER_DRAW_HZ, WorldConfig
 from stylesync.errors import SimulationError
 from stylesync.motion.stance_fsm import Stance
-from stylesync.sim.backend import make_backend
+from stylesync.sim.factory import make_backend
 from stylesync.sim.disturbance import throw_ball_at_chest
 from stylesync.viewer.snapshot import Snapshot, snapshot_from_state
 

@@ -18,7 +18,7 @@ from collections.abc import Callable
 from typing import Any
 
 from stylesync.errors import ConfigError
-from stylesync.sim.backend import LinkShape
+from stylesync.model.state import LinkShape
 from stylesync.viewer.snapshot import Snapshot
 
 log = logging.getLogger("stylesync.viewer")
