@@ -14,7 +14,7 @@ from stylesync.errors import ConfigError
 
 # ../shared beside the checkout: recorded motion capture that benches and experiments use when it is present.
 SHARED_DIR = Path(__file__).resolve().parents[3] / "shared"
-BALANCE_METHODS = ("inverse_dynamics", "jacobian_transpose")
+BALANCE_METHODS = ("whole_body", "jacobian_transpose")
 VIEWER_DRAW_HZ = 20.0  # default drawing rate of a viewer, independent of the control rate [Hz]
 
 
@@ -166,10 +166,9 @@ class ControlConfig:
     # feedback (SIMBICON's torso control, controller.py); off by default: measured no better overall
     # (docs/decisions.md). Off, the root torque is one more implicit term on the stance hips.
     stance_hip_torso: bool = False
-    # How the virtual forces are realised: "inverse_dynamics" (momentum_balance.py: ground forces on the soles,
-    # then contact-consistent inverse dynamics) or "jacobian_transpose" (controller.py: Eq. 17-18 and Eq. 20 as
-    # printed, with the stable PD). See docs/decisions.md.
-    balance: str = "inverse_dynamics"
+    # How the virtual forces are realised: "whole_body" (whole_body.py: tasks and sole contacts in one QP per tick)
+    # or "jacobian_transpose" (controller.py: Eq. 17-18 and Eq. 20 as printed, with the stable PD).
+    balance: str = "whole_body"
     joint_tracking_omega_rad_s: float = 20.0  # inverse dynamics: Eq. 13 as q̈* = ω² e + 2 ζ ω ė
     joint_tracking_damping_ratio: float = 1.0
     joint_acceleration_limit_rad_s2: float = 200.0  # the joint PD's desired acceleration is saturated here
@@ -188,6 +187,11 @@ class ControlConfig:
     # supporting (contact_forces.sole_touches); 0 = only a foot pressing the ground does. Off by default, as
     # WorldConfig.friction_anchor, with which it keeps a standing character's feet planted [m].
     sole_contact_gap_m: float = 0.0
+    # Whole body: the hands follow the operator's hands in world space (a task each, off by default) [1/s², 1/s]
+    hand_tasks: bool = False
+    hand_task_kp: float = 100.0
+    hand_task_kd: float = 20.0
+    hand_task_weight: float = 10.0
     gravity_compensation: bool = True  # Eq. 14-15
     com_virtual_force: bool = True  # Eq. 16-17
     root_virtual_torque: bool = True  # Eq. 16, 18
@@ -208,7 +212,7 @@ class ControlConfig:
         # centre of pressure (IPM) in one problem; only the LIPM force is a separate term there.
         fixed = [n for n in ("gravity_compensation", "com_virtual_force", "root_virtual_torque",
                              "ipm_ankle_compensation") if not getattr(self, n)]
-        if self.balance == "inverse_dynamics" and fixed:
+        if self.balance == "whole_body" and fixed:
             raise ConfigError(f"ControlConfig: {', '.join(fixed)} can only be switched off with "
                               f"balance='jacobian_transpose' (the inverse-dynamics balance has no separate term)")
         for n in ("joint_tracking_omega_rad_s", "joint_tracking_damping_ratio", "momentum_moment_weight_per_m",

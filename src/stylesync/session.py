@@ -18,11 +18,12 @@ import numpy as np
 
 from stylesync import rotations as rot
 from stylesync.config import SessionConfig
-from stylesync.control.bounds import BoundsMonitor
+from stylesync.motion.bounds import BoundsMonitor
 from stylesync.control.controller import BalanceController, ControllerBase
-from stylesync.control.momentum_balance import MomentumBalanceController
+from stylesync.control.whole_body import WholeBodyController
 from stylesync.control.pid import joint_error
 from stylesync.errors import SourceError
+from stylesync.model.character_model import CharacterModel
 from stylesync.metrics.imitation import CHARACTER_LINKS, OPERATOR_JOINTS
 from stylesync.motion.pose_optimization import MotionOptimizer
 from stylesync.motion.stance_fsm import Stance
@@ -102,11 +103,18 @@ class Session:
         self.bounds = BoundsMonitor()
         self.motion = MotionOptimizer(config.motion, config.clocks.control_hz, self.bounds,
                                       config.world.gravity_mps2)
-        controller_class: type[ControllerBase] = (
-            MomentumBalanceController if config.control.balance == "inverse_dynamics" else BalanceController)
-        self.controller = controller_class(config.control, self.mass, config.world.gravity_mps2,
-                                           1.0 / config.clocks.physics_hz, 1.0 / config.clocks.control_hz,
-                                           self.bounds, config.world.friction)
+        body = self.backend.body_description()
+        self.model = CharacterModel(body, config.world.gravity_mps2)
+        self.controller: ControllerBase
+        if config.control.balance == "whole_body":
+            limits = {link.name: link.joint_limits_rad for link in body.links if link.joint_limits_rad is not None}
+            self.controller = WholeBodyController(
+                config.control, self.model, self.mass, config.world.gravity_mps2, 1.0 / config.clocks.physics_hz,
+                1.0 / config.clocks.control_hz, self.bounds, config.world.friction, limits)
+        else:
+            self.controller = BalanceController(
+                config.control, self.model, self.mass, config.world.gravity_mps2, 1.0 / config.clocks.physics_hz,
+                1.0 / config.clocks.control_hz, self.bounds, config.world.friction)
         self.on_tick = on_tick
         self.renders: list[tuple[float, np.ndarray]] = []
         self.last_sample: OperatorSample | None = None  # newest processed operator sample (recorders, viewers)
@@ -208,7 +216,7 @@ class Session:
                     state = self.backend.read_state(t)
                     ref = self.motion.update(sample, state, self.mass, analysis)
                     c2 = time.perf_counter()
-                    self.controller.update(state, ref, self.backend.joint_space_inertia())
+                    self.controller.update(state, ref)
                     c3 = time.perf_counter()
                     stage_ms["processing"].append((c1 - c0) * 1e3)
                     stage_ms["motion"].append((c2 - c1) * 1e3)

@@ -17,7 +17,7 @@ import numpy as np
 
 from stylesync import rotations as rot
 from stylesync.config import ControlConfig
-from stylesync.control import bounds as bnd
+from stylesync.motion import bounds as bnd
 from stylesync.control.crvc import (
     HIP_JOINT,
     com_virtual_force,
@@ -39,6 +39,7 @@ from stylesync.control.stable_pd import (
 from stylesync.control.support import limit_ankle_moment
 from stylesync.motion.reference import ReferencePose
 from stylesync.motion.stance_fsm import Stance
+from stylesync.model.character_model import CharacterModel
 from stylesync.model.state import CharacterState, JointFeedback, MassProperties, Torques
 from stylesync.model.character import JOINT_DOF_START, JOINTS, N_DOFS, Q_WORLD_MODEL, ROOT_DOFS
 
@@ -82,7 +83,7 @@ class ControllerBase(ABC):
         self._ref_vel = np.zeros((len(JOINTS), 3))
 
     @abstractmethod
-    def update(self, state: CharacterState, ref: ReferencePose, mass_matrix: np.ndarray) -> None:
+    def update(self, state: CharacterState, ref: ReferencePose) -> None:
         """One control tick: read the state and the reference, prepare the torques."""
 
     # Whether ``torques`` reads the joints' state at each physics step; a controller that holds its torques from
@@ -116,9 +117,11 @@ class ControllerBase(ABC):
 
 
 class BalanceController(ControllerBase):
-    def __init__(self, cfg: ControlConfig, mass: MassProperties, gravity_mps2: float, physics_dt_s: float,
-                 control_dt_s: float, bounds: bnd.BoundsMonitor | None = None, friction: float = 0.9):
+    def __init__(self, cfg: ControlConfig, model: CharacterModel, mass: MassProperties, gravity_mps2: float,
+                 physics_dt_s: float, control_dt_s: float, bounds: bnd.BoundsMonitor | None = None,
+                 friction: float = 0.9):
         super().__init__(cfg, mass, gravity_mps2, physics_dt_s, control_dt_s, bounds, friction)
+        self.model = model
         self.pid = JointPid(cfg, physics_dt_s)
         self._ff = np.zeros((len(JOINTS), 3))
         self._ref: ReferencePose | None = None
@@ -151,8 +154,10 @@ class BalanceController(ControllerBase):
         self._root_map = s_map
         self._gain = implicit_gain(mass_matrix, d)[ROOT_DOFS:, ROOT_DOFS:]
 
-    def update(self, state: CharacterState, ref: ReferencePose, mass_matrix: np.ndarray) -> None:
+    def update(self, state: CharacterState, ref: ReferencePose) -> None:
         cfg = self.cfg
+        self.model.update(state)
+        mass_matrix = self.model.mass_matrix_world_layout()
         w = supporting_weights(ref.stance_weight, state.feet_pressing())
         foot_yaw = {s: rot.yaw_from_quat(state.link_quat_wxyz[state.link(f"{s}_ankle")]) for s in ("left", "right")}
         self._prepare_implicit(state, w, mass_matrix)

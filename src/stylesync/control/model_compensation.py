@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from stylesync import rotations as rot
-from stylesync.control.bounds import BoundsMonitor, lipm_force_bound_n
+from stylesync.motion.bounds import BoundsMonitor, lipm_force_bound_n
 from stylesync.control.gravity_compensation import ANKLE_JOINT
 from stylesync.control.support import support_point
 from stylesync.motion.reference import LipmMap

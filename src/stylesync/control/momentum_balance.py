@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from stylesync.config import ControlConfig
-from stylesync.control import bounds as bnd
+from stylesync.motion import bounds as bnd
 from stylesync.control.contact_forces import (
     feasible_horizontal_force,
     regularisation,

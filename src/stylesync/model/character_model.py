@@ -135,6 +135,7 @@ class CharacterModel:
         self.link_frame_ids = [self._frame_ids[n] for n in LINK_NAMES]
         # Index maps from the state's (n_joints, 4) / (n_joints, 3) arrays to q and v (wxyz -> xyzw for balls).
         q_idx, v_idx, q_flat, v_flat = [], [], [], []
+        self._hinge_q: dict[int, int] = {}  # a hinge's DOF in the character's layout -> its index in q
         perm = np.arange(self.nv)  # perm[i]: Pinocchio's index of DOF i of the character's layout
         for k, spec in enumerate(JOINTS):
             jid = self.model.getJointId(spec.name)
@@ -147,6 +148,7 @@ class CharacterModel:
                 v_idx += [iv, iv + 1, iv + 2]
                 v_flat += [3 * k, 3 * k + 1, 3 * k + 2]
             else:
+                self._hinge_q[ROOT_DOFS + JOINT_DOF_START[k]] = iq
                 q_idx.append(iq)
                 q_flat.append(4 * k)
                 v_idx.append(iv)
@@ -250,3 +252,7 @@ class CharacterModel:
         """M in the engine's layout (root velocities in world axes): Tᵀ M T."""
         t = self.root_velocity_map()
         return t.T @ self.mass_matrix @ t
+
+    def joint_position(self, dof: int) -> float:
+        """A hinge's angle [rad] by its index in the character's DOF layout."""
+        return float(self.q[self._hinge_q[dof]])

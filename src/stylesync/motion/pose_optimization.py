@@ -23,7 +23,7 @@ import numpy as np
 
 from stylesync import rotations as rot
 from stylesync.config import MotionConfig
-from stylesync.control.bounds import BoundsMonitor, step_length_bound_m
+from stylesync.motion.bounds import BoundsMonitor, step_length_bound_m
 from stylesync.motion.balance_strategy import level_root, stance_hip_blend, swing_hip_feedback
 from stylesync.motion.leg_ik import solve_leg
 from stylesync.motion.reference import LipmMap, ReferencePose

@@ -12,7 +12,7 @@ import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
 from stylesync import rotations as rot
-from stylesync.control.bounds import ds_com_bound_m, step_length_bound_m
+from stylesync.motion.bounds import ds_com_bound_m, step_length_bound_m
 from stylesync.motion.stance_fsm import Stance
 from stylesync.processing.joint_map import TRACKED_POSITIONS
 from stylesync.model.state import CharacterState, LinkShape

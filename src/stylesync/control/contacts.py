@@ -1,0 +1,129 @@
+"""Sole contacts: where the ground can push the character, and how hard.
+
+Each supporting sole passes a force at each of its four corners inside the friction cone, linearised as a 4-sided
+pyramid: ``f_c = Σ_e λ_ce β_e`` with ``λ >= 0``. Forces on the corners keep the centre of pressure on the sole and
+bound the torsion, so the corners' pyramids are the sole's contact wrench cone. A contact adds to the whole-body QP
+its 16 force variables, its generator ``B = Σ_c J_cᵀ β`` (nv, 16) in the equations of motion, the constraint that
+the sole does not move (``J q̈ + J̇ q̇ = -k_v J q̇``), a regularisation ``ε λ²`` that grows as its stance weight
+falls (a foot about to lift off is unloaded first), and an upper bound on its normal force that ramps to zero
+with the stance weight, so contacts are added and removed without a jump of the forces.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from stylesync import rotations as rot
+from stylesync.model.character import ANKLE_HEIGHT_M, FOOT_CENTER_AHEAD_OF_ANKLE_M, FOOT_LENGTH_M, FOOT_WIDTH_M
+from stylesync.model.character_model import SOLE_FRAMES, CharacterModel
+
+SOLE_MARGIN = 0.9  # fraction of the sole's length and width the corner forces may use
+FRICTION_MARGIN = 0.8  # fraction of the friction coefficient the pyramid uses
+COP_MARGIN = 0.9  # fraction of the support's extent the desired horizontal force may use
+MOMENTUM_ACCEL_ALLOWANCE_MPS2 = 0.5  # horizontal COM acceleration allowed beyond the pendulum's [m/s²]
+REGULARISATION = 1e-4  # ε of a full-weight foot [1/N² against the tasks' squared residuals]
+MIN_WEIGHT = 0.05  # a stance weight below this is treated as this (ε = REGULARISATION / weight)
+# The normal-force bound: this many body weights at full contact, ramped down linearly below RAMP_WEIGHT.
+MAX_NORMAL_FORCE_BODY_WEIGHTS = 3.0
+RAMP_WEIGHT = 0.1
+FORCES_PER_SOLE = 16  # 4 corners x 4 pyramid edges
+_HALF_L, _HALF_W = SOLE_MARGIN * FOOT_LENGTH_M / 2, SOLE_MARGIN * FOOT_WIDTH_M / 2
+# Sole corners relative to the sole's centre in the foot's canonical frame (x forward, y left, z up) [m], (4, 3).
+SOLE_CORNERS_IN_SOLE = np.array([[sx * _HALF_L, sy * _HALF_W, 0.0] for sx in (1.0, -1.0) for sy in (1.0, -1.0)])
+# The same relative to the ankle joint [m], (4, 3).
+SOLE_CORNERS_IN_FOOT = SOLE_CORNERS_IN_SOLE + np.array([FOOT_CENTER_AHEAD_OF_ANKLE_M, 0.0, -ANKLE_HEIGHT_M])
+_EDGE_DIRS = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]])
+
+
+def sole_corners_world(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray) -> np.ndarray:
+    """(4, 3) world positions of a foot's sole corners [m]."""
+    return np.asarray(ankle_world, dtype=float) + SOLE_CORNERS_IN_FOOT @ rot.matrix_from_quat(foot_quat_wxyz).T
+
+
+def sole_touches(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray, pressing: bool, gap_m: float) -> bool:
+    """Whether a foot can be given ground forces: it presses the ground (``CharacterState.feet_pressing``), or the
+    lowest corner of its sole is within ``gap_m`` of the ground (``gap_m`` > 0: a planted foot just unloaded)."""
+    return pressing or (gap_m > 0 and float(sole_corners_world(ankle_world, foot_quat_wxyz)[:, 2].min()) < gap_m)
+
+
+@functools.lru_cache(maxsize=8)
+def pyramid_edges(friction: float) -> np.ndarray:
+    """(4, 3) unit edges of the linearised friction cone of a flat ground (FRICTION_MARGIN of ``friction``)."""
+    mu = FRICTION_MARGIN * friction
+    e = np.column_stack([mu * _EDGE_DIRS, np.ones(4)])
+    e /= np.linalg.norm(e, axis=1, keepdims=True)
+    e.setflags(write=False)
+    return e
+
+
+def feasible_horizontal_force(force_n: np.ndarray, com_world: np.ndarray, corners_world: list[np.ndarray],
+                              mass_kg: float, gravity_mps2: float) -> np.ndarray:
+    """The desired force (3,) [N] with its horizontal part limited to what a centre of pressure inside the support
+    can give: by the linear inverted pendulum (the model of Eq. 21), m p̈ = m g / h (c - p_cop) per horizontal
+    axis, with p_cop within the soles' extent on that axis, shrunk by COP_MARGIN about its middle, widened by
+    MOMENTUM_ACCEL_ALLOWANCE_MPS2 (a change of angular momentum, the hip strategy, gives some force the pendulum
+    does not). A larger request cannot be met by the ground; left in the momentum task, it would be traded against
+    the vertical force and the moment, which lifts or tips the body."""
+    out = np.array(force_n, dtype=float)
+    if not corners_world:
+        return out
+    pts = np.concatenate(corners_world)
+    h = max(float(com_world[2]) - float(pts[:, 2].mean()), 0.1)
+    k = mass_kg * gravity_mps2 / h
+    lo, hi = pts[:, :2].min(axis=0).tolist(), pts[:, :2].max(axis=0).tolist()
+    extra = mass_kg * MOMENTUM_ACCEL_ALLOWANCE_MPS2
+    for ax in (0, 1):
+        mid, half = 0.5 * (lo[ax] + hi[ax]), 0.5 * COP_MARGIN * (hi[ax] - lo[ax])
+        c = float(com_world[ax])
+        lo_f = min(k * (c - mid - half), 0.0) - extra
+        hi_f = max(k * (c - mid + half), 0.0) + extra
+        out[ax] = min(max(float(out[ax]), lo_f), hi_f)
+    return out
+
+
+class SoleContact:
+    """One foot's sole on the ground, as the whole-body QP sees it."""
+
+    def __init__(self, side: str, friction: float, body_weight_n: float):
+        self.side = side
+        self.frame = SOLE_FRAMES[side]
+        self.edges = pyramid_edges(friction)  # (4, 3)
+        self.body_weight_n = body_weight_n
+        self.stance_weight = 1.0  # set per tick: the share of the body this foot is meant to carry, [0, 1]
+        # Per tick, after update(): the generator (nv, 16), the sole's Jacobian (6, nv), drift (6,), corners (4, 3).
+        self.generator = np.zeros((0, 0))
+        self.jacobian = np.zeros((6, 0))
+        self.drift = np.zeros(6)
+        self.velocity = np.zeros(6)
+        self.corners_world = np.zeros((4, 3))
+        # Normal components of the 16 unit forces (the same at every corner): Σ_e n_e λ_e is the normal force.
+        self.normal_row = np.tile(self.edges[:, 2], 4)
+
+    def update(self, model: CharacterModel) -> None:
+        f = model.frame_id(self.frame)
+        self.jacobian = model.frame_jacobian(f)
+        self.drift = model.frame_drift(f)
+        self.velocity = model.frame_velocity(f)
+        r_world_sole = model.frame_rotation(f)
+        levers = SOLE_CORNERS_IN_SOLE @ r_world_sole.T  # (4, 3) corner - sole centre, world axes
+        self.corners_world = model.frame_position(f) + levers
+        # B = Σ_c J_cᵀ β_e = J_linᵀ β_e + J_angᵀ (r_c × β_e), corner by corner, edge by edge.
+        forces = np.tile(self.edges.T, 4)  # (3, 16)
+        moments = np.cross(np.repeat(levers, 4, axis=0), np.tile(self.edges, (4, 1))).T  # (3, 16)
+        self.generator = self.jacobian[:3].T @ forces + self.jacobian[3:].T @ moments
+
+    @property
+    def regularisation(self) -> float:
+        """ε of this contact's forces: larger as its stance weight falls."""
+        return REGULARISATION / max(self.stance_weight, MIN_WEIGHT)
+
+    @property
+    def max_normal_force_n(self) -> float:
+        """Upper bound of the normal force [N], ramped down with the stance weight below RAMP_WEIGHT."""
+        return MAX_NORMAL_FORCE_BODY_WEIGHTS * self.body_weight_n * min(1.0, self.stance_weight / RAMP_WEIGHT)
+
+    def constraint_rows(self, velocity_gain: float) -> tuple[np.ndarray, np.ndarray]:
+        """The sole does not move: ``J q̈ = -J̇ q̇ - k_v J q̇`` (its residual velocity damped at ``velocity_gain``)."""
+        return self.jacobian, -self.drift - velocity_gain * self.velocity

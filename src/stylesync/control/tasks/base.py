@@ -1,0 +1,35 @@
+"""What a whole-body task is: a name, a weight per row, and at each control tick the rows ``A q̈ = b`` it asks for.
+
+A task's desired acceleration comes from its own feedback law (a PD on its error, with its gains); the rows are its
+Jacobian ``A`` (k, nv) and ``b = ẍ* - J̇ q̇`` (the desired acceleration minus the drift). The formulation adds
+``½ Σ_rows w (A q̈ - b)²`` to the QP's objective (weighted tasks, as TSID's and placo's soft tasks).
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+
+import numpy as np
+
+from stylesync.model.character_model import CharacterModel
+
+
+@dataclass
+class TaskRows:
+    """One task's contribution at one tick: ``weight * (jacobian @ q̈ - target)²`` summed over rows."""
+
+    jacobian: np.ndarray  # (k, nv)
+    target: np.ndarray  # (k,)
+    weight: np.ndarray  # (k,) per-row weight (>= 0)
+
+
+class Task(ABC):
+    """A whole-body task. Subclasses hold their gains and targets (set by the controller before each tick)."""
+
+    name: str = "task"
+    active: bool = True
+
+    @abstractmethod
+    def rows(self, model: CharacterModel) -> TaskRows:
+        """The task's rows at the model's current state (``CharacterModel.update`` has run)."""

@@ -1,0 +1,169 @@
+"""The balance and synchronisation controller (Sec. 6) as whole-body control: tasks, contacts, one QP per tick.
+
+The same parts as the paper's controller (controller.py), composed as tasks of one quadratic programme
+(formulation.py, solved by ProxQP in solver.py):
+
+* joint posture (Eq. 13 per DOF as a desired acceleration, ``q̈* = ω² e + 2 ζ ω ė``): the retargeted operator pose;
+* pelvis orientation (the root virtual torque's PD law, per unit inertia);
+* centroidal momentum: the COM virtual force of Eq. 16 (first line, Eq. 19 errors; gains of a capture-point
+  tracking law, ControlConfig.momentum_com_kp/kd, docs/decisions.md), the pelvis height of Eq. 9 vertically, the
+  LIPM time-sync force (Eq. 21-23, bounded by Eq. 26), and the root virtual torque (Eq. 16, second line);
+* a stance foot that has not touched down yet (or a swing foot held for a late contact, Sec. 5.1) pressed onto the
+  ground; optionally the hands following the operator's hands (ControlConfig.hand_tasks);
+* sole contacts (contacts.py): the ground forces the soles can pass, found with the accelerations, replace the
+  Jacobian-transpose mapping of Eq. 17-18 and the IPM ankle torque of Eq. 20 (a centre of pressure is placed,
+  not implied); gravity compensation (Eq. 14-15) is in the equations of motion, with the feet's reactions.
+
+Why not Eq. 17-18 alone: they assume a static body and feet that push as asked. Measured with that mapping, the
+standing character toppled when it waved its arms and the walk fell within a second of its first step
+(docs/decisions.md). Adding a task is one class in ``tasks/`` and one ``add_task`` line in ``__init__``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from stylesync import rotations as rot
+from stylesync.config import ControlConfig
+from stylesync.control.contacts import SoleContact, feasible_horizontal_force, sole_corners_world, sole_touches
+from stylesync.control.controller import TORQUE_LIMIT, ControllerBase, ControlTelemetry, supporting_weights
+from stylesync.control.crvc import com_virtual_force, root_orientation_error, root_pd
+from stylesync.control.formulation import WholeBodyFormulation, hinge_limits
+from stylesync.control.model_compensation import bounded_lipm_sync_force
+from stylesync.control.pid import IS_BALL
+from stylesync.control.solver import ProxQpSolver
+from stylesync.control.stable_pd import flatten_joint_values, unflatten_joint_values
+from stylesync.control.tasks import CentroidalMomentumTask, FrameOrientationTask, FramePositionTask, JointPostureTask
+from stylesync.model.character import ANKLE_HEIGHT_M, LINK_NAMES, Q_WORLD_MODEL, ROOT_DOFS, SIDES
+from stylesync.model.character_model import HAND_FRAMES, CharacterModel
+from stylesync.model.state import CharacterState, JointFeedback, MassProperties, Torques
+from stylesync.motion import bounds as bnd
+from stylesync.motion.reference import ReferencePose
+from stylesync.motion.stance_fsm import swing_side
+
+_FOOT_LINK = {s: LINK_NAMES.index(f"{s}_ankle") for s in SIDES}
+# A stance foot not yet touching is aimed this far below the ground [m], with this weight against a joint's: with
+# 2 cm and 100 a landing foot bounced off and slid in double stance (docs/decisions.md, "Landing").
+GROUND_PRESS_M = 0.035
+FOOT_TASK_WEIGHT = 1000.0
+# A joint's desired acceleration is saturated at ControlConfig.joint_acceleration_limit_rad_s2 or, where higher, at
+# what this share of its torque limit gives its own inertia: the feet (0.001-0.005 kg·m²) were otherwise held to a
+# fraction of a N·m, and a swing foot whipped by its leg rolled over by up to 115°.
+JOINT_ACCEL_TORQUE_SHARE = 0.1
+# Each DOF's tracking weight M_ii is taken as at least this [kg·m²]: with the feet's own inertia, a swing foot's
+# tracking was the cheapest term to trade for the wrench, and it swung tilted by 20-100° and landed on an edge.
+MIN_TRACKING_INERTIA_KGM2 = 0.05
+# The hinges' limits are kept over this horizon: q + q̇ T + ½ q̈ T² stays within them [s].
+JOINT_LIMIT_HORIZON_S = 0.05
+_TORQUE_LIMIT_FLAT = flatten_joint_values(np.repeat(TORQUE_LIMIT, 3, axis=1))
+
+
+class WholeBodyController(ControllerBase):
+    needs_joint_feedback = False
+
+    def __init__(self, cfg: ControlConfig, model: CharacterModel, mass: MassProperties, gravity_mps2: float,
+                 physics_dt_s: float, control_dt_s: float, bounds: bnd.BoundsMonitor | None = None,
+                 friction: float = 0.9, joint_limits: dict[str, tuple[float, float]] | None = None):
+        super().__init__(cfg, mass, gravity_mps2, physics_dt_s, control_dt_s, bounds, friction)
+        self.model = model
+        self._tau = Torques.zeros()  # held from one control tick to the next [N·m]
+        omega, zeta = cfg.joint_tracking_omega_rad_s, cfg.joint_tracking_damping_ratio
+        self.kp, self.kd = omega * omega, 2.0 * zeta * omega
+        self.formulation = WholeBodyFormulation(_TORQUE_LIMIT_FLAT, hinge_limits(joint_limits or {}),
+                                                cfg.contact_velocity_gain, JOINT_LIMIT_HORIZON_S)
+        f = self.formulation
+        self.posture = f.add_task(JointPostureTask(cfg.joint_tracking_weight, MIN_TRACKING_INERTIA_KGM2))
+        self.pelvis = f.add_task(FrameOrientationTask("pelvis_orientation", "root", self.kp, self.kd, 0.0,
+                                                      rot.conjugate(Q_WORLD_MODEL)))
+        self.momentum = f.add_task(CentroidalMomentumTask(1.0, cfg.momentum_moment_weight_per_m ** 2))
+        self.foot_press = {s: f.add_task(FramePositionTask(f"{s}_foot_press", f"{s}_ankle", self.kp, self.kd,
+                                                           FOOT_TASK_WEIGHT, axes=(2,))) for s in SIDES}
+        self.hands = ({s: f.add_task(FramePositionTask(f"{s}_hand", HAND_FRAMES[s], cfg.hand_task_kp,
+                                                       cfg.hand_task_kd, cfg.hand_task_weight)) for s in SIDES}
+                      if cfg.hand_tasks else {})
+        self.contacts = {s: SoleContact(s, friction, mass.total_kg * gravity_mps2) for s in SIDES}
+        self.solver = ProxQpSolver()
+        self.last_qp = None  # the last tick's QpResult (iterations, time)
+        self.qp_failures = 0  # ticks whose QP did not reach its tolerance (the best iterate was used)
+
+    def update(self, state: CharacterState, ref: ReferencePose) -> None:
+        cfg = self.cfg
+        model = self.model
+        model.update(state)
+        m = self.mass.total_kg
+        touching = {s: sole_touches(state.link_origin_world[_FOOT_LINK[s]], state.link_quat_wxyz[_FOOT_LINK[s]], p,
+                                    cfg.sole_contact_gap_m) for s, p in state.feet_pressing().items()}
+        w = supporting_weights(ref.stance_weight, touching)
+        com, com_vel = model.com_world, model.com_vel_world
+
+        # Centroidal momentum rate: Eq. 16 (first line) horizontally; vertically the pelvis height of Eq. 9.
+        force = com_virtual_force(ref.com_world, ref.com_vel_world, com, com_vel, m, cfg.momentum_com_kp,
+                                  cfg.momentum_com_kd)
+        # The pelvis height above the supporting ankles as they are (a loaded sole sinks into the ground's spring
+        # by a centimetre or two; a target above the reach of straight legs could only be met by flailing).
+        support = [s for s, ws in w.items() if ws > 0]
+        ankle_z = (sum(float(state.link_origin_world[_FOOT_LINK[s], 2]) for s in support) / len(support) if support
+                   else ANKLE_HEIGHT_M)
+        pelvis_z_d = ref.pelvis_world[2] - ANKLE_HEIGHT_M + ankle_z
+        force[2] = m * (cfg.momentum_com_kp * (pelvis_z_d - state.root_pos_world[2])
+                        - cfg.momentum_com_kd * state.root_lin_vel_world[2])
+        f_lipm = np.zeros(3)
+        if cfg.lipm_time_sync and ref.lipm is not None:  # Eq. 21-23, bounded by Eq. 26
+            f_lipm = bounded_lipm_sync_force(ref.lipm, m, self.g, cfg.lipm_force_limit_n, cfg.enforce_bounds,
+                                             self.bounds, state.time_s)
+            force += f_lipm
+        corners = [sole_corners_world(state.link_origin_world[_FOOT_LINK[s]], state.link_quat_wxyz[_FOOT_LINK[s]])
+                   for s in support]
+        force = feasible_horizontal_force(force, com, corners, m, self.g)
+        e_root = root_orientation_error(ref.root_quat_wxyz, state.root_quat_wxyz)
+        moment = root_pd(e_root, state.root_ang_vel_world, cfg.momentum_root_kp, cfg.momentum_root_kd,
+                         cfg.root_yaw_gain_scale)
+        self.momentum.force_n, self.momentum.moment_nm = force, moment
+
+        # Joint posture: Eq. 13 per unit inertia, saturated (a jump of the reference, a stance change or a landing,
+        # would otherwise ask for accelerations whose torques exceed the joints' limits).
+        e = self._error_and_reference_velocity(state.joint_pos, ref)
+        qdd_joint = self.kp * e + self.kd * (self._ref_vel - state.joint_vel)
+        m_diag = model.mass_matrix.diagonal()
+        own = JOINT_ACCEL_TORQUE_SHARE * TORQUE_LIMIT / np.maximum(unflatten_joint_values(m_diag[ROOT_DOFS:]), 1e-6)
+        lim = np.maximum(cfg.joint_acceleration_limit_rad_s2, own)
+        self.posture.desired_accel = flatten_joint_values(np.minimum(np.maximum(qdd_joint, -lim), lim))
+
+        # Pelvis orientation, weighted by the pelvis's rotational inertia about world axes (as a joint's by M_ii).
+        r_base = model.data.oMi[1].rotation
+        m_rot_world = r_base @ model.mass_matrix[3:6, 3:6] @ r_base.T
+        self.pelvis.weight = cfg.joint_tracking_weight * np.maximum(m_rot_world.diagonal(), MIN_TRACKING_INERTIA_KGM2)
+        self.pelvis.target_quat_wxyz = ref.root_quat_wxyz
+
+        # A stance foot that does not touch yet is lowered onto the ground (a foot no force is planned for would
+        # otherwise be lifted by the other's reaction), and so is a swing foot the reference is held for.
+        swing = swing_side(ref.character_stance)
+        for s, task in self.foot_press.items():
+            ws = ref.stance_weight[s]
+            task.active = (ws > 0 and w[s] <= 0) or (ref.held and s == swing)
+            task.target_world = np.array([0.0, 0.0, ANKLE_HEIGHT_M - GROUND_PRESS_M])
+        for s, task in self.hands.items():
+            task.active = ref.hand_world is not None
+            if ref.hand_world is not None:
+                task.target_world = ref.hand_world[s]
+
+        contacts = []
+        for s in support:
+            c = self.contacts[s]
+            c.stance_weight = w[s]
+            contacts.append(c)
+        problem = self.formulation.build(model, contacts)
+        result = self.solver.solve(problem)
+        self.last_qp = result
+        if not result.solved:
+            self.qp_failures += 1
+        tau = unflatten_joint_values(self.formulation.torques(model, problem, result.x))
+        tau[~IS_BALL, 1:] = 0.0
+        self._tau = Torques(np.minimum(np.maximum(tau, -TORQUE_LIMIT), TORQUE_LIMIT))
+        self.telemetry = ControlTelemetry(force, f_lipm, moment)
+
+    def torques(self, fb: JointFeedback | None) -> Torques:
+        return self._tau
+
+    def reset(self) -> None:
+        self.solver.reset()
