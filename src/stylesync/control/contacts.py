@@ -100,6 +100,9 @@ class SoleContact:
         self.corners_world = np.zeros((4, 3))
         # Normal components of the 16 unit forces (the same at every corner): Σ_e n_e λ_e is the normal force.
         self.normal_row = np.tile(self.edges[:, 2], 4)
+        self._forces = np.tile(self.edges.T, 4)  # (3, 16): the unit forces, corner by corner, edge by edge
+        # The rows (4 edges x 3, 3) that give every edge's moment r × β_e from a lever r.
+        self._lever_to_moments = np.concatenate([np.cross(np.eye(3), b).T for b in self.edges])
 
     def update(self, model: CharacterModel) -> None:
         f = model.frame_id(self.frame)
@@ -110,9 +113,8 @@ class SoleContact:
         levers = SOLE_CORNERS_IN_SOLE @ r_world_sole.T  # (4, 3) corner - sole centre, world axes
         self.corners_world = model.frame_position(f) + levers
         # B = Σ_c J_cᵀ β_e = J_linᵀ β_e + J_angᵀ (r_c × β_e), corner by corner, edge by edge.
-        forces = np.tile(self.edges.T, 4)  # (3, 16)
-        moments = np.cross(np.repeat(levers, 4, axis=0), np.tile(self.edges, (4, 1))).T  # (3, 16)
-        self.generator = self.jacobian[:3].T @ forces + self.jacobian[3:].T @ moments
+        moments = (self._lever_to_moments @ levers.T).reshape(4, 3, 4).transpose(1, 2, 0).reshape(3, 16)
+        self.generator = self.jacobian[:3].T @ self._forces + self.jacobian[3:].T @ moments
 
     @property
     def regularisation(self) -> float:

@@ -91,6 +91,10 @@ class WholeBodyFormulation:
             if not task.active:
                 continue
             r = task.rows(model)
+            if r.jacobian is None:  # rows on single DOFs: a diagonal
+                h_mat[r.dofs, r.dofs] += r.weight
+                g[r.dofs] -= r.weight * r.target
+                continue
             wj = r.weight[:, None] * r.jacobian
             h_mat[:nv, :nv] += r.jacobian.T @ wj
             g[:nv] -= wj.T @ r.target
@@ -98,7 +102,7 @@ class WholeBodyFormulation:
         for i, c in enumerate(contacts):
             c.update(model)
             sl = slice(nv + FORCES_PER_SOLE * i, nv + FORCES_PER_SOLE * (i + 1))
-            h_mat[sl, sl] = c.regularisation * np.eye(FORCES_PER_SOLE)
+            h_mat[sl, sl].flat[::FORCES_PER_SOLE + 1] = c.regularisation
             gen[:, sl.start - nv:sl.stop - nv] = c.generator
         m, h = model.mass_matrix, model.bias_forces
         # Equalities: the root's equations of motion, then each sole's 6 acceleration rows.

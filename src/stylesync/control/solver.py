@@ -28,6 +28,7 @@ class ProxQpSolver:
         self.eps_abs = eps_abs
         self.max_iter = max_iter
         self._qps: dict[tuple[int, int, int], proxqp.dense.QP] = {}
+        self.iterations: list[int] = []
 
     def solve(self, p: QpProblem) -> QpResult:
         t0 = time.perf_counter()
@@ -47,6 +48,7 @@ class ProxQpSolver:
         qp.solve()
         res = qp.results
         solved = res.info.status == proxqp.QPSolverOutput.PROXQP_SOLVED
+        self.iterations.append(int(res.info.iter))
         return QpResult(res.x.copy(), int(res.info.iter), bool(solved), (time.perf_counter() - t0) * 1e3)
 
     def reset(self) -> None:

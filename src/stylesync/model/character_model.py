@@ -212,18 +212,26 @@ class CharacterModel:
         self.q, self.v = q, v[p]
         # Frame accelerations at q̈ = 0 are the drift terms J̇ q̇ of the tasks.
         pin.forwardKinematics(m, d, q, v, self._zero_a)
-        pin.computeJointJacobians(m, d, q)
+        pin.computeJointJacobians(m, d)  # from the placements just computed
         pin.updateFramePlacements(m, d)
         pin.crba(m, d, q, pin.Convention.WORLD)
         self.mass_matrix = d.M[self._perm_rows_cols]  # (nv, nv); crba fills M whole
         self.bias_forces = pin.nonLinearEffects(m, d, q, v)[p]  # (nv,) C(q, v) v + g(q) [N, N·m]
-        self.gravity_forces = pin.computeGeneralizedGravity(m, d, q)[p]  # (nv,) g(q)
-        self.com_world = pin.centerOfMass(m, d, q, v, False).copy()  # (3,) [m]
-        self.com_vel_world = d.vcom[0].copy()  # (3,) [m/s]
-        self.com_jacobian = pin.jacobianCenterOfMass(m, d, q, False)[:, p]  # (3, nv)
-        pin.computeCentroidalMapTimeVariation(m, d, q, v)
+        pin.computeCentroidalMapTimeVariation(m, d, q, v)  # also the COM and the centroidal momentum
         self.centroidal_map = d.Ag[:, p]  # (6, nv): [linear; angular about the COM] momentum
         self.centroidal_map_dot_v = d.dAg @ v  # (6,) Ȧ_g v
+        self.com_world = d.com[0].copy()  # (3,) [m]
+        self.com_vel_world = (d.Ag[:3] @ v) / self.total_mass_kg  # (3,) [m/s]
+
+    @property
+    def gravity_forces(self) -> np.ndarray:
+        """(nv,) generalised gravity g(q) at the last update [N, N·m]."""
+        return pin.computeGeneralizedGravity(self.model, self.data, self.q)[self._perm]
+
+    @property
+    def com_jacobian(self) -> np.ndarray:
+        """(3, nv) Jacobian of the COM at the last update."""
+        return pin.jacobianCenterOfMass(self.model, self.data, self.q, False)[:, self._perm]
 
     # ---- frames ------------------------------------------------------------------------------------------
     def frame_position(self, frame: int) -> np.ndarray:

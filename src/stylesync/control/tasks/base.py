@@ -17,11 +17,13 @@ from stylesync.model.character_model import CharacterModel
 
 @dataclass
 class TaskRows:
-    """One task's contribution at one tick: ``weight * (jacobian @ q̈ - target)²`` summed over rows."""
+    """One task's contribution at one tick: ``weight * (jacobian @ q̈ - target)²`` summed over rows. A task on
+    single DOFs gives ``dofs`` instead of a Jacobian (rows q̈[dofs] = target): a diagonal in the QP's Hessian."""
 
-    jacobian: np.ndarray  # (k, nv)
+    jacobian: np.ndarray | None  # (k, nv), or None with dofs
     target: np.ndarray  # (k,)
     weight: np.ndarray  # (k,) per-row weight (>= 0)
+    dofs: np.ndarray | None = None  # (k,) DOF indices when jacobian is None
 
 
 class Task(ABC):

@@ -21,10 +21,9 @@ class JointPostureTask(Task):
         self.weight = weight
         self.min_inertia_kgm2 = min_inertia_kgm2  # [kg·m²]
         self.desired_accel = np.zeros(N_DOFS - ROOT_DOFS)  # (n_joint_dofs,) [rad/s²], set per tick
-        self._jacobian = np.zeros((N_DOFS - ROOT_DOFS, N_DOFS))
-        self._jacobian[:, ROOT_DOFS:] = np.eye(N_DOFS - ROOT_DOFS)
+        self._dofs = np.arange(ROOT_DOFS, N_DOFS)
 
     def rows(self, model: CharacterModel) -> TaskRows:
         inertia = model.mass_matrix.diagonal()[ROOT_DOFS:]
-        return TaskRows(self._jacobian, self.desired_accel,
-                        self.weight * np.maximum(inertia, self.min_inertia_kgm2))
+        return TaskRows(None, self.desired_accel, self.weight * np.maximum(inertia, self.min_inertia_kgm2),
+                        dofs=self._dofs)
