@@ -8,8 +8,8 @@ from stylesync import rotations as rot
 from stylesync.config import WorldConfig
 from stylesync.control.crvc import stance_force_torques
 from stylesync.control.jacobian_transpose import JointFrames
-from stylesync.sim.factory import make_backend
 from stylesync.model.character import JOINTS, LINK_NAMES, JointKind, chain_to_root
+from stylesync.sim.factory import make_backend
 
 
 @pytest.fixture(scope="module")

@@ -5,13 +5,13 @@ from conftest import random_pose
 
 from stylesync import rotations as rot
 from stylesync.config import WorldConfig
-from stylesync.control.contact_forces import sole_corners_world
+from stylesync.control.contacts import sole_corners_world
 from stylesync.control.gravity_compensation import gravity_torques
 from stylesync.control.jacobian_transpose import JointFrames
 from stylesync.control.pid import joint_error
-from stylesync.sim.factory import make_backend
-from stylesync.model.state import Torques
 from stylesync.model.character import STANDING_ROOT_HEIGHT_M
+from stylesync.model.state import Torques
+from stylesync.sim.factory import make_backend
 
 
 def test_gravity_compensation_holds_root_fixed_character_5s():

@@ -18,23 +18,23 @@ import numpy as np
 
 from stylesync import rotations as rot
 from stylesync.config import SessionConfig
-from stylesync.motion.bounds import BoundsMonitor
 from stylesync.control.controller import BalanceController, ControllerBase
-from stylesync.control.whole_body import WholeBodyController
 from stylesync.control.pid import joint_error
+from stylesync.control.whole_body import WholeBodyController
 from stylesync.errors import SourceError
-from stylesync.model.character_model import CharacterModel
 from stylesync.metrics.imitation import CHARACTER_LINKS, OPERATOR_JOINTS
+from stylesync.model.character import LINK_NAMES, STANDING_ROOT_HEIGHT_M
+from stylesync.model.character_model import CharacterModel
+from stylesync.model.state import CharacterState
+from stylesync.motion.bounds import BoundsMonitor
 from stylesync.motion.pose_optimization import MotionOptimizer
 from stylesync.motion.stance_fsm import Stance
 from stylesync.motion.style_features import ROW_NAMES as _FEATURES
 from stylesync.motion.style_features import style_rows
 from stylesync.prefetch import OperatorInline, OperatorPrefetch
 from stylesync.processing.operator_processing import OperatorProcessing, OperatorSample
-from stylesync.sim.factory import make_backend
 from stylesync.sim.backend import PhysicsBackend
-from stylesync.model.state import CharacterState
-from stylesync.model.character import LINK_NAMES, STANDING_ROOT_HEIGHT_M
+from stylesync.sim.factory import make_backend
 from stylesync.sources.base import OperatorSource
 
 log = logging.getLogger("stylesync.session")

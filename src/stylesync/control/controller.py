@@ -17,7 +17,6 @@ import numpy as np
 
 from stylesync import rotations as rot
 from stylesync.config import ControlConfig
-from stylesync.motion import bounds as bnd
 from stylesync.control.crvc import (
     HIP_JOINT,
     com_virtual_force,
@@ -37,11 +36,12 @@ from stylesync.control.stable_pd import (
     unflatten_joint_values,
 )
 from stylesync.control.support import limit_ankle_moment
-from stylesync.motion.reference import ReferencePose
-from stylesync.motion.stance_fsm import Stance
+from stylesync.model.character import JOINT_DOF_START, JOINTS, N_DOFS, Q_WORLD_MODEL, ROOT_DOFS
 from stylesync.model.character_model import CharacterModel
 from stylesync.model.state import CharacterState, JointFeedback, MassProperties, Torques
-from stylesync.model.character import JOINT_DOF_START, JOINTS, N_DOFS, Q_WORLD_MODEL, ROOT_DOFS
+from stylesync.motion import bounds as bnd
+from stylesync.motion.reference import ReferencePose
+from stylesync.motion.stance_fsm import Stance
 
 TORQUE_LIMIT = np.array([j.torque_limit_nm for j in JOINTS])[:, None]
 PELVIS_CHILDREN = tuple(k for k, j in enumerate(JOINTS) if j.parent == "root")  # chest and both hips

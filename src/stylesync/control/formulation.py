@@ -16,6 +16,7 @@ and the torques follow from the joint rows of the equations of motion, ``τ = M_
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TypeVar
 
 import numpy as np
 
@@ -25,11 +26,12 @@ from stylesync.model.character import JOINT_DOF_START, JOINTS, N_DOFS, ROOT_DOFS
 from stylesync.model.character_model import CharacterModel
 
 INFINITY = 1e20  # ProxQP's unbounded side
+T = TypeVar("T", bound=Task)
 
 
 @dataclass
 class QpProblem:
-    """``min ½ xᵀ H x + gᵀ x  s.t.  A x = b,  l <= C x <= u,  l_box <= x <= u_box``."""
+    """``min ½ xᵀ H x + gᵀ x  s.t.  A x = b,  l <= C x <= u``."""
 
     H: np.ndarray
     g: np.ndarray
@@ -38,8 +40,6 @@ class QpProblem:
     C: np.ndarray
     l: np.ndarray
     u: np.ndarray
-    l_box: np.ndarray
-    u_box: np.ndarray
     n_forces: int
 
 
@@ -71,7 +71,7 @@ class WholeBodyFormulation:
         self.contact_velocity_gain = contact_velocity_gain  # [1/s]
         self.limit_horizon_s = limit_horizon_s  # [s]
 
-    def add_task(self, task: Task) -> Task:
+    def add_task(self, task: T) -> T:
         self.tasks.append(task)
         return task
 
@@ -115,27 +115,32 @@ class WholeBodyFormulation:
             jac, acc = c.constraint_rows(self.contact_velocity_gain)
             a_eq[ROOT_DOFS + 6 * i:ROOT_DOFS + 6 * (i + 1), :nv] = jac
             b_eq[ROOT_DOFS + 6 * i:ROOT_DOFS + 6 * (i + 1)] = acc
-        # Inequalities: joint torques, then each sole's normal force.
+        # Inequalities: joint torques, each sole's normal force, the pyramids' λ >= 0, the hinges' limits.
         n_tau = nv - ROOT_DOFS
-        c_in = np.zeros((n_tau + len(contacts), n))
+        n_in = n_tau + len(contacts) + n_f + len(self.limits)
+        c_in = np.zeros((n_in, n))
+        lower = np.empty(n_in)
+        upper = np.empty(n_in)
         c_in[:n_tau, :nv] = m[ROOT_DOFS:]
         c_in[:n_tau, nv:] = -gen[ROOT_DOFS:]
-        lower = np.empty(len(c_in))
-        upper = np.empty(len(c_in))
         lower[:n_tau] = -self.torque_limit_nm - h[ROOT_DOFS:]
         upper[:n_tau] = self.torque_limit_nm - h[ROOT_DOFS:]
+        row = n_tau
         for i, c in enumerate(contacts):
-            c_in[n_tau + i, nv + FORCES_PER_SOLE * i:nv + FORCES_PER_SOLE * (i + 1)] = c.normal_row
-            lower[n_tau + i], upper[n_tau + i] = 0.0, c.max_normal_force_n
-        l_box = np.full(n, -INFINITY)
-        u_box = np.full(n, INFINITY)
-        l_box[nv:] = 0.0
+            c_in[row, nv + FORCES_PER_SOLE * i:nv + FORCES_PER_SOLE * (i + 1)] = c.normal_row
+            lower[row], upper[row] = 0.0, c.max_normal_force_n
+            row += 1
+        c_in[row:row + n_f, nv:].flat[::n_f + 1] = 1.0
+        lower[row:row + n_f], upper[row:row + n_f] = 0.0, INFINITY
+        row += n_f
         t = self.limit_horizon_s
         for lim in self.limits:  # q + q̇ T + ½ q̈ T² within the limits
             q, qd = model.joint_position(lim.dof), model.v[lim.dof]
-            l_box[lim.dof] = min(2.0 * (lim.lower_rad - q - qd * t) / (t * t), 0.0)
-            u_box[lim.dof] = max(2.0 * (lim.upper_rad - q - qd * t) / (t * t), 0.0)
-        return QpProblem(h_mat, g, a_eq, b_eq, c_in, lower, upper, l_box, u_box, n_f)
+            c_in[row, lim.dof] = 1.0
+            lower[row] = min(2.0 * (lim.lower_rad - q - qd * t) / (t * t), 0.0)
+            upper[row] = max(2.0 * (lim.upper_rad - q - qd * t) / (t * t), 0.0)
+            row += 1
+        return QpProblem(h_mat, g, a_eq, b_eq, c_in, lower, upper, n_f)
 
     @staticmethod
     def torques(model: CharacterModel, problem: QpProblem, x: np.ndarray) -> np.ndarray:

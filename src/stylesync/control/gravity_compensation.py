@@ -15,8 +15,8 @@ import numpy as np
 from stylesync import rotations as rot
 from stylesync.control.jacobian_transpose import JointFrames
 from stylesync.control.support import support_point
-from stylesync.model.state import CharacterState
 from stylesync.model.character import JOINTS, LINK_NAMES, subtree_links
+from stylesync.model.state import CharacterState
 
 _UP = np.array([0.0, 0.0, 1.0])
 

@@ -11,8 +11,8 @@ from __future__ import annotations
 import numpy as np
 
 from stylesync import rotations as rot
-from stylesync.model.state import CharacterState
 from stylesync.model.character import JOINTS, LINK_NAMES, Q_WORLD_MODEL, JointKind
+from stylesync.model.state import CharacterState
 
 _R_WORLD_MODEL = rot.matrix_from_quat(Q_WORLD_MODEL)
 _CHILD_LINK = np.array([LINK_NAMES.index(j.name) for j in JOINTS])

@@ -15,11 +15,11 @@ from __future__ import annotations
 import numpy as np
 
 from stylesync import rotations as rot
-from stylesync.motion.bounds import BoundsMonitor, lipm_force_bound_n
 from stylesync.control.gravity_compensation import ANKLE_JOINT
 from stylesync.control.support import support_point
-from stylesync.motion.reference import LipmMap
 from stylesync.model.character import JOINTS
+from stylesync.motion.bounds import BoundsMonitor, lipm_force_bound_n
+from stylesync.motion.reference import LipmMap
 
 
 def ipm_ankle_moments(com_desired: np.ndarray, ankle_pos: dict[str, np.ndarray], stance_weight: dict[str, float],

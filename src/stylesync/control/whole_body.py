@@ -1,7 +1,7 @@
 """The balance and synchronisation controller (Sec. 6) as whole-body control: tasks, contacts, one QP per tick.
 
 The same parts as the paper's controller (controller.py), composed as tasks of one quadratic programme
-(formulation.py, solved by ProxQP in solver.py):
+(formulation.py, solved by DAQP in solver.py):
 
 * joint posture (Eq. 13 per DOF as a desired acceleration, ``q̈* = ω² e + 2 ζ ω ė``): the retargeted operator pose;
 * pelvis orientation (the root virtual torque's PD law, per unit inertia);
@@ -31,7 +31,7 @@ from stylesync.control.crvc import com_virtual_force, root_orientation_error, ro
 from stylesync.control.formulation import WholeBodyFormulation, hinge_limits
 from stylesync.control.model_compensation import bounded_lipm_sync_force
 from stylesync.control.pid import IS_BALL
-from stylesync.control.solver import ProxQpSolver
+from stylesync.control.solver import DaqpSolver, QpResult
 from stylesync.control.stable_pd import flatten_joint_values, unflatten_joint_values
 from stylesync.control.tasks import CentroidalMomentumTask, FrameOrientationTask, FramePositionTask, JointPostureTask
 from stylesync.model.character import ANKLE_HEIGHT_M, LINK_NAMES, Q_WORLD_MODEL, ROOT_DOFS, SIDES
@@ -82,8 +82,8 @@ class WholeBodyController(ControllerBase):
                                                        cfg.hand_task_kd, cfg.hand_task_weight)) for s in SIDES}
                       if cfg.hand_tasks else {})
         self.contacts = {s: SoleContact(s, friction, mass.total_kg * gravity_mps2) for s in SIDES}
-        self.solver = ProxQpSolver()
-        self.last_qp = None  # the last tick's QpResult (iterations, time)
+        self.solver = DaqpSolver()
+        self.last_qp: QpResult | None = None  # the last tick's solution (iterations, time)
         self.qp_failures = 0  # ticks whose QP did not reach its tolerance (the best iterate was used)
 
     def update(self, state: CharacterState, ref: ReferencePose) -> None:

@@ -26,8 +26,8 @@ from stylesync import rotations as rot  # noqa: E402
 from stylesync.config import OperatorConfig, SessionConfig  # noqa: E402
 from stylesync.experiments.common import run_session  # noqa: E402
 from stylesync.metrics.plots import plan_view, save_figure  # noqa: E402
-from stylesync.session import Session  # noqa: E402
 from stylesync.model.character import SHANK_LENGTH_M, THIGH_LENGTH_M  # noqa: E402
+from stylesync.session import Session  # noqa: E402
 from stylesync.sources.builtin_operator import builtin_operator  # noqa: E402
 from stylesync.sources.deepmimic_clip import DeepMimicClip  # noqa: E402
 from stylesync.sources.frame import JOINT_INDEX  # noqa: E402

@@ -28,10 +28,11 @@ from stylesync.control.gravity_compensation import gravity_torques
 from stylesync.control.jacobian_transpose import JointFrames
 from stylesync.control.pid import IS_BALL, JointPid, joint_error
 from stylesync.control.stable_pd import flatten_joint_values, implicit_gain, joint_damping, unflatten_joint_values
+from stylesync.model.character import JOINT_NAMES, JOINTS, N_JOINT_DOFS, ROOT_DOFS, model_quat_from_canonical
+from stylesync.model.character_model import CharacterModel
+from stylesync.model.state import Torques
 from stylesync.processing.joint_map import hinge_angle
 from stylesync.sim.factory import make_backend
-from stylesync.model.state import Torques
-from stylesync.model.character import JOINT_NAMES, JOINTS, N_JOINT_DOFS, ROOT_DOFS, model_quat_from_canonical
 from stylesync.sources.deepmimic_clip import DeepMimicClip
 
 GROUPS = ("chest", "neck", "hip", "knee", "ankle", "shoulder", "elbow")
@@ -105,13 +106,16 @@ def ramp_error(group: str, gains: PidGains, slope: float, height: float, axis: n
     else:
         vel_axis = np.array([axis[0], 0.0, 0.0])
     ff = np.zeros((len(JOINTS), 3))
+    model = CharacterModel(backend.body_description(), 9.8)
     for i in range(n):
         t = i * dt
         target[k] = _target(group, min(slope * t, height), axis)
         ref_vel[k] = vel_axis * slope if t < ramp_s else 0.0
         if i % GAIN_UPDATE_EVERY == 0:
-            g = implicit_gain(backend.joint_space_inertia(), d)[ROOT_DOFS:, ROOT_DOFS:]
             s = backend.read_state(t)
+            model.update(s)
+            joints = slice(ROOT_DOFS, None)  # the root is welded: the joints' block of M
+            g = implicit_gain(model.mass_matrix[joints, joints], d[joints, joints])
             ff = gravity_torques(s, JointFrames(s), mass.link_mass_kg, 9.8, {"left": 0.0, "right": 0.0}, {})
         fb = backend.read_joint_feedback()
         e = joint_error(fb.joint_pos, target)[k]

@@ -11,8 +11,8 @@ from stylesync.config import WorldConfig
 from stylesync.export.bvh_export import write_bvh
 from stylesync.export.session_file import SessionFile
 from stylesync.export.video import write_mp4
-from stylesync.sim.factory import make_backend
 from stylesync.model.character import STANDING_ROOT_HEIGHT_M
+from stylesync.sim.factory import make_backend
 
 
 def rest_link_origins() -> np.ndarray:

@@ -28,8 +28,8 @@ from typing import IO, Any, NamedTuple
 import numpy as np
 
 from stylesync.errors import SourceError
-from stylesync.processing.joint_map import TRACKED_POSITIONS
 from stylesync.model.character import JOINTS, LINK_NAMES
+from stylesync.processing.joint_map import TRACKED_POSITIONS
 
 FORMAT = "stylesync-session"
 VERSION = 1

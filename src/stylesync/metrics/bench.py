@@ -30,9 +30,9 @@ import numpy as np
 
 from stylesync.config import ControlConfig, MotionConfig, OperatorConfig, SessionConfig
 from stylesync.metrics.summary import summarize
+from stylesync.model.state import Torques
 from stylesync.session import Session
 from stylesync.sim.factory import make_backend
-from stylesync.model.state import Torques
 from stylesync.sources.deepmimic_clip import builtin_clip_names
 from stylesync.sources.registry import open_source
 

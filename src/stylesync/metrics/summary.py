@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from stylesync.metrics import imitation as im
+from stylesync.model.state import CONTACT_FORCE_N
 from stylesync.motion.stance_fsm import Stance
 from stylesync.session import STANCE_CODE, SessionResult
-from stylesync.model.state import CONTACT_FORCE_N
 
 _DS = STANCE_CODE[Stance.DS]
 

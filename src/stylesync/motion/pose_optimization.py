@@ -23,8 +23,21 @@ import numpy as np
 
 from stylesync import rotations as rot
 from stylesync.config import MotionConfig
-from stylesync.motion.bounds import BoundsMonitor, step_length_bound_m
+from stylesync.model.character import (
+    ANKLE_HEIGHT_M,
+    HIP_HALF_WIDTH_M,
+    JOINT_NAMES,
+    JOINTS,
+    LINK_NAMES,
+    SHANK_LENGTH_M,
+    THIGH_LENGTH_M,
+    JointKind,
+    batch_model_quat_from_canonical,
+    canonical_quat_from_model,
+)
+from stylesync.model.state import CharacterState, MassProperties
 from stylesync.motion.balance_strategy import level_root, stance_hip_blend, swing_hip_feedback
+from stylesync.motion.bounds import BoundsMonitor, step_length_bound_m
 from stylesync.motion.leg_ik import solve_leg
 from stylesync.motion.reference import LipmMap, ReferencePose
 from stylesync.motion.stance_fsm import (
@@ -39,19 +52,6 @@ from stylesync.processing.body_parameters import leg_length_m
 from stylesync.processing.interpolation import smooth_step
 from stylesync.processing.joint_map import hinge_angle, local_rotations
 from stylesync.processing.operator_processing import OperatorSample
-from stylesync.model.state import CharacterState, MassProperties
-from stylesync.model.character import (
-    ANKLE_HEIGHT_M,
-    HIP_HALF_WIDTH_M,
-    JOINT_NAMES,
-    JOINTS,
-    LINK_NAMES,
-    SHANK_LENGTH_M,
-    THIGH_LENGTH_M,
-    JointKind,
-    batch_model_quat_from_canonical,
-    canonical_quat_from_model,
-)
 
 _MIN_AXIS_SPREAD_M = 0.08
 _UP = np.array([0.0, 0.0, 1.0])

@@ -42,11 +42,6 @@ class PhysicsBackend(ABC):
         """Torques act during the next :meth:`step` only."""
 
     @abstractmethod
-    def joint_space_inertia(self) -> np.ndarray:
-        """Mass matrix M(q) of the floating character at the current state, (ROOT_DOFS + N_JOINT_DOFS) squared,
-        in the layout of ``sim.character`` (root linear and angular velocity, then the joint DOFs) [kg, kg·m^2]."""
-
-    @abstractmethod
     def step(self) -> None: ...
 
     @abstractmethod

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from stylesync import rotations as rot
-from stylesync.sim.backend import PhysicsBackend
-from stylesync.model.state import CharacterState
 from stylesync.model.character import LINK_NAMES
+from stylesync.model.state import CharacterState
+from stylesync.sim.backend import PhysicsBackend
 
 BALL_START_M = 1.5  # a pushed ball starts this far in front of the chest [m]
 BALL_SPEED_MPS = 7.0  # a pushed ball's speed [m/s]

@@ -22,21 +22,18 @@ from stylesync import rotations as rot
 from stylesync.config import WorldConfig
 from stylesync.errors import SimulationError
 from stylesync.model.body_description import BodyDescription, BodyJointKind, LinkDescription
-from stylesync.sim.backend import PhysicsBackend
-from stylesync.model.state import CharacterState, JointFeedback, LinkShape, MassProperties, Torques
 from stylesync.model.character import (
     FOOT_LINKS,
-    JOINT_DOF_COUNT,
-    JOINT_DOF_START,
     JOINT_NAMES,
     JOINTS,
     LINK_NAMES,
     Q_WORLD_MODEL,
-    ROOT_DOFS,
     URDF_GLOBAL_SCALING,
     URDF_PATH_IN_PYBULLET_DATA,
     JointKind,
 )
+from stylesync.model.state import CharacterState, JointFeedback, LinkShape, MassProperties, Torques
+from stylesync.sim.backend import PhysicsBackend
 
 _Q_MODEL_WORLD = rot.conjugate(Q_WORLD_MODEL)
 SOCCER_BALL_URDF = "soccerball.urdf"
@@ -144,23 +141,6 @@ class PyBulletBackend(PhysicsBackend):
         self.balls: list[int] = []
         self._all_joints = list(range(c.getNumJoints(self.body)))
         self._raw: tuple | None = None  # the engine's state as last read, until the next step or reset
-        self._dof_map = self._pybullet_dof_map()
-        self._dof_rows_cols = np.ix_(self._dof_map, self._dof_map)
-
-    def _pybullet_dof_map(self) -> np.ndarray:
-        """Indices into PyBullet's padded generalised velocity (flags=1: root 6 + 1 pad, ball joints 3 + 1 pad,
-        hinges 1, fixed 0) of our layout's DOFs (root 6, then JOINTS order)."""
-        c = self._pb
-        start, offset = {}, 7
-        for j in range(c.getNumJoints(self.body)):
-            start[j] = offset
-            kind = c.getJointInfo(self.body, j)[2]
-            offset += {pb.JOINT_SPHERICAL: 4, pb.JOINT_REVOLUTE: 1, pb.JOINT_PRISMATIC: 1}.get(kind, 0)
-        out = list(range(ROOT_DOFS))
-        for k, j in enumerate(self._joint_idx):
-            out += [start[j] + a for a in range(JOINT_DOF_COUNT[k])]
-        assert len(out) == ROOT_DOFS + JOINT_DOF_START[-1] + JOINT_DOF_COUNT[-1]
-        return np.array(out)
 
     # ------------------------------------------------------------------------------------------------------
     def reset(self, root_pos_world, root_quat_wxyz, joint_pos=None) -> None:
@@ -294,16 +274,6 @@ class PyBulletBackend(PhysicsBackend):
             forces = [rows[k] if self._is_ball[k] else [rows[k][0]] for k in range(len(self._joint_idx))]
             self._last_torque_values, self._last_forces = v, forces
         self._pb.setJointMotorControlMultiDofArray(self.body, self._joint_idx, pb.TORQUE_CONTROL, forces=forces)
-
-    def joint_space_inertia(self) -> np.ndarray:
-        pos, orn, _, _, states = self._read_raw()
-        q = [*pos, *orn]
-        for js in states:
-            q += js[0]
-        rows = self._pb.calculateMassMatrix(self.body, q, flags=1)
-        n = len(rows)
-        m = np.fromiter(itertools.chain.from_iterable(rows), float, n * n).reshape(n, n)  # faster than asarray
-        return m[self._dof_rows_cols]
 
     def step(self) -> None:
         self._raw = None

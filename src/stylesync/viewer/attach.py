@@ -17,8 +17,8 @@ import numpy as np
 from stylesync.config import VIEWER_DRAW_HZ, WorldConfig
 from stylesync.errors import SimulationError
 from stylesync.motion.stance_fsm import Stance
-from stylesync.sim.factory import make_backend
 from stylesync.sim.disturbance import throw_ball_at_chest
+from stylesync.sim.factory import make_backend
 from stylesync.viewer.snapshot import Snapshot, snapshot_from_state
 
 log = logging.getLogger("stylesync.viewer")

@@ -12,11 +12,11 @@ import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
 from stylesync import rotations as rot
+from stylesync.model.character import LINK_NAMES, SHANK_LENGTH_M, THIGH_LENGTH_M
+from stylesync.model.state import CharacterState, LinkShape
 from stylesync.motion.bounds import ds_com_bound_m, step_length_bound_m
 from stylesync.motion.stance_fsm import Stance
 from stylesync.processing.joint_map import TRACKED_POSITIONS
-from stylesync.model.state import CharacterState, LinkShape
-from stylesync.model.character import LINK_NAMES, SHANK_LENGTH_M, THIGH_LENGTH_M
 
 FOOT_SOLE_HALF_EXTENTS_M = (0.0885, 0.045)  # half length and half width of the foot box (collision shape) [m]
 FOOT_CENTRE_AHEAD_M = 0.045  # the foot box centre lies this far ahead of the ankle joint [m]

@@ -21,8 +21,8 @@ import numpy as np
 
 from stylesync import rotations as rot
 from stylesync.errors import ConfigError
-from stylesync.motion.stance_fsm import Stance
 from stylesync.model.state import LinkShape
+from stylesync.motion.stance_fsm import Stance
 from stylesync.viewer.snapshot import (
     OPERATOR_BONES,
     Snapshot,
