@@ -1,0 +1,144 @@
+"""The whole-body controller's parts: sole contacts (generator against finite differences), the formulation (its
+solutions obey the equations of motion, the contacts and the limits), the solver (warm start = cold start), tasks
+added by one line (a hand-position task switched on by a flag)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from stylesync import rotations as rot
+from stylesync.config import ControlConfig, OperatorConfig, SessionConfig, WorldConfig
+from stylesync.control.contacts import FORCES_PER_SOLE, SoleContact
+from stylesync.control.formulation import WholeBodyFormulation
+from stylesync.control.solver import DaqpSolver
+from stylesync.control.tasks import JointPostureTask, Task, TaskRows
+from stylesync.control.whole_body import _TORQUE_LIMIT_FLAT
+from stylesync.model.character import N_DOFS, ROOT_DOFS, STANDING_ROOT_HEIGHT_M
+from stylesync.model.character_model import CharacterModel
+from stylesync.session import Session
+from stylesync.sim.pybullet_backend import PyBulletBackend
+from stylesync.sources.builtin_operator import builtin_operator
+
+
+@pytest.fixture(scope="module")
+def standing():
+    backend = PyBulletBackend(WorldConfig(), 600.0)
+    backend.reset(np.array([0.0, 0.0, STANDING_ROOT_HEIGHT_M]), rot.IDENTITY_WXYZ)
+    for _ in range(300):
+        backend.step()
+    model = CharacterModel(backend.body_description(), 9.8)
+    model.update(backend.read_state(0.5))
+    yield backend, model
+    backend.close()
+
+
+def test_contact_generator_is_the_corner_forces_power(standing):
+    """(Bᵀ v)_{c,e} = β_e · v_c: the generator maps each unit pyramid force to the generalised force whose power
+    at velocity v is that of the force at its corner (corner velocities by finite differences on the manifold)."""
+    _, model = standing
+    contact = SoleContact("left", 0.9, 45.0 * 9.8)
+    contact.update(model)
+    rng = np.random.default_rng(0)
+    v = rng.normal(size=N_DOFS)
+    corners0 = contact.corners_world.copy()
+    q0 = model.q.copy()
+    eps = 1e-7
+    v_pin = np.zeros(N_DOFS)
+    v_pin[model._perm] = v  # the character's layout -> Pinocchio's
+    model.update_qv(pin.integrate(model.model, q0, v_pin * eps), np.zeros(N_DOFS))
+    moved = SoleContact("left", 0.9, 45.0 * 9.8)
+    moved.update(model)
+    corner_vel = (moved.corners_world - corners0) / eps  # (4, 3)
+    expected = np.array([e @ corner_vel[c] for c in range(4) for e in contact.edges])
+    np.testing.assert_allclose(contact.generator.T @ v, expected, atol=1e-5)
+    model.update_qv(q0, np.zeros(N_DOFS))
+
+
+def _standing_problem(model):
+    formulation = WholeBodyFormulation(_TORQUE_LIMIT_FLAT, (), 10.0, 0.05)
+    posture = formulation.add_task(JointPostureTask(10.0, 0.05))
+    posture.desired_accel = np.zeros(N_DOFS - ROOT_DOFS)
+    contacts = [SoleContact(s, 0.9, 45.0 * 9.8) for s in ("left", "right")]
+    return formulation, contacts
+
+
+def test_solution_obeys_the_equations_of_motion_contacts_and_limits(standing):
+    _, model = standing
+    formulation, contacts = _standing_problem(model)
+    problem = formulation.build(model, contacts)
+    result = DaqpSolver().solve(problem)
+    assert result.solved
+    qdd, lam = result.x[:N_DOFS], result.x[N_DOFS:]
+    assert lam.shape == (2 * FORCES_PER_SOLE,)
+    assert lam.min() >= -1e-9  # inside the friction pyramids
+    gen = np.hstack([c.generator for c in contacts])
+    tau = formulation.torques(model, problem, result.x)
+    residual = model.mass_matrix @ qdd + model.bias_forces - gen @ lam
+    np.testing.assert_allclose(residual[:ROOT_DOFS], 0.0, atol=1e-6)  # the root is not actuated
+    np.testing.assert_allclose(residual[ROOT_DOFS:], tau, atol=1e-6)  # the joints' torques
+    assert np.all(np.abs(tau) <= _TORQUE_LIMIT_FLAT + 1e-6)
+    for c in contacts:  # the soles do not accelerate (beyond the damping of their residual velocity)
+        jac, acc = c.constraint_rows(10.0)
+        np.testing.assert_allclose(jac @ qdd, acc, atol=1e-6)
+    normal = sum(float(c.normal_row @ lam[16 * i:16 * (i + 1)]) for i, c in enumerate(contacts))
+    assert normal == pytest.approx(model.total_mass_kg * 9.8, rel=0.05)  # standing: the feet carry the body
+
+
+def test_warm_start_reaches_the_cold_solution(standing):
+    _, model = standing
+    formulation, contacts = _standing_problem(model)
+    problem = formulation.build(model, contacts)
+    solver = DaqpSolver()
+    cold = solver.solve(problem)
+    formulation.task("posture").desired_accel = np.full(N_DOFS - ROOT_DOFS, 0.5)  # type: ignore[attr-defined]
+    problem2 = formulation.build(model, contacts)
+    warm = solver.solve(problem2)
+    fresh = DaqpSolver().solve(problem2)
+    assert cold.solved and warm.solved and fresh.solved
+    np.testing.assert_allclose(warm.x, fresh.x, atol=1e-6)
+
+
+def test_a_task_is_a_class_and_one_line(standing):
+    """A task defined here, added with one line, changes the solution toward what it asks."""
+    _, model = standing
+
+    class LeanChest(Task):
+        name = "lean_chest"
+
+        def rows(self, m: CharacterModel) -> TaskRows:
+            j = np.zeros((1, N_DOFS))
+            j[0, ROOT_DOFS + 2] = 1.0  # the chest's third DOF
+            return TaskRows(j, np.array([3.0]), np.array([100.0]))
+
+    formulation, contacts = _standing_problem(model)
+    before = DaqpSolver().solve(formulation.build(model, contacts)).x[ROOT_DOFS + 2]
+    formulation.add_task(LeanChest())
+    after = DaqpSolver().solve(formulation.build(model, contacts)).x[ROOT_DOFS + 2]
+    assert abs(after - 3.0) < abs(before - 3.0)
+    assert after == pytest.approx(3.0, abs=0.5)
+
+
+def _hand_error(hand_tasks: bool) -> tuple[float, bool]:
+    cfg = SessionConfig(duration_s=4.0, operator=OperatorConfig(clip="walk"),
+                        control=ControlConfig(hand_tasks=hand_tasks))
+    source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
+    session = Session(cfg, source)
+    errors: list[float] = []
+
+    def tick(state, ref):
+        if ref.hand_world is not None and state.time_s > 1.0:
+            f = session.model.frame_id("left_wrist")
+            errors.append(float(np.linalg.norm(session.model.frame_position(f) - ref.hand_world["left"])))
+
+    session.on_tick = tick
+    result = session.run()
+    return float(np.mean(errors)), result.fell
+
+
+def test_hand_tasks_bring_the_hands_to_the_operators():
+    with_tasks, fell = _hand_error(True)
+    without, _ = _hand_error(False)
+    assert not fell
+    assert with_tasks < 0.8 * without, (with_tasks, without)
