@@ -14,7 +14,7 @@ from stylesync.control.contacts import FORCES_PER_SOLE, SoleContact
 from stylesync.control.formulation import WholeBodyFormulation
 from stylesync.control.solver import DaqpSolver
 from stylesync.control.tasks import JointPostureTask, Task, TaskRows
-from stylesync.control.whole_body import _TORQUE_LIMIT_FLAT
+from stylesync.control.whole_body import _TORQUE_LIMIT_FLAT, HAND_REACH_SHARE
 from stylesync.model.character import N_DOFS, ROOT_DOFS, STANDING_ROOT_HEIGHT_M
 from stylesync.model.character_model import CharacterModel
 from stylesync.session import Session
@@ -121,16 +121,23 @@ def test_a_task_is_a_class_and_one_line(standing):
 
 
 def _hand_error(hand_tasks: bool) -> tuple[float, bool]:
-    cfg = SessionConfig(duration_s=4.0, operator=OperatorConfig(clip="walk"),
+    """Mean distance of the left wrist to the hand target (the operator's wrist around his pelvis, scaled, within
+    the arm's reach: what the hand task asks), over a punch."""
+    cfg = SessionConfig(duration_s=2.5, operator=OperatorConfig(clip="punch"),
                         control=ControlConfig(hand_tasks=hand_tasks))
     source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
     session = Session(cfg, source)
+    model = session.model
+    reach = HAND_REACH_SHARE * (model.rest_distance("left_shoulder", "left_elbow")
+                                + model.rest_distance("left_elbow", "left_wrist"))
     errors: list[float] = []
 
     def tick(state, ref):
         if ref.hand_world is not None and state.time_s > 1.0:
-            f = session.model.frame_id("left_wrist")
-            errors.append(float(np.linalg.norm(session.model.frame_position(f) - ref.hand_world["left"])))
+            shoulder = model.frame_position(model.frame_id("left_shoulder"))
+            offset = ref.hand_world["left"] - shoulder
+            target = shoulder + offset * min(1.0, reach / float(np.linalg.norm(offset)))
+            errors.append(float(np.linalg.norm(model.frame_position(model.frame_id("left_wrist")) - target)))
 
     session.on_tick = tick
     result = session.run()
@@ -141,4 +148,4 @@ def test_hand_tasks_bring_the_hands_to_the_operators():
     with_tasks, fell = _hand_error(True)
     without, _ = _hand_error(False)
     assert not fell
-    assert with_tasks < 0.8 * without, (with_tasks, without)
+    assert with_tasks < 0.7 * without, (with_tasks, without)

@@ -191,7 +191,7 @@ class ControlConfig:
     hand_tasks: bool = False
     hand_task_kp: float = 100.0
     hand_task_kd: float = 20.0
-    hand_task_weight: float = 10.0
+    hand_task_weight: float = 100.0
     gravity_compensation: bool = True  # Eq. 14-15
     com_virtual_force: bool = True  # Eq. 16-17
     root_virtual_torque: bool = True  # Eq. 16, 18

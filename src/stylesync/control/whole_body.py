@@ -55,6 +55,8 @@ JOINT_ACCEL_TORQUE_SHARE = 0.1
 MIN_TRACKING_INERTIA_KGM2 = 0.05
 # The hinges' limits are kept over this horizon: q + q̇ T + ½ q̈ T² stays within them [s].
 JOINT_LIMIT_HORIZON_S = 0.05
+# A hand target is kept within this share of the arm's length from its shoulder (a straight arm reaches it).
+HAND_REACH_SHARE = 1.0
 _TORQUE_LIMIT_FLAT = flatten_joint_values(np.repeat(TORQUE_LIMIT, 3, axis=1))
 
 
@@ -81,6 +83,9 @@ class WholeBodyController(ControllerBase):
         self.hands = ({s: f.add_task(FramePositionTask(f"{s}_hand", HAND_FRAMES[s], cfg.hand_task_kp,
                                                        cfg.hand_task_kd, cfg.hand_task_weight)) for s in SIDES}
                       if cfg.hand_tasks else {})
+        self._arm_length_m = model.rest_distance("left_shoulder", "left_elbow") + model.rest_distance(
+            "left_elbow", "left_wrist")
+        self._hand_target: dict[str, np.ndarray] = {}  # the last tick's hand targets [m]
         self.contacts = {s: SoleContact(s, friction, mass.total_kg * gravity_mps2) for s in SIDES}
         self.solver = DaqpSolver()
         self.last_qp: QpResult | None = None  # the last tick's solution (iterations, time)
@@ -145,7 +150,17 @@ class WholeBodyController(ControllerBase):
         for s, task in self.hands.items():
             task.active = ref.hand_world is not None
             if ref.hand_world is not None:
-                task.target_world = ref.hand_world[s]
+                # Within the character's reach from its shoulder (the operator's arms, scaled by his legs, may
+                # reach further); the target's velocity from successive ticks.
+                shoulder = model.frame_position(model.frame_id(f"{s}_shoulder"))
+                offset = ref.hand_world[s] - shoulder
+                dist = float(np.linalg.norm(offset))
+                reach = HAND_REACH_SHARE * self._arm_length_m
+                target = shoulder + offset * min(1.0, reach / max(dist, 1e-9))
+                previous = self._hand_target.get(s)
+                task.target_vel_world = ((target - previous) / self.control_dt_s if previous is not None
+                                         else state.root_lin_vel_world)
+                task.target_world = self._hand_target[s] = target
 
         contacts = []
         for s in support:

@@ -261,6 +261,13 @@ class CharacterModel:
         t = self.root_velocity_map()
         return t.T @ self.mass_matrix @ t
 
+    def rest_distance(self, frame_a: str, frame_b: str) -> float:
+        """Distance between two frames' origins in the rest pose [m] (a segment's length)."""
+        data = self.model.createData()
+        pin.framesForwardKinematics(self.model, data, pin.neutral(self.model))
+        a, b = data.oMf[self.frame_id(frame_a)], data.oMf[self.frame_id(frame_b)]
+        return float(np.linalg.norm(a.translation - b.translation))
+
     def joint_position(self, dof: int) -> float:
         """A hinge's angle [rad] by its index in the character's DOF layout."""
         return float(self.q[self._hinge_q[dof]])

@@ -377,8 +377,9 @@ class MotionOptimizer:
             dh, dc = com_h - a_h[st], com_c - a_c[st]
             lipm = LipmMap(np.array([dh[0], dh[1], 0.0]), float(max(dh[2], 0.1)),
                            np.array([dc[0], dc[1], 0.0]), float(max(dc[2], 0.1)))
-        # The operator's wrists relative to his pelvis, scaled, from the character's reference pelvis (hand tasks).
-        hands = {k: pelvis_d + scale * (s.pos[f"WRIST_{v}"] - p_h) for k, v in _SIDE_UP.items()}
+        # The operator's wrists relative to his pelvis in world axes, scaled, from the character's pelvis (hand tasks:
+        # the hands go where his are around his body, whatever the lag of the body over the ground).
+        hands = {k: state.root_pos_world + scale * (s.pos[f"WRIST_{v}"] - p_h) for k, v in _SIDE_UP.items()}
         return ReferencePose(
             time_s=state.time_s, joint_pos=joint_pos, root_quat_wxyz=q_root_d, pelvis_world=pelvis_d,
             com_world=com_d,

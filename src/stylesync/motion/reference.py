@@ -37,5 +37,5 @@ class ReferencePose:
     held: bool  # the reference is held waiting for a late contact
     scale: float  # character / operator size ratio (h_C / h_H of Eq. 9)
     step_bound_exceeded: bool
-    # The operator's hands relative to his pelvis, scaled, placed at the character's reference pelvis [m] (world)
+    # The operator's wrists relative to his pelvis (world axes), scaled, placed at the character's pelvis [m]
     hand_world: dict[str, np.ndarray] | None = None
