@@ -22,8 +22,7 @@ from stylesync.control.controller import BalanceController, ControllerBase
 from stylesync.control.pid import joint_error
 from stylesync.control.whole_body import WholeBodyController
 from stylesync.errors import SourceError
-from stylesync.metrics.imitation import CHARACTER_LINKS, OPERATOR_JOINTS
-from stylesync.model.character import LINK_NAMES, STANDING_ROOT_HEIGHT_M
+from stylesync.model.character import CHARACTER_LINKS, LINK_NAMES, OPERATOR_JOINTS, STANDING_ROOT_HEIGHT_M
 from stylesync.model.character_model import CharacterModel
 from stylesync.model.state import CharacterState
 from stylesync.motion.bounds import BoundsMonitor

@@ -9,18 +9,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from stylesync.model.character import LINK_NAMES
+from stylesync.model.character import CHARACTER_LINKS, JOINT_PAIRS, OPERATOR_JOINTS
 
-# Character links whose frame origin is the joint of the same name on the operator (canonical joints).
-JOINT_PAIRS: tuple[tuple[str, str], ...] = (
-    ("root", "PELVIS"), ("chest", "SPINE_CHEST"), ("neck", "NECK"),
-    ("left_hip", "HIP_LEFT"), ("left_knee", "KNEE_LEFT"), ("left_ankle", "ANKLE_LEFT"),
-    ("right_hip", "HIP_RIGHT"), ("right_knee", "KNEE_RIGHT"), ("right_ankle", "ANKLE_RIGHT"),
-    ("left_shoulder", "SHOULDER_LEFT"), ("left_elbow", "ELBOW_LEFT"), ("left_wrist", "WRIST_LEFT"),
-    ("right_shoulder", "SHOULDER_RIGHT"), ("right_elbow", "ELBOW_RIGHT"), ("right_wrist", "WRIST_RIGHT"),
-)
-CHARACTER_LINKS = np.array([LINK_NAMES.index(c) for c, _ in JOINT_PAIRS])
-OPERATOR_JOINTS: tuple[str, ...] = tuple(o for _, o in JOINT_PAIRS)
+__all__ = ["CHARACTER_LINKS", "JOINT_PAIRS", "OPERATOR_JOINTS"]
+
 UHC_FALL_DISTANCE_M = 0.5  # termination when the mean joint distance exceeds this (UHC/PHC) [m]
 
 

@@ -135,3 +135,15 @@ def batch_model_quat_from_canonical(q_canonical_wxyz: np.ndarray) -> np.ndarray:
 def canonical_quat_from_model(q_model_wxyz: np.ndarray) -> np.ndarray:
     """Joint rotation in canonical (world-aligned) axes from the same rotation in model axes."""
     return np.asarray(q_model_wxyz, dtype=float) @ _CANONICAL_FROM_MODEL_T
+
+
+# Character links whose frame origin is the joint of the same name on the operator (canonical joints).
+JOINT_PAIRS: tuple[tuple[str, str], ...] = (
+    ("root", "PELVIS"), ("chest", "SPINE_CHEST"), ("neck", "NECK"),
+    ("left_hip", "HIP_LEFT"), ("left_knee", "KNEE_LEFT"), ("left_ankle", "ANKLE_LEFT"),
+    ("right_hip", "HIP_RIGHT"), ("right_knee", "KNEE_RIGHT"), ("right_ankle", "ANKLE_RIGHT"),
+    ("left_shoulder", "SHOULDER_LEFT"), ("left_elbow", "ELBOW_LEFT"), ("left_wrist", "WRIST_LEFT"),
+    ("right_shoulder", "SHOULDER_RIGHT"), ("right_elbow", "ELBOW_RIGHT"), ("right_wrist", "WRIST_RIGHT"),
+)
+CHARACTER_LINKS = np.array([LINK_NAMES.index(c) for c, _ in JOINT_PAIRS])
+OPERATOR_JOINTS: tuple[str, ...] = tuple(o for _, o in JOINT_PAIRS)
