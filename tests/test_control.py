@@ -5,7 +5,14 @@ import pytest
 from conftest import random_pose
 
 from stylesync import rotations as rot
-from stylesync.config import ControlConfig, OperatorConfig, SessionConfig, WorldConfig
+from stylesync.config import (
+    ControlConfig,
+    JacobianTransposeConfig,
+    OperatorConfig,
+    SessionConfig,
+    WholeBodyConfig,
+    WorldConfig,
+)
 from stylesync.control.gravity_compensation import LEG_JOINTS, gravity_torques
 from stylesync.control.jacobian_transpose import JointFrames
 from stylesync.control.pid import joint_error
@@ -81,7 +88,7 @@ def test_table3_gains_stay_stable_on_a_root_fixed_character():
     b = make_backend(WorldConfig(), 600.0, fixed_root=True)
     b.reset(np.array([0.0, 0.0, 1.5]), rot.IDENTITY_WXYZ)
     target = random_pose(5, hinge_rad=0.5)
-    pid = JointPid(ControlConfig(), 1 / 600)
+    pid = JointPid(JacobianTransposeConfig(), 1 / 600)
     dt = 1 / 600
     d = np.zeros((ROOT_DOFS + N_JOINT_DOFS,) * 2)
     j = np.arange(ROOT_DOFS, ROOT_DOFS + N_JOINT_DOFS)
@@ -147,7 +154,7 @@ def test_default_walk_over_sensor_noise_seeds_mostly_completes_and_follows_the_o
 def test_planted_feet_options_keep_a_standing_character_within_2_cm_for_60_s():
     # The acceptance figure (60 s, COM drift < 2 cm) with friction anchors and the sole contact gap.
     com, feet = _standing_run(60.0, world=WorldConfig(friction_anchor=True),
-                              control=ControlConfig(sole_contact_gap_m=0.003))
+                              control=ControlConfig(whole_body=WholeBodyConfig(sole_contact_gap_m=0.003)))
     assert np.linalg.norm(com - com[0], axis=1).max() < 0.02
     assert np.abs(feet - feet[0]).max() < 0.01  # planted feet stay planted
 
@@ -163,7 +170,8 @@ def test_torso_hip_gives_the_pelvis_exactly_the_root_torque():
     backend = make_backend(WorldConfig(), 600.0)
     model = CharacterModel(backend.body_description(), 9.8)
     backend.close()
-    ctl = BalanceController(ControlConfig(stance_hip_torso=True), model, MassProperties(np.ones(len(LINK_NAMES))),
+    jt = JacobianTransposeConfig(stance_hip_torso=True)
+    ctl = BalanceController(ControlConfig(jacobian_transpose=jt), model, MassProperties(np.ones(len(LINK_NAMES))),
                             9.8, 1 / 600, 1 / 133)
     ctl._torso_hip = HIP_JOINT["left"]
     ctl._ff = rng.normal(0, 5, (12, 3))
@@ -181,17 +189,21 @@ def test_torso_hip_gives_the_pelvis_exactly_the_root_torque():
 def test_a_balance_part_the_controller_cannot_switch_off_is_refused():
     from stylesync.errors import ConfigError
 
-    with pytest.raises(ConfigError, match="gravity_compensation"):
-        ControlConfig(gravity_compensation=False)  # the default whole-body balance has no separate term
-    ControlConfig(balance="jacobian_transpose", gravity_compensation=False, com_virtual_force=False)
-    ControlConfig(lipm_time_sync=False)
+    with pytest.raises(ConfigError, match="balance"):
+        ControlConfig(balance="inverse_kinematics")
+    with pytest.raises(ConfigError, match="momentum_com_kp"):
+        WholeBodyConfig(momentum_com_kp=-1.0)
+    with pytest.raises(ConfigError, match="integral_limit"):
+        JacobianTransposeConfig(integral_limit_rad_s=0.0)
+    ControlConfig(balance="jacobian_transpose",
+                  jacobian_transpose=JacobianTransposeConfig(gravity_compensation=False, com_virtual_force=False))
 
 
 def test_bench_baselines_differ_from_stylesync():
     from stylesync.metrics.bench import CONTROLLERS
 
     assert CONTROLLERS["plain-pd"][0].balance == "jacobian_transpose"
-    assert not CONTROLLERS["plain-pd"][0].gravity_compensation
+    assert not CONTROLLERS["plain-pd"][0].jacobian_transpose.gravity_compensation
     assert not CONTROLLERS["no-compensation"][0].lipm_time_sync
     assert CONTROLLERS["stylesync"][0].lipm_time_sync
 

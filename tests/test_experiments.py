@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from stylesync.config import ControlConfig, PidGains
+from stylesync.config import JacobianTransposeConfig, PidGains
 from stylesync.experiments import push, squat_jump, tune
 from stylesync.experiments.scripted_operator import sagittal_leg, standing_ankles
 from stylesync.sources.deepmimic_clip import DeepMimicClip
@@ -53,7 +53,7 @@ def test_tuning_ramp_error_falls_with_stiffer_gains():
     clip = DeepMimicClip.builtin("walk")
     slope, height, axis = tune.ramp_spec(clip, "knee")
     assert 1.0 < slope < 20.0 and 0.5 < height < 2.0  # a walking knee: a few rad/s, about a radian
-    base = ControlConfig().pid["knee"]
+    base = JacobianTransposeConfig().pid["knee"]
     soft = tune.ramp_error("knee", PidGains(base.kp / 4, 0.0, base.kd / 4), slope, height, axis)
     stiff = tune.ramp_error("knee", PidGains(base.kp * 2, 0.0, base.kd * 2), slope, height, axis)
     assert stiff[0] < soft[0]

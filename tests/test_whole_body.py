@@ -9,7 +9,7 @@ import pinocchio as pin
 import pytest
 
 from stylesync import rotations as rot
-from stylesync.config import ControlConfig, OperatorConfig, SessionConfig, WorldConfig
+from stylesync.config import ControlConfig, OperatorConfig, SessionConfig, WholeBodyConfig, WorldConfig
 from stylesync.control.contacts import FORCES_PER_SOLE, SoleContact
 from stylesync.control.formulation import WholeBodyFormulation
 from stylesync.control.solver import DaqpSolver
@@ -124,7 +124,7 @@ def _hand_error(hand_tasks: bool) -> tuple[float, bool]:
     """Mean distance of the left wrist to the hand target (the operator's wrist around his pelvis, scaled, within
     the arm's reach: what the hand task asks), over a punch."""
     cfg = SessionConfig(duration_s=2.5, operator=OperatorConfig(clip="punch"),
-                        control=ControlConfig(hand_tasks=hand_tasks))
+                        control=ControlConfig(whole_body=WholeBodyConfig(hand_tasks=hand_tasks)))
     source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
     session = Session(cfg, source)
     model = session.model

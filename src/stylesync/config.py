@@ -152,77 +152,93 @@ class MotionConfig:
 
 
 @dataclass(frozen=True)
-class ControlConfig:
+class JacobianTransposeConfig:
+    """The paper's controller as printed (controller.py): PID (Eq. 13) with gravity compensation (Eq. 14-15), the
+    COM and root virtual control mapped by Jacobian transposes (Eq. 16-18), the IPM ankle torque (Eq. 20)."""
+
     pid: dict[str, PidGains] = field(default_factory=_table3)
     integral_limit_rad_s: float = 0.2  # anti-windup clamp of ∫e dt per DOF [rad·s]
     # CR-VC, Eq. 16; Table 3 prints two "Kp" columns, the second is read as Kd.
     com_force_kp_npm: float = 50.0  # Table 3, virtual force Kp [N/m]
     com_force_kd_nspm: float = 30.0  # Table 3, virtual force Kd [N·s/m]
-    root_torque_kp: float = 1000.0  # Table 3 gives 5000; see below [N·m/rad]
-    root_torque_kd: float = 100.0  # Table 3 gives 1000; see below [N·m·s/rad]
-    # Extra scaling of the root torque about the vertical (heading), which the stance hips also carry.
-    root_yaw_gain_scale: float = 1.0
+    root_torque_kp: float = 1000.0  # Table 3 gives 5000; see docs/decisions.md [N·m/rad]
+    root_torque_kd: float = 100.0  # Table 3 gives 1000; see docs/decisions.md [N·m·s/rad]
     # In single stance the stance hip carries the root torque alone and cancels the other pelvis joints'
     # feedback (SIMBICON's torso control, controller.py); off by default: measured no better overall
     # (docs/decisions.md). Off, the root torque is one more implicit term on the stance hips.
     stance_hip_torso: bool = False
-    # How the virtual forces are realised: "whole_body" (whole_body.py: tasks and sole contacts in one QP per tick)
-    # or "jacobian_transpose" (controller.py: Eq. 17-18 and Eq. 20 as printed, with the stable PD).
-    balance: str = "whole_body"
-    joint_tracking_omega_rad_s: float = 20.0  # inverse dynamics: Eq. 13 as q̈* = ω² e + 2 ζ ω ė
-    joint_tracking_damping_ratio: float = 1.0
-    joint_acceleration_limit_rad_s2: float = 200.0  # the joint PD's desired acceleration is saturated here
-    joint_tracking_weight: float = 10.0  # inverse dynamics: weight of M_ii Δq̈_i² against the wrench error
-    # Inverse dynamics: the COM force of Eq. 16 per unit mass, horizontally (Eq. 16, first line) and vertically (the
-    # pelvis height of Eq. 9). Table 3's 50 and 30 (com_force_*) are used by the Jacobian-transpose controller. These
-    # are the gains of a capture-point (DCM) tracking law with unit gain for this character's pendulum,
-    # kp = ω², kd = 2ω with ω = sqrt(g / h) ≈ 3.4 1/s (docs/decisions.md) [1/s², 1/s].
-    momentum_com_kp: float = 12.0
-    momentum_com_kd: float = 7.0
-    momentum_root_kp: float = 200.0  # inverse dynamics: root virtual torque of Eq. 16 about the COM [N·m/rad]
-    momentum_root_kd: float = 40.0  # [N·m·s/rad]
-    momentum_moment_weight_per_m: float = 2.0  # weight of the moment rows against the force rows [1/m]
-    contact_velocity_gain: float = 10.0  # a supporting foot's residual velocity is damped at this rate [1/s]
-    # Inverse dynamics: a planted sole whose lowest corner is within this height of the ground still counts as
-    # supporting (contact_forces.sole_touches); 0 = only a foot pressing the ground does. Off by default, as
-    # WorldConfig.friction_anchor, with which it keeps a standing character's feet planted [m].
-    sole_contact_gap_m: float = 0.0
-    # Whole body: the hands follow the operator's hands in world space (a task each, off by default) [1/s², 1/s]
-    hand_tasks: bool = False
-    hand_task_kp: float = 100.0
-    hand_task_kd: float = 20.0
-    hand_task_weight: float = 100.0
     gravity_compensation: bool = True  # Eq. 14-15
     com_virtual_force: bool = True  # Eq. 16-17
     root_virtual_torque: bool = True  # Eq. 16, 18
     ipm_ankle_compensation: bool = True  # Eq. 20
+
+    def __post_init__(self) -> None:
+        for n in ("com_force_kp_npm", "com_force_kd_nspm", "root_torque_kp", "root_torque_kd"):
+            _non_negative(f"JacobianTransposeConfig.{n}", getattr(self, n))
+        _positive("JacobianTransposeConfig.integral_limit_rad_s", self.integral_limit_rad_s)
+        for group in ("chest", "neck", "hip", "knee", "ankle", "shoulder", "elbow"):
+            if group not in self.pid:
+                raise ConfigError(f"JacobianTransposeConfig.pid lacks gains for '{group}'")
+
+
+@dataclass(frozen=True)
+class WholeBodyConfig:
+    """The whole-body controller (whole_body.py): tasks and sole contacts in one QP per control tick."""
+
+    joint_tracking_omega_rad_s: float = 20.0  # posture task: Eq. 13 as q̈* = ω² e + 2 ζ ω ė
+    joint_tracking_damping_ratio: float = 1.0
+    joint_acceleration_limit_rad_s2: float = 200.0  # the posture task's desired acceleration is saturated here
+    joint_tracking_weight: float = 10.0  # weight of M_ii Δq̈_i² against the momentum task's squared newtons
+    # The COM force of Eq. 16 per unit mass, horizontally (Eq. 16, first line) and vertically (the pelvis height of
+    # Eq. 9). These are the gains of a capture-point (DCM) tracking law with unit gain for this character's
+    # pendulum, kp = ω², kd = 2ω with ω = sqrt(g / h) ≈ 3.4 1/s, instead of Table 3's 50 and 30 (docs/decisions.md)
+    # [1/s², 1/s].
+    momentum_com_kp: float = 12.0
+    momentum_com_kd: float = 7.0
+    momentum_root_kp: float = 200.0  # root virtual torque of Eq. 16 about the COM [N·m/rad]
+    momentum_root_kd: float = 40.0  # [N·m·s/rad]
+    momentum_moment_weight_per_m: float = 2.0  # the moment rows' weight is this squared, the force rows' 1 [1/m]
+    contact_velocity_gain: float = 10.0  # a supporting sole's residual velocity is damped at this rate [1/s]
+    # A planted sole whose lowest corner is within this height of the ground still counts as supporting
+    # (contacts.sole_touches); 0 = only a foot pressing the ground does. Off by default, as
+    # WorldConfig.friction_anchor, with which it keeps a standing character's feet planted [m].
+    sole_contact_gap_m: float = 0.0
+    # The hands follow the operator's hands in world space (a task each, off by default) [1/s², 1/s]
+    hand_tasks: bool = False
+    hand_task_kp: float = 100.0
+    hand_task_kd: float = 20.0
+    hand_task_weight: float = 100.0
+
+    def __post_init__(self) -> None:
+        for n in ("joint_tracking_omega_rad_s", "joint_tracking_damping_ratio", "momentum_moment_weight_per_m",
+                  "joint_acceleration_limit_rad_s2"):
+            _positive(f"WholeBodyConfig.{n}", getattr(self, n))
+        for n in ("momentum_com_kp", "momentum_com_kd", "momentum_root_kp", "momentum_root_kd",
+                  "contact_velocity_gain", "sole_contact_gap_m", "joint_tracking_weight", "hand_task_kp",
+                  "hand_task_kd", "hand_task_weight"):
+            _non_negative(f"WholeBodyConfig.{n}", getattr(self, n))
+
+
+@dataclass(frozen=True)
+class ControlConfig:
+    """The balance and synchronisation controller (Sec. 6): which method realises it, and what both share."""
+
+    # "whole_body" (whole_body.py: tasks and sole contacts in one QP per tick) or "jacobian_transpose"
+    # (controller.py: Eq. 17-18 and Eq. 20 as printed, with the stable PD). See docs/decisions.md.
+    balance: str = "whole_body"
+    whole_body: WholeBodyConfig = field(default_factory=WholeBodyConfig)
+    jacobian_transpose: JacobianTransposeConfig = field(default_factory=JacobianTransposeConfig)
+    # Extra scaling of the root torque about the vertical (heading), which the stance hips also carry.
+    root_yaw_gain_scale: float = 1.0
     lipm_time_sync: bool = True  # Eq. 21-23
     enforce_bounds: bool = True  # Eq. 24-28
     lipm_force_limit_n: float = 150.0  # clamp of |f_cro| before the bounds check [N]
 
     def __post_init__(self) -> None:
-        for n in ("com_force_kp_npm", "com_force_kd_nspm", "root_torque_kp", "root_torque_kd", "momentum_com_kp",
-                  "momentum_com_kd"):
-            _non_negative(f"ControlConfig.{n}", getattr(self, n))
-        _positive("ControlConfig.integral_limit_rad_s", self.integral_limit_rad_s)
         _positive("ControlConfig.root_yaw_gain_scale", self.root_yaw_gain_scale)
+        _non_negative("ControlConfig.lipm_force_limit_n", self.lipm_force_limit_n)
         if self.balance not in BALANCE_METHODS:
             raise ConfigError(f"ControlConfig.balance must be one of {BALANCE_METHODS}, got {self.balance!r}")
-        # The inverse-dynamics controller realises gravity compensation, the COM and root virtual control and the
-        # centre of pressure (IPM) in one problem; only the LIPM force is a separate term there.
-        fixed = [n for n in ("gravity_compensation", "com_virtual_force", "root_virtual_torque",
-                             "ipm_ankle_compensation") if not getattr(self, n)]
-        if self.balance == "whole_body" and fixed:
-            raise ConfigError(f"ControlConfig: {', '.join(fixed)} can only be switched off with "
-                              f"balance='jacobian_transpose' (the inverse-dynamics balance has no separate term)")
-        for n in ("joint_tracking_omega_rad_s", "joint_tracking_damping_ratio", "momentum_moment_weight_per_m",
-                  "joint_acceleration_limit_rad_s2"):
-            _positive(f"ControlConfig.{n}", getattr(self, n))
-        for n in ("momentum_root_kp", "momentum_root_kd", "contact_velocity_gain", "sole_contact_gap_m"):
-            _non_negative(f"ControlConfig.{n}", getattr(self, n))
-        for group in ("chest", "neck", "hip", "knee", "ankle", "shoulder", "elbow"):
-            if group not in self.pid:
-                raise ConfigError(f"ControlConfig.pid lacks gains for '{group}'")
 
 
 @dataclass(frozen=True)

@@ -122,10 +122,11 @@ class BalanceController(ControllerBase):
                  friction: float = 0.9):
         super().__init__(cfg, mass, gravity_mps2, physics_dt_s, control_dt_s, bounds, friction)
         self.model = model
-        self.pid = JointPid(cfg, physics_dt_s)
+        self.jt = jt = cfg.jacobian_transpose
+        self.pid = JointPid(jt, physics_dt_s)
         self._ff = np.zeros((len(JOINTS), 3))
         self._ref: ReferencePose | None = None
-        self.root_kp, self.root_kd = cfg.root_torque_kp, cfg.root_torque_kd
+        self.root_kp, self.root_kd = jt.root_torque_kp, jt.root_torque_kd
         # D of stable_pd.py: the joints' diagonal is constant; the root torque's block is filled per tick.
         self._damping = joint_damping(self.pid.kp, self.pid.kd, physics_dt_s)
         self._gain = np.eye(N_DOFS - ROOT_DOFS)  # G of stable_pd, joint rows and columns
@@ -140,12 +141,12 @@ class BalanceController(ControllerBase):
         d = self._damping.copy()
         s_map = np.zeros((N_DOFS - ROOT_DOFS, 3))
         single = [side for side, ws in stance_weight.items() if ws >= 1.0]
-        self._torso_hip = HIP_JOINT[single[0]] if (self.cfg.root_virtual_torque and self.cfg.stance_hip_torso
+        self._torso_hip = HIP_JOINT[single[0]] if (self.jt.root_virtual_torque and self.jt.stance_hip_torso
                                                    and single) else None
         self._torso_dofs = (JOINT_DOF_START[self._torso_hip] + np.arange(3) if self._torso_hip is not None
                             else np.zeros(0, dtype=int))
         d[ROOT_DOFS + self._torso_dofs, ROOT_DOFS + self._torso_dofs] = 0.0  # no PD there: nothing to predict
-        if self.cfg.root_virtual_torque and self._torso_hip is None:
+        if self.jt.root_virtual_torque and self._torso_hip is None:
             hips = {side: state.joint_pos[HIP_JOINT[side]] for side in ("left", "right")}
             s_map = stance_hip_map(state.root_quat_wxyz, hips, stance_weight)
             # Q_hips = S τ_r(ω_next): the root damping is implicit in the root's angular acceleration (DOFs 3-5).
@@ -155,7 +156,7 @@ class BalanceController(ControllerBase):
         self._gain = implicit_gain(mass_matrix, d)[ROOT_DOFS:, ROOT_DOFS:]
 
     def update(self, state: CharacterState, ref: ReferencePose) -> None:
-        cfg = self.cfg
+        cfg, jt = self.cfg, self.jt
         self.model.update(state)
         mass_matrix = self.model.mass_matrix_world_layout()
         w = supporting_weights(ref.stance_weight, state.feet_pressing())
@@ -163,14 +164,14 @@ class BalanceController(ControllerBase):
         self._prepare_implicit(state, w, mass_matrix)
         frames = JointFrames(state)
         ff = np.zeros((len(JOINTS), 3))
-        if cfg.gravity_compensation:  # Eq. 14-15
+        if jt.gravity_compensation:  # Eq. 14-15
             ff += gravity_torques(state, frames, self.mass.link_mass_kg, self.g, w, ref.ankle_world,
-                                  skip_stance_ankle=cfg.ipm_ankle_compensation)
+                                  skip_stance_ankle=jt.ipm_ankle_compensation)
         com = self.mass.com(state)
         force = np.zeros(3)
-        if cfg.com_virtual_force:  # Eq. 16 (first line), Eq. 19
+        if jt.com_virtual_force:  # Eq. 16 (first line), Eq. 19
             force += com_virtual_force(ref.com_world, ref.com_vel_world, com, self.mass.com_velocity(state),
-                                       self.mass.total_kg, cfg.com_force_kp_npm, cfg.com_force_kd_nspm)
+                                       self.mass.total_kg, jt.com_force_kp_npm, jt.com_force_kd_nspm)
         f_lipm = np.zeros(3)
         if cfg.lipm_time_sync and ref.lipm is not None:  # Eq. 21-23
             f_lipm = bounded_lipm_sync_force(ref.lipm, self.mass.total_kg, self.g, cfg.lipm_force_limit_n,
@@ -192,7 +193,7 @@ class BalanceController(ControllerBase):
         moment = np.zeros((len(JOINTS), 3))  # world moments of Eq. 17 and Eq. 20
         if np.any(force):
             moment += stance_force_moments(frames, state.link_com_world, self.mass.link_mass_kg, force, w)  # Eq. 17
-        if cfg.ipm_ankle_compensation:  # Eq. 20
+        if jt.ipm_ankle_compensation:  # Eq. 20
             moment += ipm_ankle_moments(ref.com_world, ref.ankle_world, w, self.mass.total_kg, self.g, foot_yaw)
         # In single stance the ankle cannot push harder than its sole allows (support.py); in double stance the
         # two feet share a larger support polygon, and a per-sole clamp there was measured to make the standing
@@ -219,7 +220,7 @@ class BalanceController(ControllerBase):
         r_flat = flatten_joint_values(r)
         r_flat[self._torso_dofs] = 0.0
         tau_r = np.zeros(3)
-        if self.cfg.root_virtual_torque:  # Eq. 16 (second line), Eq. 18: -w τ_r on each stance hip
+        if self.jt.root_virtual_torque:  # Eq. 16 (second line), Eq. 18: -w τ_r on each stance hip
             tau_r = root_virtual_torque(ref.root_quat_wxyz, fb.root_quat_wxyz, fb.root_ang_vel_world, self.root_kp,
                                         self.root_kd, self.cfg.root_yaw_gain_scale, predict_dt_s=self.physics_dt_s)
             self.telemetry.root_torque_nm = tau_r

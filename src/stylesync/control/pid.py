@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from stylesync import rotations as rot
-from stylesync.config import ControlConfig, pid_group
+from stylesync.config import JacobianTransposeConfig, pid_group
 from stylesync.model.character import JOINTS, JointKind
 
 IS_BALL = np.array([j.kind is JointKind.BALL for j in JOINTS])
@@ -21,7 +21,7 @@ _BALL = np.flatnonzero(IS_BALL)
 _HINGE = np.flatnonzero(~IS_BALL)
 
 
-def gain_arrays(cfg: ControlConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def gain_arrays(cfg: JacobianTransposeConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     kp = np.array([cfg.pid[pid_group(j.name)].kp for j in JOINTS])
     ki = np.array([cfg.pid[pid_group(j.name)].ki for j in JOINTS])
     kd = np.array([cfg.pid[pid_group(j.name)].kd for j in JOINTS])
@@ -46,7 +46,7 @@ def reference_velocity(q_previous: np.ndarray, q_current: np.ndarray, dt_s: floa
 
 
 class JointPid:
-    def __init__(self, cfg: ControlConfig, dt_s: float):
+    def __init__(self, cfg: JacobianTransposeConfig, dt_s: float):
         kp, ki, kd = gain_arrays(cfg)
         self.kp = np.repeat(kp[:, None], 3, axis=1)  # (n_joints, 3) per DOF
         self.ki = np.repeat(ki[:, None], 3, axis=1)

@@ -67,22 +67,23 @@ class WholeBodyController(ControllerBase):
                  physics_dt_s: float, control_dt_s: float, bounds: bnd.BoundsMonitor | None = None,
                  friction: float = 0.9, joint_limits: dict[str, tuple[float, float]] | None = None):
         super().__init__(cfg, mass, gravity_mps2, physics_dt_s, control_dt_s, bounds, friction)
+        self.wb = wb = cfg.whole_body
         self.model = model
         self._tau = Torques.zeros()  # held from one control tick to the next [N·m]
-        omega, zeta = cfg.joint_tracking_omega_rad_s, cfg.joint_tracking_damping_ratio
+        omega, zeta = wb.joint_tracking_omega_rad_s, wb.joint_tracking_damping_ratio
         self.kp, self.kd = omega * omega, 2.0 * zeta * omega
         self.formulation = WholeBodyFormulation(_TORQUE_LIMIT_FLAT, hinge_limits(joint_limits or {}),
-                                                cfg.contact_velocity_gain, JOINT_LIMIT_HORIZON_S)
+                                                wb.contact_velocity_gain, JOINT_LIMIT_HORIZON_S)
         f = self.formulation
-        self.posture = f.add_task(JointPostureTask(cfg.joint_tracking_weight, MIN_TRACKING_INERTIA_KGM2))
+        self.posture = f.add_task(JointPostureTask(wb.joint_tracking_weight, MIN_TRACKING_INERTIA_KGM2))
         self.pelvis = f.add_task(FrameOrientationTask("pelvis_orientation", "root", self.kp, self.kd, 0.0,
                                                       rot.conjugate(Q_WORLD_MODEL)))
-        self.momentum = f.add_task(CentroidalMomentumTask(1.0, cfg.momentum_moment_weight_per_m ** 2))
+        self.momentum = f.add_task(CentroidalMomentumTask(1.0, wb.momentum_moment_weight_per_m ** 2))
         self.foot_press = {s: f.add_task(FramePositionTask(f"{s}_foot_press", f"{s}_ankle", self.kp, self.kd,
                                                            FOOT_TASK_WEIGHT, axes=(2,))) for s in SIDES}
-        self.hands = ({s: f.add_task(FramePositionTask(f"{s}_hand", HAND_FRAMES[s], cfg.hand_task_kp,
-                                                       cfg.hand_task_kd, cfg.hand_task_weight)) for s in SIDES}
-                      if cfg.hand_tasks else {})
+        self.hands = ({s: f.add_task(FramePositionTask(f"{s}_hand", HAND_FRAMES[s], wb.hand_task_kp,
+                                                       wb.hand_task_kd, wb.hand_task_weight)) for s in SIDES}
+                      if wb.hand_tasks else {})
         self._arm_length_m = model.rest_distance("left_shoulder", "left_elbow") + model.rest_distance(
             "left_elbow", "left_wrist")
         self._hand_target: dict[str, np.ndarray] = {}  # the last tick's hand targets [m]
@@ -92,26 +93,26 @@ class WholeBodyController(ControllerBase):
         self.qp_failures = 0  # ticks whose QP did not reach its tolerance (the best iterate was used)
 
     def update(self, state: CharacterState, ref: ReferencePose) -> None:
-        cfg = self.cfg
+        cfg, wb = self.cfg, self.wb
         model = self.model
         model.update(state)
         m = self.mass.total_kg
         touching = {s: sole_touches(state.link_origin_world[_FOOT_LINK[s]], state.link_quat_wxyz[_FOOT_LINK[s]], p,
-                                    cfg.sole_contact_gap_m) for s, p in state.feet_pressing().items()}
+                                    wb.sole_contact_gap_m) for s, p in state.feet_pressing().items()}
         w = supporting_weights(ref.stance_weight, touching)
         com, com_vel = model.com_world, model.com_vel_world
 
         # Centroidal momentum rate: Eq. 16 (first line) horizontally; vertically the pelvis height of Eq. 9.
-        force = com_virtual_force(ref.com_world, ref.com_vel_world, com, com_vel, m, cfg.momentum_com_kp,
-                                  cfg.momentum_com_kd)
+        force = com_virtual_force(ref.com_world, ref.com_vel_world, com, com_vel, m, wb.momentum_com_kp,
+                                  wb.momentum_com_kd)
         # The pelvis height above the supporting ankles as they are (a loaded sole sinks into the ground's spring
         # by a centimetre or two; a target above the reach of straight legs could only be met by flailing).
         support = [s for s, ws in w.items() if ws > 0]
         ankle_z = (sum(float(state.link_origin_world[_FOOT_LINK[s], 2]) for s in support) / len(support) if support
                    else ANKLE_HEIGHT_M)
         pelvis_z_d = ref.pelvis_world[2] - ANKLE_HEIGHT_M + ankle_z
-        force[2] = m * (cfg.momentum_com_kp * (pelvis_z_d - state.root_pos_world[2])
-                        - cfg.momentum_com_kd * state.root_lin_vel_world[2])
+        force[2] = m * (wb.momentum_com_kp * (pelvis_z_d - state.root_pos_world[2])
+                        - wb.momentum_com_kd * state.root_lin_vel_world[2])
         f_lipm = np.zeros(3)
         if cfg.lipm_time_sync and ref.lipm is not None:  # Eq. 21-23, bounded by Eq. 26
             f_lipm = bounded_lipm_sync_force(ref.lipm, m, self.g, cfg.lipm_force_limit_n, cfg.enforce_bounds,
@@ -121,7 +122,7 @@ class WholeBodyController(ControllerBase):
                    for s in support]
         force = feasible_horizontal_force(force, com, corners, m, self.g)
         e_root = root_orientation_error(ref.root_quat_wxyz, state.root_quat_wxyz)
-        moment = root_pd(e_root, state.root_ang_vel_world, cfg.momentum_root_kp, cfg.momentum_root_kd,
+        moment = root_pd(e_root, state.root_ang_vel_world, wb.momentum_root_kp, wb.momentum_root_kd,
                          cfg.root_yaw_gain_scale)
         self.momentum.force_n, self.momentum.moment_nm = force, moment
 
@@ -131,13 +132,13 @@ class WholeBodyController(ControllerBase):
         qdd_joint = self.kp * e + self.kd * (self._ref_vel - state.joint_vel)
         m_diag = model.mass_matrix.diagonal()
         own = JOINT_ACCEL_TORQUE_SHARE * TORQUE_LIMIT / np.maximum(unflatten_joint_values(m_diag[ROOT_DOFS:]), 1e-6)
-        lim = np.maximum(cfg.joint_acceleration_limit_rad_s2, own)
+        lim = np.maximum(wb.joint_acceleration_limit_rad_s2, own)
         self.posture.desired_accel = flatten_joint_values(np.minimum(np.maximum(qdd_joint, -lim), lim))
 
         # Pelvis orientation, weighted by the pelvis's rotational inertia about world axes (as a joint's by M_ii).
         r_base = model.data.oMi[1].rotation
         m_rot_world = r_base @ model.mass_matrix[3:6, 3:6] @ r_base.T
-        self.pelvis.weight = cfg.joint_tracking_weight * np.maximum(m_rot_world.diagonal(), MIN_TRACKING_INERTIA_KGM2)
+        self.pelvis.weight = wb.joint_tracking_weight * np.maximum(m_rot_world.diagonal(), MIN_TRACKING_INERTIA_KGM2)
         self.pelvis.target_quat_wxyz = ref.root_quat_wxyz
 
         # A stance foot that does not touch yet is lowered onto the ground (a foot no force is planned for would

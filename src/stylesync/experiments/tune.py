@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from stylesync import rotations as rot
-from stylesync.config import ControlConfig, PidGains, WorldConfig
+from stylesync.config import JacobianTransposeConfig, PidGains, WorldConfig
 from stylesync.control.gravity_compensation import gravity_torques
 from stylesync.control.jacobian_transpose import JointFrames
 from stylesync.control.pid import IS_BALL, JointPid, joint_error
@@ -85,7 +85,7 @@ def _target(group: str, angle: float, axis: np.ndarray) -> np.ndarray:
 
 def ramp_error(group: str, gains: PidGains, slope: float, height: float, axis: np.ndarray) -> tuple[float, float]:
     """(summed |error| [rad·s], RMS error [rad]) of the group's right-side joint tracking the ramp."""
-    cfg = ControlConfig(pid={**ControlConfig().pid, group: gains})
+    cfg = JacobianTransposeConfig(pid={**JacobianTransposeConfig().pid, group: gains})
     k = JOINT_NAMES.index(_CHAR_JOINT[group])
     dt = 1.0 / PHYSICS_HZ
     backend = make_backend(WorldConfig(), PHYSICS_HZ, fixed_root=True)
@@ -134,7 +134,7 @@ def run(out: Path, duration_s: float = 0.0, seed: int = 0) -> tuple[bool, dict]:
     """``duration_s`` and ``seed`` are unused (the ramps fix both); kept for the common experiment signature."""
     out.mkdir(parents=True, exist_ok=True)
     clip = DeepMimicClip.builtin("walk")
-    table3 = ControlConfig().pid
+    table3 = JacobianTransposeConfig().pid
     rows: dict[str, dict] = {}
     for group in GROUPS:
         slope, height, axis = ramp_spec(clip, group)

@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from stylesync.config import ControlConfig, MotionConfig, OperatorConfig, SessionConfig
+from stylesync.config import ControlConfig, JacobianTransposeConfig, MotionConfig, OperatorConfig, SessionConfig
 from stylesync.metrics.summary import summarize
 from stylesync.model.state import Torques
 from stylesync.session import Session
@@ -38,8 +38,10 @@ from stylesync.sources.registry import open_source
 
 CONTROLLERS: dict[str, tuple[ControlConfig, MotionConfig]] = {
     "stylesync": (ControlConfig(), MotionConfig()),
-    "plain-pd": (ControlConfig(balance="jacobian_transpose", gravity_compensation=False, com_virtual_force=False,
-                               root_virtual_torque=False, ipm_ankle_compensation=False, lipm_time_sync=False),
+    "plain-pd": (ControlConfig(balance="jacobian_transpose", lipm_time_sync=False,
+                               jacobian_transpose=JacobianTransposeConfig(
+                                   gravity_compensation=False, com_virtual_force=False, root_virtual_torque=False,
+                                   ipm_ankle_compensation=False)),
                  MotionConfig(stance_hip_weight_w0=1.0)),
     "no-compensation": (ControlConfig(lipm_time_sync=False), MotionConfig()),
 }
