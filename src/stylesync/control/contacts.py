@@ -69,10 +69,11 @@ def feasible_horizontal_force(force_n: np.ndarray, com_world: np.ndarray, corner
     out = np.array(force_n, dtype=float)
     if not corners_world:
         return out
-    pts = np.concatenate(corners_world)
-    h = max(float(com_world[2]) - float(pts[:, 2].mean()), 0.1)
+    pts = np.concatenate(corners_world).tolist()  # Python floats: a few scalars per corner
+    h = max(float(com_world[2]) - sum(p[2] for p in pts) / len(pts), 0.1)
     k = mass_kg * gravity_mps2 / h
-    lo, hi = pts[:, :2].min(axis=0).tolist(), pts[:, :2].max(axis=0).tolist()
+    lo = [min(p[0] for p in pts), min(p[1] for p in pts)]
+    hi = [max(p[0] for p in pts), max(p[1] for p in pts)]
     extra = mass_kg * MOMENTUM_ACCEL_ALLOWANCE_MPS2
     for ax in (0, 1):
         mid, half = 0.5 * (lo[ax] + hi[ax]), 0.5 * COP_MARGIN * (hi[ax] - lo[ax])

@@ -7,6 +7,7 @@ vector of ``R_ref Rᵀ`` [rad], and rows ``J q̈ = ẍ* - J̇ q̇`` (LOCAL_WORLD
 from __future__ import annotations
 
 import numpy as np
+import pinocchio as pin
 
 from stylesync import rotations as rot
 from stylesync.control.tasks.base import Task, TaskRows
@@ -54,8 +55,7 @@ class FrameOrientationTask(Task):
     def rows(self, model: CharacterModel) -> TaskRows:
         f = model.frame_id(self.frame)
         r = model.frame_rotation(f) @ self._r_frame_canonical
-        self.error_rotvec = rot.rotvec_from_quat(rot.multiply(self.target_quat_wxyz,
-                                                              rot.conjugate(rot.quat_from_matrix(r))))
+        self.error_rotvec = pin.log3(rot.matrix_from_quat(self.target_quat_wxyz) @ r.T)
         omega = model.frame_velocity(f)[3:]
         accel = self.gain_scale * (self.kp * self.error_rotvec - self.kd * omega)
         return TaskRows(model.frame_jacobian(f)[3:], accel - model.frame_drift(f)[3:], self.weight)
