@@ -81,6 +81,22 @@ class SessionResult:
     operator_prefetched: bool = False  # the operator side ran ahead in a second process (prefetch.py)
 
 
+@dataclass
+class _RunState:
+    """What one run accumulates: the tick log, stage timings, the fall, the wall clock's origin."""
+
+    render_every_s: float | None
+    log: TickLog = field(default_factory=TickLog)
+    stage_ms: dict[str, list[float]] = field(default_factory=lambda: {
+        "processing": [], "motion": [], "control_update": [], "torques": [], "physics": []})
+    latency_ms: list[float] = field(default_factory=list)
+    fall_time: float | None = None
+    fall_reason: str = ""
+    wall0: float = 0.0
+    last_frame_sim_s: float = 0.0
+    next_render_s: float = 0.0
+
+
 def control_tick_steps(n_steps: int, physics_dt_s: float, control_dt_s: float) -> list[int]:
     """The physics steps a control tick runs on: the first step at or after each control period's due time."""
     steps, next_control = [], 0.0
@@ -168,100 +184,123 @@ class Session:
 
     def run(self, progress: Callable[[float, float], None] | None = None,
             render_every_s: float | None = None) -> SessionResult:
+        """Run the session for ``duration_s`` of simulated time (or until a fall, or ``close``)."""
         cfg = self.cfg
-        clocks = cfg.clocks
-        dt = 1.0 / clocks.physics_hz
-        control_dt = 1.0 / clocks.control_hz
-        n_steps = int(round(cfg.duration_s * clocks.physics_hz))
+        dt = 1.0 / cfg.clocks.physics_hz
+        n_steps = int(round(cfg.duration_s * cfg.clocks.physics_hz))
         self._place_character()
-        tick_log = TickLog()
-        stage_ms: dict[str, list[float]] = {"processing": [], "motion": [], "control_update": [], "torques": [],
-                                            "physics": []}
-        next_render = 0.0
-        last_frame_sim = 0.0
-        self.fell, fall_time, fall_reason = False, None, ""
-        latency_ms: list[float] = []
-        wall0 = time.perf_counter()
-        step = 0
-        tick_steps = control_tick_steps(n_steps, dt, control_dt)
+        run = _RunState(render_every_s)
+        tick_steps = control_tick_steps(n_steps, dt, 1.0 / cfg.clocks.control_hz)
         is_tick = np.zeros(n_steps, dtype=bool)
         is_tick[tick_steps] = True
         operator: OperatorInline | OperatorPrefetch = OperatorInline(self.source, self.processing)
         if self.prefetch_operator and OperatorPrefetch.usable(self.source, cfg.realtime, cfg.gui):
             operator = OperatorPrefetch(self.source, self.processing, [k * dt for k in tick_steps])
+        self.fell = False
+        run.wall0 = time.perf_counter()
+        step = 0
         try:
             for step in range(n_steps):
                 t = step * dt
                 if is_tick[step]:
-                    self._service_commands()
-                    if self.paused:
-                        p0 = time.perf_counter()
-                        while self.paused and not self.closed:
-                            time.sleep(0.02)
-                            self._service_commands()
-                        wall0 += time.perf_counter() - p0  # a pause is neither simulated nor wall time of the run
-                    c0 = time.perf_counter()
-                    frames = operator.poll(t)
-                    for f in frames:
-                        if "arrival_wall_s" in f.extras:
-                            latency_ms.append((c0 - f.extras["arrival_wall_s"]) * 1e3)
-                    if frames:
-                        last_frame_sim = t
-                    elif t - last_frame_sim > SILENT_STREAM_TIMEOUT_S and self._source_is_live():
-                        raise SourceError(f"operator stream silent for more than {SILENT_STREAM_TIMEOUT_S:.0f} s")
-                    sample, analysis = operator.tick(t)
-                    self.last_sample = sample
-                    c1 = time.perf_counter()
-                    state = self.backend.read_state(t)
-                    ref = self.motion.update(sample, state, self.mass, analysis)
-                    c2 = time.perf_counter()
-                    self.controller.update(state, ref)
-                    c3 = time.perf_counter()
-                    stage_ms["processing"].append((c1 - c0) * 1e3)
-                    stage_ms["motion"].append((c2 - c1) * 1e3)
-                    stage_ms["control_update"].append((c3 - c2) * 1e3)
-                    self._log(tick_log, t, sample, state, ref, (c3 - c0) * 1e3)
-                    if self.on_tick is not None:
-                        self.on_tick(state, ref)
-                    reason = self._fall_reason(state)
-                    if reason and not self.fell:
-                        self.fell, fall_time, fall_reason = True, t, reason
-                        log.warning("character fell at t=%.2f s (%s)", t, reason)
-                    if self.fell and self.stop_on_fall:
+                    self._wait_while_paused(run)
+                    state = self._control_tick(t, operator, run)
+                    if self._detect_fall(state, t, run) or self.closed:
                         break
-                    if self.closed:
-                        break
-                    if render_every_s is not None and t >= next_render and hasattr(self.backend, "render_rgb"):
-                        next_render += render_every_s
-                        r0 = time.perf_counter()
-                        com = self.mass.com(state)
-                        self.renders.append((t, self.backend.render_rgb([com[0], com[1], 0.8])))  # type: ignore[attr-defined]
-                        wall0 += time.perf_counter() - r0  # an output of the run, not part of the pipeline's time
+                    self._render_if_due(state, t, run)
                     if progress is not None:
-                        progress(t, time.perf_counter() - wall0)
-                p0 = time.perf_counter()
-                fb = self.backend.read_joint_feedback() if self.controller.needs_joint_feedback else None
-                torques = self.controller.torques(fb)
-                self.last_torques = torques.values
-                self.backend.apply_torques(torques)
-                p1 = time.perf_counter()
-                self.backend.step()
-                p2 = time.perf_counter()
-                stage_ms["torques"].append((p1 - p0) * 1e3)
-                stage_ms["physics"].append((p2 - p1) * 1e3)
+                        progress(t, time.perf_counter() - run.wall0)
+                self._physics_step(run)
                 if cfg.realtime:
-                    lag = (t + dt) - (time.perf_counter() - wall0)
-                    if lag > 0:
-                        time.sleep(lag)
+                    self._pace(t + dt, run)
         finally:
             operator.close()
-        _add_after_run_columns(tick_log)
-        wall = time.perf_counter() - wall0
-        sim_t = (step + 1) * dt if not (self.fell and self.stop_on_fall) else float(fall_time or 0.0)
-        return SessionResult(tick_log, self.fell, fall_time, fall_reason, sim_t, wall, step + 1,
+        _add_after_run_columns(run.log)
+        wall = time.perf_counter() - run.wall0
+        sim_t = (step + 1) * dt if not (self.fell and self.stop_on_fall) else float(run.fall_time or 0.0)
+        return SessionResult(run.log, self.fell, run.fall_time, run.fall_reason, sim_t, wall, step + 1,
                              operator.rejected_frames, operator.dropped_joint_values,
-                             dict(self.bounds.counts), stage_ms, latency_ms,
+                             dict(self.bounds.counts), run.stage_ms, run.latency_ms,
                              isinstance(operator, OperatorPrefetch))
+
+    # ---- the parts of a run ----------------------------------------------------------------------------------
+    def _wait_while_paused(self, run: _RunState) -> None:
+        """Commands from viewers, and a pause: neither simulated time nor wall time of the run."""
+        self._service_commands()
+        if self.paused:
+            p0 = time.perf_counter()
+            while self.paused and not self.closed:
+                time.sleep(0.02)
+                self._service_commands()
+            run.wall0 += time.perf_counter() - p0
+
+    def _control_tick(self, t: float, operator: OperatorInline | OperatorPrefetch, run: _RunState) -> CharacterState:
+        """Operator side, motion optimisation and the controller's update for the control tick at ``t``."""
+        c0 = time.perf_counter()
+        frames = operator.poll(t)
+        for f in frames:
+            if "arrival_wall_s" in f.extras:
+                run.latency_ms.append((c0 - f.extras["arrival_wall_s"]) * 1e3)
+        self._watch_stream(bool(frames), t, run)
+        sample, analysis = operator.tick(t)
+        self.last_sample = sample
+        c1 = time.perf_counter()
+        state = self.backend.read_state(t)
+        ref = self.motion.update(sample, state, self.mass, analysis)
+        c2 = time.perf_counter()
+        self.controller.update(state, ref)
+        c3 = time.perf_counter()
+        run.stage_ms["processing"].append((c1 - c0) * 1e3)
+        run.stage_ms["motion"].append((c2 - c1) * 1e3)
+        run.stage_ms["control_update"].append((c3 - c2) * 1e3)
+        self._log(run.log, t, sample, state, ref, (c3 - c0) * 1e3)
+        if self.on_tick is not None:
+            self.on_tick(state, ref)
+        return state
+
+    def _watch_stream(self, got_frames: bool, t: float, run: _RunState) -> None:
+        """Watchdog: a live stream silent for longer than SILENT_STREAM_TIMEOUT_S ends the run."""
+        if got_frames:
+            run.last_frame_sim_s = t
+        elif t - run.last_frame_sim_s > SILENT_STREAM_TIMEOUT_S and self._source_is_live():
+            raise SourceError(f"operator stream silent for more than {SILENT_STREAM_TIMEOUT_S:.0f} s")
+
+    def _detect_fall(self, state: CharacterState, t: float, run: _RunState) -> bool:
+        """Record the first fall; whether the run ends here."""
+        reason = self._fall_reason(state)
+        if reason and not self.fell:
+            self.fell, run.fall_time, run.fall_reason = True, t, reason
+            log.warning("character fell at t=%.2f s (%s)", t, reason)
+        return self.fell and self.stop_on_fall
+
+    def _render_if_due(self, state: CharacterState, t: float, run: _RunState) -> None:
+        """The rendered strip: an output of the run, not part of the pipeline's time."""
+        if run.render_every_s is None or t < run.next_render_s or not hasattr(self.backend, "render_rgb"):
+            return
+        run.next_render_s += run.render_every_s
+        r0 = time.perf_counter()
+        com = self.mass.com(state)
+        self.renders.append((t, self.backend.render_rgb([com[0], com[1], 0.8])))  # type: ignore[attr-defined]
+        run.wall0 += time.perf_counter() - r0
+
+    def _physics_step(self, run: _RunState) -> None:
+        p0 = time.perf_counter()
+        fb = self.backend.read_joint_feedback() if self.controller.needs_joint_feedback else None
+        torques = self.controller.torques(fb)
+        self.last_torques = torques.values
+        self.backend.apply_torques(torques)
+        p1 = time.perf_counter()
+        self.backend.step()
+        p2 = time.perf_counter()
+        run.stage_ms["torques"].append((p1 - p0) * 1e3)
+        run.stage_ms["physics"].append((p2 - p1) * 1e3)
+
+    @staticmethod
+    def _pace(t_next: float, run: _RunState) -> None:
+        """Paced to the wall clock: wait until simulated time ``t_next`` is due."""
+        lag = t_next - (time.perf_counter() - run.wall0)
+        if lag > 0:
+            time.sleep(lag)
 
     def _source_is_live(self) -> bool:
         return bool(getattr(self.source, "live", False))
