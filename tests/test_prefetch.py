@@ -11,7 +11,7 @@ import pytest
 
 from stylesync.config import SessionConfig
 from stylesync.errors import SourceError
-from stylesync.motion.pose_optimization import analyse_operator
+from stylesync.motion.operator_analysis import analyse_operator
 from stylesync.prefetch import OperatorPrefetch, pack, unpack
 from stylesync.processing.operator_processing import OperatorProcessing
 from stylesync.session import Session, control_tick_steps

@@ -26,7 +26,7 @@ from multiprocessing.connection import Connection
 import numpy as np
 
 from stylesync.errors import SourceError
-from stylesync.motion.pose_optimization import UPPER_JOINTS, OperatorAnalysis, analyse_operator
+from stylesync.motion.operator_analysis import UPPER_JOINTS, OperatorAnalysis, analyse_operator
 from stylesync.motion.style_features import ROW_NAMES, StyleFeatures
 from stylesync.processing.joint_map import TRACKED_ORIENTATIONS, TRACKED_POSITIONS
 from stylesync.processing.operator_processing import OperatorProcessing, OperatorSample

@@ -17,8 +17,6 @@ Per control tick, from the smoothed operator sample and the character's current 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from stylesync import rotations as rot
@@ -36,9 +34,10 @@ from stylesync.model.character import (
     canonical_quat_from_model,
 )
 from stylesync.model.state import CharacterState, MassProperties
-from stylesync.motion.balance_strategy import level_root, stance_hip_blend, swing_hip_feedback
+from stylesync.motion.balance_strategy import stance_hip_blend, swing_hip_feedback
 from stylesync.motion.bounds import BoundsMonitor, step_length_bound_m
 from stylesync.motion.leg_ik import solve_leg
+from stylesync.motion.operator_analysis import UPPER_JOINTS, OperatorAnalysis, analyse_operator, upper_local
 from stylesync.motion.reference import LipmMap, ReferencePose
 from stylesync.motion.stance_fsm import (
     CharacterStanceFsm,
@@ -47,10 +46,9 @@ from stylesync.motion.stance_fsm import (
     stance_weights,
     swing_side,
 )
-from stylesync.motion.style_features import StyleExtractor, StyleFeatures
 from stylesync.processing.body_parameters import leg_length_m
 from stylesync.processing.interpolation import smooth_step
-from stylesync.processing.joint_map import hinge_angle, local_rotations
+from stylesync.processing.joint_map import hinge_angle
 from stylesync.processing.operator_processing import OperatorSample
 
 _MIN_AXIS_SPREAD_M = 0.08
@@ -67,9 +65,7 @@ _VELOCITY_SMOOTHING = 0.2  # per tick, exponential average of the desired COM ve
 _SIDE_UP = {"left": "LEFT", "right": "RIGHT"}
 _OTHER_SIDE = {"left": "right", "right": "left"}
 _LINK = {n: i for i, n in enumerate(LINK_NAMES)}
-UPPER_JOINTS = ("chest", "neck", "left_shoulder", "right_shoulder", "left_elbow", "right_elbow")  # joint map
 CHAR_LEG_LENGTH_M = THIGH_LENGTH_M + SHANK_LENGTH_M
-_STYLE = StyleExtractor()  # stateless
 
 
 def _heading_frame_fraction(p_h, al_h, ar_h, al_c, ar_c, scale: float, R: np.ndarray) -> np.ndarray:
@@ -105,38 +101,6 @@ class _SmoothedRate:
             self._rate += _VELOCITY_SMOOTHING * ((x - self._prev) / self.dt_s - self._rate)
         self._prev = np.array(x, dtype=float)
         return self._rate.copy()
-
-
-@dataclass(frozen=True)
-class OperatorAnalysis:
-    """What the motion stage reads from one operator sample alone, without the character: it can be computed
-    ahead of the control tick (prefetch.py) and is the same wherever it is computed."""
-
-    features: StyleFeatures  # Sec. 5.2
-    root_quat_wxyz: np.ndarray  # the level root with the operator's heading H (Sec. 5.4)
-    upper_local_wxyz: np.ndarray  # (len(UPPER_JOINTS), 4) joint-map local rotations, chest against that root
-    leg_m: float  # the operator's leg length, Eq. 1 [m]
-
-
-def operator_features(s: OperatorSample) -> StyleFeatures:
-    """The style features F of Sec. 5.2 of one operator sample."""
-    hip = {k: s.pos[f"HIP_{v}"] for k, v in _SIDE_UP.items()}
-    knee = {k: s.pos[f"KNEE_{v}"] for k, v in _SIDE_UP.items()}
-    ankle = {k: s.pos[f"ANKLE_{v}"] for k, v in _SIDE_UP.items()}
-    shank = {k: s.quat[f"KNEE_{v}"] for k, v in _SIDE_UP.items()}
-    foot = {k: s.quat[f"ANKLE_{v}"] for k, v in _SIDE_UP.items()}
-    return _STYLE(hip, knee, ankle, shank, foot, s.com_world, s.quat["PELVIS"])
-
-
-def _upper_local(s: OperatorSample, root_quat_wxyz: np.ndarray) -> np.ndarray:
-    """The upper body's joint-map rotations; the chest keeps the operator's torso orientation in the world."""
-    return local_rotations(s.quat, UPPER_JOINTS, {"chest": root_quat_wxyz})
-
-
-def analyse_operator(s: OperatorSample) -> OperatorAnalysis:
-    features = operator_features(s)
-    q_root = level_root(features.H)
-    return OperatorAnalysis(features, q_root, _upper_local(s, q_root), leg_length_m(s.pos, ankle_height_m=0.0))
 
 
 class MotionOptimizer:
@@ -357,7 +321,7 @@ class MotionOptimizer:
             local[f"{side}_ankle"] = rot.multiply(swing_ik, twist_now)
 
         # Upper body from the joint map; the chest keeps the operator's torso orientation in the world.
-        upper = analysis.upper_local_wxyz if s is sample else _upper_local(s, q_root_d)
+        upper = analysis.upper_local_wxyz if s is sample else upper_local(s, q_root_d)
         for j, q in zip(UPPER_JOINTS, upper, strict=True):
             if j.endswith("elbow"):
                 knee_angle[j] = hinge_angle(q, j)
