@@ -17,6 +17,8 @@ Per control tick, from the smoothed operator sample and the character's current 
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+
 import numpy as np
 
 from stylesync import rotations as rot
@@ -103,6 +105,39 @@ class _SmoothedRate:
         return self._rate.copy()
 
 
+@dataclass
+class _Tick:
+    """What the steps of one motion tick hand each other (world frame, metres; ``_h`` the operator, ``_c`` the
+    character, ``_d`` a target)."""
+
+    sample: OperatorSample  # this tick's operator sample
+    s: OperatorSample  # the sample the reference follows (the held one during a late contact)
+    analysis: OperatorAnalysis
+    op_state: Stance
+    ch_state: Stance
+    contact: dict[str, bool]
+    op_leg_m: float = 0.0
+    scale: float = 1.0  # h_C / h_H, Eq. 9
+    q_root_d: np.ndarray = field(default_factory=lambda: np.array([1.0, 0.0, 0.0, 0.0]))
+    R_root_d: np.ndarray = field(default_factory=lambda: np.eye(3))
+    a_h: dict[str, np.ndarray] = field(default_factory=dict)  # operator ankles
+    a_c: dict[str, np.ndarray] = field(default_factory=dict)  # character ankles
+    p_h: np.ndarray = field(default_factory=lambda: np.zeros(3))  # operator pelvis
+    com_h: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    com_c: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    com_vel_c: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    com_vel_h: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    ankle_h_z: float = 0.0
+    pelvis_d: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    com_d: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    com_vel_d: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    weights: dict[str, float] = field(default_factory=dict)  # stance weights
+    swing: str | None = None
+    targets: dict[str, np.ndarray] = field(default_factory=dict)  # ankle targets
+    foot_yaw: dict[str, float] = field(default_factory=dict)
+    step_exceeded: bool = False
+
+
 class MotionOptimizer:
     def __init__(self, cfg: MotionConfig, control_hz: float, bounds: BoundsMonitor | None = None,
                  gravity_mps2: float = 9.8):
@@ -130,12 +165,22 @@ class MotionOptimizer:
 
     def update(self, sample: OperatorSample, state: CharacterState, mass: MassProperties,
                analysis: OperatorAnalysis | None = None) -> ReferencePose:
-        """The reference pose of one control tick. ``analysis``: :func:`analyse_operator` of ``sample`` if it was
-        computed ahead (prefetch.py); None computes it here."""
-        cfg = self.cfg
+        """The reference pose of one control tick, in the steps of the module's notes. ``analysis``:
+        :func:`analyse_operator` of ``sample`` if it was computed ahead (prefetch.py); None computes it here."""
         if analysis is None:
             analysis = analyse_operator(sample)
-        features = analysis.features
+        tick = self._track_stance(sample, state, analysis)
+        self._retarget_lower_body(tick, state, mass)
+        self._plan_feet(tick, state)
+        local, hinge = self._solve_legs(tick, state)
+        self._map_upper_body(tick, local, hinge)
+        return self._reference(tick, state, local, hinge)
+
+    # ---- 1. stance tracking (Sec. 5.1) ---------------------------------------------------------------------
+    def _track_stance(self, sample: OperatorSample, state: CharacterState,
+                      analysis: OperatorAnalysis) -> _Tick:
+        """Both stance FSMs, the operator's swing time, and the sample the reference follows (held while the
+        character waits for a late contact)."""
         op_state = self.op_fsm.update(sample.pos["ANKLE_LEFT"][2], sample.pos["ANKLE_RIGHT"][2])
         contact = state.feet_pressing()
         ch_state = self.char_fsm.update(op_state, contact, state.time_s)
@@ -149,34 +194,36 @@ class MotionOptimizer:
         else:
             s = sample
             self._held = sample
+        return _Tick(sample=sample, s=s, analysis=analysis, op_state=op_state, ch_state=ch_state, contact=contact)
 
+    # ---- 2. lower-body retargeting (Eq. 9-10) ----------------------------------------------------------------
+    def _retarget_lower_body(self, tick: _Tick, state: CharacterState, mass: MassProperties) -> None:
+        """The operator's size (Eq. 1, 9), then the pelvis and COM targets retargeted onto the character's feet."""
+        s, analysis = tick.s, tick.analysis
         # Operator size: leg length by Eq. 1, smoothed; scale = h_C / h_H (Eq. 9).
-        leg = analysis.leg_m if s is sample else leg_length_m(s.pos, ankle_height_m=0.0)
+        leg = analysis.leg_m if s is tick.sample else leg_length_m(s.pos, ankle_height_m=0.0)
         op_leg_m = leg if self._op_leg_m is None else self._op_leg_m + _SCALE_SMOOTHING * (leg - self._op_leg_m)
         self._op_leg_m = op_leg_m
         scale = CHAR_LEG_LENGTH_M / op_leg_m
+        tick.op_leg_m, tick.scale = op_leg_m, scale
 
-        heading = features.H
-        q_root_d = analysis.root_quat_wxyz
-        R_root_d = rot.matrix_from_quat(q_root_d)
-        a_h = {k: s.pos[f"ANKLE_{v}"] for k, v in _SIDE_UP.items()}
+        tick.q_root_d = analysis.root_quat_wxyz
+        R_root_d = tick.R_root_d = rot.matrix_from_quat(tick.q_root_d)
+        a_h = tick.a_h = {k: s.pos[f"ANKLE_{v}"] for k, v in _SIDE_UP.items()}
         # The operator's feet the horizontal retargeting of Eq. 10 is anchored on: floor-filtered, as his COM
         # (operator_processing.py).
         a_hs = s.support_ankle_world
-        a_c = {k: state.link_origin_world[_LINK[f"{k}_ankle"]].copy() for k in _SIDE_UP}
-        # Planted feet are flat on the (level) ground: their ankle height is the model's, not the measured one,
-        # which rises when a foot rolls and would feed back into the pelvis height of Eq. 9.
-        a_plant = {k: np.array([v[0], v[1], ANKLE_HEIGHT_M]) for k, v in a_c.items()}
-        ankle_c_z = ANKLE_HEIGHT_M
-        p_h = s.pos["PELVIS"]
-        com_h = s.com_world
-        com_c, com_vel_c = mass.com(state), mass.com_velocity(state)
+        a_c = tick.a_c = {k: state.link_origin_world[_LINK[f"{k}_ankle"]].copy() for k in _SIDE_UP}
+        p_h = tick.p_h = s.pos["PELVIS"]
+        com_h = tick.com_h = s.com_world
+        com_c = tick.com_c = mass.com(state)
+        tick.com_vel_c = mass.com_velocity(state)
 
         # Lower-body retargeting (Eq. 9-10) for the pelvis and the COM, anchored on the feet the operator stands
         # on (on the character's stance while a late contact holds the reference): after an early contact
         # (Sec. 5.1) the character is in double stance while the operator still swings a foot, whose position
         # says nothing of where his body is over the ground.
-        anchor = ch_state if self.char_fsm.hold_reference else op_state
+        anchor = tick.ch_state if self.char_fsm.hold_reference else tick.op_state
         if anchor is Stance.DS:
             pelvis_xy = _heading_frame_fraction(p_h, a_hs["left"], a_hs["right"], a_c["left"], a_c["right"],
                                                 scale, R_root_d)
@@ -188,6 +235,7 @@ class MotionOptimizer:
             pelvis_xy = a_c[st] + scale * (p_h - a_hs[st])
             com_xy = a_c[st] + scale * (com_h - a_hs[st])
             ankle_h_z = a_h[st][2]
+        tick.ankle_h_z = ankle_h_z
         # A change of stance changes the anchor of Eq. 10 (the fraction between the feet, or the stance foot); the
         # operator's and the character's feet are never placed exactly alike, so the targets would jump. The jump
         # is taken up as an offset that decays with ANCHOR_BLEND_S.
@@ -198,95 +246,114 @@ class MotionOptimizer:
         pelvis_xy = np.array([*(pelvis_xy[:2] + self._anchor_offset[0]), 0.0])
         com_xy = np.array([*(com_xy[:2] + self._anchor_offset[1]), 0.0])
         self._last_xy = np.array([pelvis_xy[:2], com_xy[:2]])
-        pelvis_d = np.array([pelvis_xy[0], pelvis_xy[1], ankle_c_z + scale * (p_h[2] - ankle_h_z)])  # Eq. 9
+        tick.pelvis_d = np.array([pelvis_xy[0], pelvis_xy[1], ANKLE_HEIGHT_M + scale * (p_h[2] - ankle_h_z)])  # Eq. 9
         # The operator's COM height reflects his own mass distribution, not the character's: the vertical is left
         # to the pelvis height (Eq. 9) through the leg IK, and the COM target keeps the character's own height.
-        com_d = np.array([com_xy[0], com_xy[1], com_c[2]])
+        tick.com_d = np.array([com_xy[0], com_xy[1], com_c[2]])
         # The desired COM velocity is the rate of change of this target (smoothed), not the operator's own COM
         # velocity scaled: the two differ whenever the feet the target is anchored on differ (a foot the operator
         # slides or places elsewhere), and a velocity target that disagrees with the position target drives the
         # COM past it.
-        com_vel_d = self._com_d_rate(com_d)
+        com_vel_d = self._com_d_rate(tick.com_d)
         com_vel_d[2] = 0.0
-        com_vel_h = self._com_h_rate(com_h)
+        tick.com_vel_d = com_vel_d
+        tick.com_vel_h = self._com_h_rate(com_h)
 
-        # Leg IK in the motion plane N, feet flat (Sec. 5.3) and the balance strategy (Sec. 5.4).
-        weights = stance_weights(ch_state, self._ds_left_share(com_c, a_c))
-        sw = swing_side(ch_state)
-        local: dict[str, np.ndarray] = {}
-        knee_angle: dict[str, float] = {}
-        step_exceeded = False
-        q_cur = state.joint_pos
-        # Foot targets: a planted foot where it is, the swing foot where the operator's is.
-        targets: dict[str, np.ndarray] = {}
-        foot_yaw: dict[str, float] = {}
+    # ---- 3. foot targets: planted feet, swing-foot planning (Eq. 28) -----------------------------------------
+    def _plan_feet(self, tick: _Tick, state: CharacterState) -> None:
+        """A planted foot where it is, the swing foot where the operator's is; the pelvis lowered as far as a
+        foot that must land needs."""
+        tick.weights = stance_weights(tick.ch_state, self._ds_left_share(tick.com_c, tick.a_c))
+        sw = tick.swing = swing_side(tick.ch_state)
         for side in ("left", "right"):
-            other = _OTHER_SIDE[side]
             if side == sw:
-                # Where the operator's foot is, scaled, relative to the character's body ("pelvis": from its
-                # pelvis as his is from his; no balance feedback, as Sec. 7.2's c_d = c_v = 0), or
-                # ("capture_point") relative to the stance foot as his is to his, moved as the swing proceeds
-                # towards where the foot lands relative to the character's capture point (COM + v / ω,
-                # ω = sqrt(g / h), the LIPM of Eq. 21) as his does relative to his, within the landing limits:
-                # a character slower or faster than the operator steps shorter or further, as far as it needs to
-                # stop over its feet (a foot-position form of Eq. 12's feedback). The move grows with the swing's
-                # progress (its time over the operator's last swing time): at lift-off the foot is behind the
-                # body, and the full move would pull it further back.
-                target = pelvis_d + scale * (a_h[side] - p_h)
-                if cfg.swing_placement == "capture_point":
-                    from_stance = a_c[other] + scale * (a_h[side] - a_h[other])
-                    xi_c = com_c + com_vel_c * np.sqrt(max(com_c[2], 0.1) / self.g)
-                    h_h = max(com_h[2] - ankle_h_z + ANKLE_HEIGHT_M / scale, 0.1)
-                    xi_h = com_h + com_vel_h * np.sqrt(h_h / self.g)
-                    land = R_root_d.T @ (scale * (a_h[side] - xi_h))  # heading frame, from the capture point
-                    land[0] = min(land[0], -cfg.step_behind_capture_point_m)
-                    out = 1.0 if side == "left" else -1.0
-                    land[1] = out * min(max(out * land[1], cfg.step_outside_capture_point_m[0]),
-                                        cfg.step_outside_capture_point_m[1])
-                    progress = smooth_step((state.time_s - self._swing_t0_s) / self._op_swing_s)
-                    target[:2] = (from_stance + progress * (xi_c + R_root_d @ land - from_stance))[:2]
-                else:
-                    target[:2] = (state.root_pos_world + scale * (a_h[side] - p_h))[:2]
-                target[2] = min(max(target[2], ankle_c_z), ankle_c_z + cfg.max_swing_foot_lift_m)
-                if self.char_fsm.hold_reference:
-                    # Late contact (Sec. 5.1): the operator has landed, the character's foot has not. The held
-                    # reference keeps the foot where the operator put it, horizontally, and lowers it to the
-                    # ground (slightly below, so that it does touch).
-                    target[2] = ANKLE_HEIGHT_M - LATE_CONTACT_PRESS_M
-                bound = step_length_bound_m(CHAR_LEG_LENGTH_M, op_leg_m)  # Eq. 28
-                step = target[:2] - a_c[other][:2]
-                dist = float(np.linalg.norm(step))
-                step_exceeded = dist > bound
-                self.bounds.report("step_length", step_exceeded, state.time_s,
-                                   f"step {dist:.2f} m > bound {bound:.2f} m (Eq. 28)")
-                if step_exceeded:
-                    target[:2] = a_c[other][:2] + step * (bound / dist)
-                # The swing starts where the foot lifts off: the difference to the first target is taken up over
-                # SWING_BLEND_S (a target jump would swing the leg hard enough to lift the stance foot).
-                if self._swing != side:
-                    self._swing_offset = a_c[side][:2] - target[:2]
-                    self._swing_t0_s = state.time_s
-                self._swing_offset *= self._swing_decay
-                target[:2] += self._swing_offset
-                foot_yaw[side] = rot.twist_angle(s.quat[f"ANKLE_{_SIDE_UP[side]}"], _UP)
+                tick.targets[side] = self._swing_target(tick, state, side)
+                tick.foot_yaw[side] = rot.twist_angle(tick.s.quat[f"ANKLE_{_SIDE_UP[side]}"], _UP)
             else:
-                target = a_plant[side]
-                foot_yaw[side] = rot.twist_angle(state.link_quat_wxyz[_LINK[f"{side}_ankle"]], _UP)
-            targets[side] = target
+                # Planted feet are flat on the (level) ground: their ankle height is the model's, not the measured
+                # one, which rises when a foot rolls and would feed back into the pelvis height of Eq. 9.
+                a = tick.a_c[side]
+                tick.targets[side] = np.array([a[0], a[1], ANKLE_HEIGHT_M])
+                tick.foot_yaw[side] = rot.twist_angle(state.link_quat_wxyz[_LINK[f"{side}_ankle"]], _UP)
         self._swing = sw
         # A foot that has to reach the ground and does not touch it yet (a stance foot, or the swing foot held
         # for a late contact) must be within the leg's reach of its hip: the pelvis is lowered as far as that
         # needs. With the pelvis at the operator's height (Eq. 9) the legs are nearly straight, and a foot ahead
         # of the body could otherwise never land.
         for side, sign in (("left", 1.0), ("right", -1.0)):
-            must_land = weights[side] > 0 or (side == sw and self.char_fsm.hold_reference)
-            if must_land and not contact[side]:
-                hip_xy = (pelvis_d + R_root_d @ np.array([0.0, sign * HIP_HALF_WIDTH_M, 0.0]))[:2]
+            must_land = tick.weights[side] > 0 or (side == sw and self.char_fsm.hold_reference)
+            if must_land and not tick.contact[side]:
+                hip_xy = (tick.pelvis_d + tick.R_root_d @ np.array([0.0, sign * HIP_HALF_WIDTH_M, 0.0]))[:2]
                 reach = LANDING_REACH * CHAR_LEG_LENGTH_M
-                d2 = float(np.sum((targets[side][:2] - hip_xy) ** 2))
-                pelvis_d[2] = min(pelvis_d[2], targets[side][2] + float(np.sqrt(max(reach * reach - d2, 0.0))))
+                d2 = float(np.sum((tick.targets[side][:2] - hip_xy) ** 2))
+                tick.pelvis_d[2] = min(tick.pelvis_d[2],
+                                       tick.targets[side][2] + float(np.sqrt(max(reach * reach - d2, 0.0))))
+
+    def _swing_target(self, tick: _Tick, state: CharacterState, side: str) -> np.ndarray:
+        """Where the swing foot goes this tick.
+
+        Where the operator's foot is, scaled, relative to the character's body ("pelvis": from its pelvis as his
+        is from his; no balance feedback, as Sec. 7.2's c_d = c_v = 0), or ("capture_point") relative to the
+        stance foot as his is to his, moved as the swing proceeds towards where the foot lands relative to the
+        character's capture point (COM + v / ω, ω = sqrt(g / h), the LIPM of Eq. 21) as his does relative to his,
+        within the landing limits: a character slower or faster than the operator steps shorter or further, as far
+        as it needs to stop over its feet (a foot-position form of Eq. 12's feedback). The move grows with the
+        swing's progress (its time over the operator's last swing time): at lift-off the foot is behind the body,
+        and the full move would pull it further back.
+        """
+        cfg = self.cfg
+        other = _OTHER_SIDE[side]
+        a_h, a_c, scale, R_root_d = tick.a_h, tick.a_c, tick.scale, tick.R_root_d
+        target = tick.pelvis_d + scale * (a_h[side] - tick.p_h)
+        if cfg.swing_placement == "capture_point":
+            com_c, com_h = tick.com_c, tick.com_h
+            from_stance = a_c[other] + scale * (a_h[side] - a_h[other])
+            xi_c = com_c + tick.com_vel_c * np.sqrt(max(com_c[2], 0.1) / self.g)
+            h_h = max(com_h[2] - tick.ankle_h_z + ANKLE_HEIGHT_M / scale, 0.1)
+            xi_h = com_h + tick.com_vel_h * np.sqrt(h_h / self.g)
+            land = R_root_d.T @ (scale * (a_h[side] - xi_h))  # heading frame, from the capture point
+            land[0] = min(land[0], -cfg.step_behind_capture_point_m)
+            out = 1.0 if side == "left" else -1.0
+            land[1] = out * min(max(out * land[1], cfg.step_outside_capture_point_m[0]),
+                                cfg.step_outside_capture_point_m[1])
+            progress = smooth_step((state.time_s - self._swing_t0_s) / self._op_swing_s)
+            target[:2] = (from_stance + progress * (xi_c + R_root_d @ land - from_stance))[:2]
+        else:
+            target[:2] = (state.root_pos_world + scale * (a_h[side] - tick.p_h))[:2]
+        target[2] = min(max(target[2], ANKLE_HEIGHT_M), ANKLE_HEIGHT_M + cfg.max_swing_foot_lift_m)
+        if self.char_fsm.hold_reference:
+            # Late contact (Sec. 5.1): the operator has landed, the character's foot has not. The held reference
+            # keeps the foot where the operator put it, horizontally, and lowers it to the ground (slightly below,
+            # so that it does touch).
+            target[2] = ANKLE_HEIGHT_M - LATE_CONTACT_PRESS_M
+        bound = step_length_bound_m(CHAR_LEG_LENGTH_M, tick.op_leg_m)  # Eq. 28
+        step = target[:2] - a_c[other][:2]
+        dist = float(np.linalg.norm(step))
+        tick.step_exceeded = dist > bound
+        self.bounds.report("step_length", tick.step_exceeded, state.time_s,
+                           f"step {dist:.2f} m > bound {bound:.2f} m (Eq. 28)")
+        if tick.step_exceeded:
+            target[:2] = a_c[other][:2] + step * (bound / dist)
+        # The swing starts where the foot lifts off: the difference to the first target is taken up over
+        # SWING_BLEND_S (a target jump would swing the leg hard enough to lift the stance foot).
+        if self._swing != side:
+            self._swing_offset = a_c[side][:2] - target[:2]
+            self._swing_t0_s = state.time_s
+        self._swing_offset *= self._swing_decay
+        target[:2] += self._swing_offset
+        return target
+
+    # ---- 4. leg IK (Sec. 5.3) and balance strategy (Sec. 5.4) ------------------------------------------------
+    def _solve_legs(self, tick: _Tick, state: CharacterState) -> tuple[dict[str, np.ndarray], dict[str, float]]:
+        """Each leg's hip, knee and ankle: IK in the motion plane N, Eq. 11 on a stance hip, Eq. 12 on the swing
+        hip, feet flat. Returns local rotations (canonical) and hinge angles [rad]."""
+        cfg = self.cfg
+        local: dict[str, np.ndarray] = {}
+        knee_angle: dict[str, float] = {}
+        q_cur = state.joint_pos
+        sw, q_root_d, features = tick.swing, tick.q_root_d, tick.analysis.features
         for side, sign in (("left", 1.0), ("right", -1.0)):
-            hip_w = pelvis_d + R_root_d @ np.array([0.0, sign * HIP_HALF_WIDTH_M, 0.0])
+            hip_w = tick.pelvis_d + tick.R_root_d @ np.array([0.0, sign * HIP_HALF_WIDTH_M, 0.0])
             q_root_frame = q_root_d
             if side == sw:
                 # The swing leg is solved from where its hip actually is (as SIMBICON's world-frame swing hip):
@@ -296,19 +363,18 @@ class MotionOptimizer:
                 q_root_frame = state.root_quat_wxyz
             N = features.N_l if side == "left" else features.N_r
             other = _OTHER_SIDE[side]
-            target = targets[side]
-            ik = solve_leg(hip_w, target, THIGH_LENGTH_M, SHANK_LENGTH_M, N)
+            ik = solve_leg(hip_w, tick.targets[side], THIGH_LENGTH_M, SHANK_LENGTH_M, N)
             q_thigh = ik.thigh_quat_wxyz
             if side == sw:
-                q_thigh = swing_hip_feedback(q_thigh, np.zeros(3), com_c - a_c[other], np.zeros(3),
-                                             com_vel_c, cfg.swing_hip_cd, cfg.swing_hip_cv, heading)
+                q_thigh = swing_hip_feedback(q_thigh, np.zeros(3), tick.com_c - tick.a_c[other], np.zeros(3),
+                                             tick.com_vel_c, cfg.swing_hip_cd, cfg.swing_hip_cv, features.H)
             q_hip = rot.multiply(rot.conjugate(q_root_frame), q_thigh)
-            if weights[side] > 0 and ch_state is not Stance.DS:
+            if tick.weights[side] > 0 and tick.ch_state is not Stance.DS:
                 q_hip_cur = canonical_quat_from_model(q_cur[JOINT_NAMES.index(f"{side}_hip")])
                 q_hip = stance_hip_blend(q_hip, q_hip_cur, cfg.stance_hip_weight_w0)  # Eq. 11
             local[f"{side}_hip"] = q_hip
             knee_angle[f"{side}_knee"] = ik.knee_angle_rad
-            q_foot = rot.quat_from_yaw(foot_yaw[side])
+            q_foot = rot.quat_from_yaw(tick.foot_yaw[side])
             # Feet flat (Sec. 5.3). A planted foot on the IK's shank, which keeps the ankles' stiffness against
             # leaning; the swing foot on the actual shank, so that it is flat in the world whatever the swing leg's
             # tracking error, and lands on its sole rather than an edge it would roll over. The twist about the
@@ -319,37 +385,45 @@ class MotionOptimizer:
             swing_ik, _ = rot.swing_twist(q_ankle_ik, _UP)
             _, twist_now = rot.swing_twist(canonical_quat_from_model(q_cur[JOINT_NAMES.index(f"{side}_ankle")]), _UP)
             local[f"{side}_ankle"] = rot.multiply(swing_ik, twist_now)
+        return local, knee_angle
 
-        # Upper body from the joint map; the chest keeps the operator's torso orientation in the world.
-        upper = analysis.upper_local_wxyz if s is sample else upper_local(s, q_root_d)
+    # ---- 5. upper body (joint map) -----------------------------------------------------------------------------
+    def _map_upper_body(self, tick: _Tick, local: dict[str, np.ndarray], hinge: dict[str, float]) -> None:
+        """Upper body from the joint map; the chest keeps the operator's torso orientation in the world."""
+        s = tick.s
+        upper = tick.analysis.upper_local_wxyz if s is tick.sample else upper_local(s, tick.q_root_d)
         for j, q in zip(UPPER_JOINTS, upper, strict=True):
             if j.endswith("elbow"):
-                knee_angle[j] = hinge_angle(q, j)
+                hinge[j] = hinge_angle(q, j)
             else:
                 local[j] = q
 
+    def _reference(self, tick: _Tick, state: CharacterState, local: dict[str, np.ndarray],
+                   hinge: dict[str, float]) -> ReferencePose:
+        """The targets in the character's joint layout, with the LIPM map of Eq. 23 in single stance."""
+        q_cur = state.joint_pos
         joint_pos = np.zeros((len(JOINTS), 4))
         joint_pos[_BALL_JOINTS] = rot.batch_align_sign(
             batch_model_quat_from_canonical(np.array([local[JOINTS[k].name] for k in _BALL_JOINTS])),
             q_cur[_BALL_JOINTS])
         for k in _HINGE_JOINTS:
-            joint_pos[k, 0] = knee_angle[JOINTS[k].name]
-
+            joint_pos[k, 0] = hinge[JOINTS[k].name]
         lipm = None
-        if ch_state is not Stance.DS:
-            st = "left" if ch_state is Stance.LS else "right"
-            dh, dc = com_h - a_h[st], com_c - a_c[st]
+        if tick.ch_state is not Stance.DS:
+            st = "left" if tick.ch_state is Stance.LS else "right"
+            dh, dc = tick.com_h - tick.a_h[st], tick.com_c - tick.a_c[st]
             lipm = LipmMap(np.array([dh[0], dh[1], 0.0]), float(max(dh[2], 0.1)),
                            np.array([dc[0], dc[1], 0.0]), float(max(dc[2], 0.1)))
         # The operator's wrists relative to his pelvis in world axes, scaled, from the character's pelvis (hand tasks:
         # the hands go where his are around his body, whatever the lag of the body over the ground).
-        hands = {k: state.root_pos_world + scale * (s.pos[f"WRIST_{v}"] - p_h) for k, v in _SIDE_UP.items()}
+        hands = {k: state.root_pos_world + tick.scale * (tick.s.pos[f"WRIST_{v}"] - tick.p_h)
+                 for k, v in _SIDE_UP.items()}
         return ReferencePose(
-            time_s=state.time_s, joint_pos=joint_pos, root_quat_wxyz=q_root_d, pelvis_world=pelvis_d,
-            com_world=com_d,
-            com_vel_world=com_vel_d, operator_stance=op_state, character_stance=ch_state, stance_weight=weights,
-            ankle_world=a_c, lipm=lipm, operator_features=features, held=self.char_fsm.hold_reference,
-            scale=scale, step_bound_exceeded=step_exceeded, hand_world=hands,
+            time_s=state.time_s, joint_pos=joint_pos, root_quat_wxyz=tick.q_root_d, pelvis_world=tick.pelvis_d,
+            com_world=tick.com_d, com_vel_world=tick.com_vel_d, operator_stance=tick.op_state,
+            character_stance=tick.ch_state, stance_weight=tick.weights, ankle_world=tick.a_c, lipm=lipm,
+            operator_features=tick.analysis.features, held=self.char_fsm.hold_reference, scale=tick.scale,
+            step_bound_exceeded=tick.step_exceeded, hand_world=hands,
         )
 
     @staticmethod
