@@ -2,23 +2,23 @@
 
     python benchmarks/compare_controllers.py --baseline 9e63c3d --seeds 48
 
-The earlier version is checked out in a temporary git worktree and run in its own interpreter (PYTHONPATH at its
-src/), so both use their own code with this environment's libraries. Measured for each, alternately: the demo walk
-(seed 0: fall, steps, transition delays), the walk over sensor-noise seeds 0..N-1 for 12 s (runs that complete),
-standing 60 s (COM drift after settling), the control update's cost (median over the walk's ticks) and the
-realtime factor against physics alone, and the push experiment's limits. Figures are printed as a Markdown table.
+Both versions (HEAD and the baseline) are checked out in temporary git worktrees and run in their own interpreters
+(versions.py), so both use their own code with this environment's libraries. Measured for each, alternately: the
+demo walk (seed 0: fall, steps, transition delays), the walk over sensor-noise seeds 0..N-1 for 12 s (runs that
+complete), standing 60 s (COM drift after settling), the control update's cost (median over the walk's ticks) and
+the realtime factor against physics alone (the engine alone measured in this process). Figures are printed as a
+Markdown table.
 """
 
 from __future__ import annotations
 
 import argparse
-import json
-import subprocess
 import sys
-import tempfile
-from pathlib import Path
 
-REPO = Path(__file__).resolve().parents[1]
+from versions import checkouts, probe
+
+from stylesync.config import SessionConfig
+from stylesync.metrics.bench import physics_only_rtf
 
 # Run inside each version's interpreter: only APIs both versions share.
 _PROBE = r'''
@@ -55,47 +55,21 @@ print(json.dumps(out))
 '''
 
 
-def _probe(python_path: Path, what: str, arg: str) -> dict:
-    env = {"PYTHONPATH": str(python_path), "PATH": "/usr/bin:/bin"}
-    import os
-    env = {**os.environ, **env}
-    out = subprocess.run([sys.executable, "-c", _PROBE, what, arg], capture_output=True, text=True, env=env,
-                         check=True)
-    return json.loads(out.stdout.strip().splitlines()[-1])
-
-
-def _physics_alone_rtf(duration_s: float) -> float:
-    sys.path.insert(0, str(REPO / "benchmarks"))
-    from bench_pipeline import physics_only_rtf  # type: ignore[import-not-found]
-
-    from stylesync.config import SessionConfig
-
-    return float(physics_only_rtf(SessionConfig(duration_s=duration_s), duration_s))
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--baseline", default="9e63c3d", help="git ref of the earlier version")
     ap.add_argument("--seeds", type=int, default=48)
     ap.add_argument("--stand", type=float, default=60.0, help="simulated seconds of the standing run")
     args = ap.parse_args()
-    with tempfile.TemporaryDirectory() as tmp:
-        base = Path(tmp) / "baseline"
-        subprocess.run(["git", "-C", str(REPO), "worktree", "add", "--detach", str(base), args.baseline],
-                       check=True, capture_output=True)
-        try:
-            trees = {"this version": REPO / "src", f"baseline {args.baseline}": base / "src"}
-            rows: dict[str, dict] = {name: {"walks": [], "phys": []} for name in trees}
-            for seed in range(args.seeds):  # alternated, so that both see the machine's slow and fast spells
-                for name, path in trees.items():
-                    rows[name]["walks"].append(_probe(path, "walk", str(seed)))
-                print(f"seed {seed} done", file=sys.stderr, flush=True)
+    with checkouts({"this version": "HEAD", f"baseline {args.baseline}": args.baseline}) as trees:
+        rows: dict[str, dict] = {name: {"walks": [], "phys": []} for name in trees}
+        for seed in range(args.seeds):  # alternated, so that both see the machine's slow and fast spells
             for name, path in trees.items():
-                rows[name]["stand"] = _probe(path, "stand", str(args.stand))
-                rows[name]["phys"].append(_physics_alone_rtf(12.0))
-        finally:
-            subprocess.run(["git", "-C", str(REPO), "worktree", "remove", "--force", str(base)], check=False,
-                           capture_output=True)
+                rows[name]["walks"].append(probe(path, _PROBE, "walk", str(seed)))
+            print(f"seed {seed} done", file=sys.stderr, flush=True)
+        for name, path in trees.items():
+            rows[name]["stand"] = probe(path, _PROBE, "stand", str(args.stand))
+            rows[name]["phys"].append(physics_only_rtf(SessionConfig(duration_s=12.0), 12.0))
     print("| controller | walk seed 0 | steps (char/op) | max delay [s] | seeds completing 12 s | standing 60 s drift "
           "[cm] | control update p50 [ms] | realtime factor (walk) / physics alone |")
     print("|---|---|---|---|---|---|---|---|")

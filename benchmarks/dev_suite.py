@@ -16,16 +16,13 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
-import subprocess
 import sys
-import tempfile
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
+from versions import REPO, checkouts, probe
 
-REPO = Path(__file__).resolve().parents[1]
 SHARED = REPO.parent / "shared" / "mocap"
 # Category of each clip, from the clips' READMEs (../shared/mocap/*/README.md) and the humanoid3d clip names.
 CATEGORIES = {
@@ -85,16 +82,6 @@ def clip_specs() -> list[tuple[str, str, str]]:
     return [(spec, name, CATEGORIES.get(name, "other")) for spec, name in out]
 
 
-def probe(src: Path, spec: str, seed: int, duration: float) -> dict:
-    env = {**os.environ, "PYTHONPATH": str(src)}
-    out = subprocess.run([sys.executable, "-c", _PROBE, spec, str(seed), str(duration)], capture_output=True,
-                         text=True, env=env, timeout=900)
-    lines = [ln for ln in out.stdout.splitlines() if ln.startswith("{")]
-    if not lines:
-        return {"error": (out.stderr.strip().splitlines() or ["no output"])[-1][:200]}
-    return json.loads(lines[-1])
-
-
 def _share(k: int, n: int) -> str:
     return f"{100 * k / n:.0f} % ({k}/{n})" if n else "-"
 
@@ -142,29 +129,19 @@ def main() -> None:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     clips = clip_specs()
-    with tempfile.TemporaryDirectory() as tmp:
-        trees = {"this version": Path(tmp) / "head", f"baseline {args.baseline}": Path(tmp) / "baseline"}
-        refs = {"this version": "HEAD", f"baseline {args.baseline}": args.baseline}
-        for name, path in trees.items():
-            subprocess.run(["git", "-C", str(REPO), "worktree", "add", "--detach", str(path), refs[name]],
-                           check=True, capture_output=True)
-        try:
-            jobs = [(spec, name, cat, seed, v) for spec, name, cat in clips for seed in range(args.seeds)
-                    for v in trees]
+    refs = {"this version": "HEAD", f"baseline {args.baseline}": args.baseline}
+    with checkouts(refs) as trees:
+        jobs = [(spec, name, cat, seed, v) for spec, name, cat in clips for seed in range(args.seeds) for v in trees]
 
-            def run(job):
-                spec, name, cat, seed, v = job
-                r = probe(trees[v] / "src", spec, seed, args.duration)
-                status = r.get("error") or (f"fell {r['fall_time_s']:.2f} s" if r["fell"] else "complete")
-                print(f"{v:>20} {name:>32} seed {seed}: {status}", file=sys.stderr, flush=True)
-                return {"clip": name, "spec": spec, "category": cat, "seed": seed, "version": v, **r}
+        def run(job):
+            spec, name, cat, seed, v = job
+            r = probe(trees[v], _PROBE, spec, str(seed), str(args.duration))
+            status = r.get("error") or (f"fell {r['fall_time_s']:.2f} s" if r["fell"] else "complete")
+            print(f"{v:>20} {name:>32} seed {seed}: {status}", file=sys.stderr, flush=True)
+            return {"clip": name, "spec": spec, "category": cat, "seed": seed, "version": v, **r}
 
-            with ThreadPoolExecutor(max_workers=args.workers) as pool:
-                rows = list(pool.map(run, jobs))
-        finally:
-            for path in trees.values():
-                subprocess.run(["git", "-C", str(REPO), "worktree", "remove", "--force", str(path)], check=False,
-                               capture_output=True)
+        with ThreadPoolExecutor(max_workers=args.workers) as pool:
+            rows = list(pool.map(run, jobs))
     md = table(rows, list(trees))
     (out / "dev_suite.json").write_text(json.dumps(rows, indent=1))
     (out / "dev_suite.md").write_text(md + "\n")

@@ -118,14 +118,12 @@ class Session:
         self.bounds = BoundsMonitor()
         self.motion = MotionOptimizer(config.motion, config.clocks.control_hz, self.bounds,
                                       config.world.gravity_mps2)
-        body = self.backend.body_description()
-        self.model = CharacterModel(body, config.world.gravity_mps2)
+        self.model = CharacterModel(self.backend.body_description(), config.world.gravity_mps2)
         self.controller: ControllerBase
         if config.control.balance == "whole_body":
-            limits = {link.name: link.joint_limits_rad for link in body.links if link.joint_limits_rad is not None}
             self.controller = WholeBodyController(
                 config.control, self.model, self.mass, config.world.gravity_mps2, 1.0 / config.clocks.physics_hz,
-                1.0 / config.clocks.control_hz, self.bounds, config.world.friction, limits)
+                1.0 / config.clocks.control_hz, self.bounds, config.world.friction)
         else:
             self.controller = BalanceController(
                 config.control, self.model, self.mass, config.world.gravity_mps2, 1.0 / config.clocks.physics_hz,

@@ -10,7 +10,6 @@ its own last solution when the contact set changes back and forth during a walk.
 
 from __future__ import annotations
 
-import time
 from ctypes import c_int
 from dataclasses import dataclass
 
@@ -28,17 +27,15 @@ class QpResult:
     x: np.ndarray  # (n,) the solution
     iterations: int
     solved: bool
-    solve_ms: float
+    exitflag: int  # DAQP's exit flag (1, 2: optimal)
 
 
 class DaqpSolver:
     def __init__(self, iter_limit: int = 1000):
         self.iter_limit = iter_limit
         self._duals: dict[tuple[int, int], np.ndarray] = {}  # the last multipliers per problem size
-        self.iterations: list[int] = []
 
     def solve(self, p: QpProblem) -> QpResult:
-        t0 = time.perf_counter()
         n_eq = len(p.A)
         a = np.vstack([p.A, p.C])
         upper = np.concatenate([p.b, p.u])
@@ -54,8 +51,7 @@ class DaqpSolver:
             self._duals[key] = np.asarray(info["lam"], dtype=float)
         else:
             self._duals.pop(key, None)
-        self.iterations.append(int(info["iterations"]))
-        return QpResult(np.asarray(x, dtype=float), int(info["iterations"]), solved, (time.perf_counter() - t0) * 1e3)
+        return QpResult(np.asarray(x, dtype=float), int(info["iterations"]), solved, int(exitflag))
 
     def reset(self) -> None:
         self._duals.clear()

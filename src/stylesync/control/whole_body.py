@@ -21,6 +21,8 @@ standing character toppled when it waved its arms and the walk fell within a sec
 
 from __future__ import annotations
 
+import logging
+
 import numpy as np
 
 from stylesync import rotations as rot
@@ -31,7 +33,7 @@ from stylesync.control.crvc import com_virtual_force, root_orientation_error, ro
 from stylesync.control.formulation import WholeBodyFormulation, hinge_limits
 from stylesync.control.model_compensation import bounded_lipm_sync_force
 from stylesync.control.pid import IS_BALL
-from stylesync.control.solver import DaqpSolver, QpResult
+from stylesync.control.solver import DaqpSolver
 from stylesync.control.stable_pd import flatten_joint_values, unflatten_joint_values
 from stylesync.control.tasks import CentroidalMomentumTask, FrameOrientationTask, FramePositionTask, JointPostureTask
 from stylesync.model.character import ANKLE_HEIGHT_M, LINK_NAMES, Q_WORLD_MODEL, ROOT_DOFS, SIDES
@@ -41,6 +43,7 @@ from stylesync.motion import bounds as bnd
 from stylesync.motion.reference import ReferencePose
 from stylesync.motion.stance_fsm import swing_side
 
+log = logging.getLogger("stylesync.control")
 _FOOT_LINK = {s: LINK_NAMES.index(f"{s}_ankle") for s in SIDES}
 # A stance foot not yet touching is aimed this far below the ground [m], with this weight against a joint's: with
 # 2 cm and 100 a landing foot bounced off and slid in double stance (docs/decisions.md, "Landing").
@@ -65,14 +68,14 @@ class WholeBodyController(ControllerBase):
 
     def __init__(self, cfg: ControlConfig, model: CharacterModel, mass: MassProperties, gravity_mps2: float,
                  physics_dt_s: float, control_dt_s: float, bounds: bnd.BoundsMonitor | None = None,
-                 friction: float = 0.9, joint_limits: dict[str, tuple[float, float]] | None = None):
+                 friction: float = 0.9):
         super().__init__(cfg, mass, gravity_mps2, physics_dt_s, control_dt_s, bounds, friction)
         self.wb = wb = cfg.whole_body
         self.model = model
         self._tau = Torques.zeros()  # held from one control tick to the next [N·m]
         omega, zeta = wb.joint_tracking_omega_rad_s, wb.joint_tracking_damping_ratio
         self.kp, self.kd = omega * omega, 2.0 * zeta * omega
-        self.formulation = WholeBodyFormulation(_TORQUE_LIMIT_FLAT, hinge_limits(joint_limits or {}),
+        self.formulation = WholeBodyFormulation(_TORQUE_LIMIT_FLAT, hinge_limits(model.joint_limits_rad),
                                                 wb.contact_velocity_gain, JOINT_LIMIT_HORIZON_S)
         f = self.formulation
         self.posture = f.add_task(JointPostureTask(wb.joint_tracking_weight, MIN_TRACKING_INERTIA_KGM2))
@@ -81,6 +84,8 @@ class WholeBodyController(ControllerBase):
         self.momentum = f.add_task(CentroidalMomentumTask(1.0, wb.momentum_moment_weight_per_m ** 2))
         self.foot_press = {s: f.add_task(FramePositionTask(f"{s}_foot_press", f"{s}_ankle", self.kp, self.kd,
                                                            FOOT_TASK_WEIGHT, axes=(2,))) for s in SIDES}
+        for task in self.foot_press.values():
+            task.target_world = np.array([0.0, 0.0, ANKLE_HEIGHT_M - GROUND_PRESS_M])
         self.hands = ({s: f.add_task(FramePositionTask(f"{s}_hand", HAND_FRAMES[s], wb.hand_task_kp,
                                                        wb.hand_task_kd, wb.hand_task_weight)) for s in SIDES}
                       if wb.hand_tasks else {})
@@ -89,8 +94,6 @@ class WholeBodyController(ControllerBase):
         self._hand_target: dict[str, np.ndarray] = {}  # the last tick's hand targets [m]
         self.contacts = {s: SoleContact(s, friction, mass.total_kg * gravity_mps2) for s in SIDES}
         self.solver = DaqpSolver()
-        self.last_qp: QpResult | None = None  # the last tick's solution (iterations, time)
-        self.qp_failures = 0  # ticks whose QP did not reach its tolerance (the best iterate was used)
 
     def update(self, state: CharacterState, ref: ReferencePose) -> None:
         cfg, wb = self.cfg, self.wb
@@ -147,7 +150,6 @@ class WholeBodyController(ControllerBase):
         for s, task in self.foot_press.items():
             ws = ref.stance_weight[s]
             task.active = (ws > 0 and w[s] <= 0) or (ref.held and s == swing)
-            task.target_world = np.array([0.0, 0.0, ANKLE_HEIGHT_M - GROUND_PRESS_M])
         for s, task in self.hands.items():
             task.active = ref.hand_world is not None
             if ref.hand_world is not None:
@@ -170,9 +172,9 @@ class WholeBodyController(ControllerBase):
             contacts.append(c)
         problem = self.formulation.build(model, contacts)
         result = self.solver.solve(problem)
-        self.last_qp = result
         if not result.solved:
-            self.qp_failures += 1
+            log.warning("t=%.2f s: the whole-body QP found no optimum (DAQP exit %d); its last iterate is used",
+                        state.time_s, result.exitflag)
         tau = unflatten_joint_values(self.formulation.torques(model, problem, result.x))
         tau[~IS_BALL, 1:] = 0.0
         self._tau = Torques(np.minimum(np.maximum(tau, -TORQUE_LIMIT), TORQUE_LIMIT))

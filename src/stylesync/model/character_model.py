@@ -130,6 +130,9 @@ class CharacterModel:
         if self.nv != N_DOFS:
             raise ConfigError(f"character model has {self.nv} DOFs, the character description {N_DOFS}")
         self.gravity_mps2 = gravity_mps2
+        # Position limits of the limited joints (the hinges), by joint name [rad]
+        self.joint_limits_rad: dict[str, tuple[float, float]] = {
+            link.name: link.joint_limits_rad for link in body.links if link.joint_limits_rad is not None}
         self.total_mass_kg = float(pin.computeTotalMass(self.model))
         self._frame_ids = {f.name: i for i, f in enumerate(self.model.frames)}
         self.link_frame_ids = [self._frame_ids[n] for n in LINK_NAMES]
