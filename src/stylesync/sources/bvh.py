@@ -14,7 +14,6 @@ in the rest pose. The floor is placed by :func:`place_on_floor`.
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 from typing import Any
 
@@ -24,6 +23,7 @@ from stylesync import rotations as rot
 from stylesync.errors import SourceError
 from stylesync.sources.base import read_json_file
 from stylesync.sources.frame import JOINT_INDEX, N_JOINTS
+from stylesync.sources.skeleton_names import match_by_name
 from stylesync.sources.skeleton_tracks import (
     REQUIRED_JOINTS,
     SEGMENT_DIRECTIONS,
@@ -33,38 +33,8 @@ from stylesync.sources.skeleton_tracks import (
     rest_corrections,
 )
 
-_SIDE_CANDIDATES: dict[str, tuple[str, ...]] = {
-    "HIP": ("{side}upleg", "{s}thigh", "{side}upperleg", "{side}thigh", "{side}hip"),
-    "KNEE": ("{side}leg", "{s}calf", "{side}lowerleg", "{side}shin", "{side}knee"),
-    "ANKLE": ("{side}foot", "{s}foot", "{side}ankle"),
-    "FOOT": ("{side}toebase", "{s}toe0", "{side}toes", "{side}toe", "{s}toe"),
-    "SHOULDER": ("{side}arm", "{s}upperarm", "{side}upperarm", "{side}shoulder"),
-    "ELBOW": ("{side}forearm", "{s}forearm", "{side}lowerarm", "{side}elbow"),
-    "WRIST": ("{side}wrist", "{side}hand", "{s}hand"),
-}
-_CENTRE_CANDIDATES: dict[str, tuple[str, ...]] = {
-    "PELVIS": ("hips", "pelvis", "hip", "root"),
-    "SPINE_CHEST": ("spine2", "chest2", "upperchest", "spine1", "chest", "spine"),
-    "NECK": ("neck", "lowerneck", "neck1"),
-    "HEAD": ("head",),
-}
 UNIT_SCALES_M: dict[str, float] = {"m": 1.0, "cm": 0.01, "mm": 0.001, "inch": 0.0254, "cmu": 0.056444}
 STATURE_RANGE_M = (1.0, 2.3)
-
-
-def name_candidates() -> dict[str, tuple[str, ...]]:
-    """Canonical joint -> normalised BVH joint names tried in order."""
-    out = dict(_CENTRE_CANDIDATES)
-    for side, s in (("left", "l"), ("right", "r")):
-        for part, patterns in _SIDE_CANDIDATES.items():
-            out[f"{part}_{side.upper()}"] = tuple(p.format(side=side, s=s) for p in patterns)
-    return out
-
-
-def normalise_name(name: str) -> str:
-    n = name.rsplit(":", 1)[-1].lower()
-    n = re.sub(r"^bip0*1", "", n)
-    return re.sub(r"[^a-z0-9]", "", n)
 
 
 def load_joint_map(path: str | Path) -> dict[str, str]:
@@ -77,21 +47,14 @@ def load_joint_map(path: str | Path) -> dict[str, str]:
     return data
 
 
-def match_joints(names: list[str], joint_map: dict[str, str] | None = None) -> dict[str, str]:
-    """Canonical joint -> BVH joint name, for the canonical joints found; raises when a required one is missing."""
-    by_norm: dict[str, str] = {}
-    for n in names:
-        by_norm.setdefault(normalise_name(n), n)
-    out: dict[str, str] = {}
-    for canon, cands in name_candidates().items():
-        for c in cands:
-            if c in by_norm:
-                out[canon] = by_norm[c]
-                break
+def match_joints(names: list[str], joint_map: dict[str, str] | None = None) -> dict[str, tuple[str, str]]:
+    """Canonical joint -> (BVH joint name, how it was matched), for the canonical joints found; raises, naming the
+    missing segments, when a required one is missing."""
+    out = match_by_name(names)
     for canon, bvh_name in (joint_map or {}).items():
         if bvh_name not in names:
             raise SourceError(f"joint map names '{bvh_name}' for {canon}, but the BVH has no such joint")
-        out[canon] = bvh_name
+        out[canon] = (bvh_name, "joint map")
     missing = [j for j in REQUIRED_JOINTS if j not in out]
     if missing:
         raise SourceError(f"unknown skeleton: no BVH joint found for {', '.join(missing)} (joints in file: "
@@ -110,7 +73,7 @@ def _axes_matrix(up_axis: int, up_sign: float) -> np.ndarray:
 
 def _parse_line_or_fail_at_eof(file: Any, line_number: int) -> tuple[int, list[str], tuple[Any, int, int, str]]:
     """bvhio's line reader, except that the end of the file raises instead of looping forever (bvhio 1.5.4 spins
-    on a truncated file)."""
+    on a truncated file) and that a joint name may hold spaces."""
     tokens: list[str] = []
     line = ""
     while not tokens:
@@ -119,6 +82,8 @@ def _parse_line_or_fail_at_eof(file: Any, line_number: int) -> tuple[int, list[s
         if line == "":
             raise SyntaxError(f"unexpected end of file at line {line_number}")
         tokens = line.strip().split()
+    if len(tokens) > 2 and tokens[0] in ("ROOT", "JOINT"):  # a name with spaces (3ds Max Biped: "Bip01 L Thigh")
+        tokens = [tokens[0], " ".join(tokens[1:])]
     return line_number, tokens, (file, line_number, len(line) - len(line.lstrip()) + len(tokens[0]), line)
 
 
@@ -177,9 +142,21 @@ class BvhRecording:
             raise SourceError(f"BVH file {p}: {n_frames} frames declared, motion data truncated")
         if not (np.all(np.isfinite(local_pos)) and np.all(np.isfinite(local_q)) and np.all(np.isfinite(offsets))):
             raise SourceError(f"BVH file {p} contains NaN or infinite values")
+        # End sites as joints named "<joint>End": the toe of a foot without toe joints (Poser/DAZ).
+        ends = [(f"{j.Name}End", i, np.array([j.EndSite.x, j.EndSite.y, j.EndSite.z], dtype=float))
+                for i, (j, _) in enumerate(joints) if not j.Children and getattr(j, "EndSite", None) is not None]
+        ends = [e for e in ends if e[0] not in names and np.all(np.isfinite(e[2])) and np.linalg.norm(e[2]) > 0]
+        if ends:
+            names = names + [e[0] for e in ends]
+            parent_index = parent_index + [e[1] for e in ends]
+            end_offsets = np.array([e[2] for e in ends])
+            offsets = np.vstack([offsets, end_offsets])
+            local_pos = np.concatenate([local_pos, np.repeat(end_offsets[:, None, :], n_frames, axis=1)])
+            local_q = np.concatenate([local_q, np.tile(rot.IDENTITY_WXYZ, (len(ends), n_frames, 1))])
         self.path = p
         self.joint_names = names
-        self.mapping = match_joints(names, joint_map)
+        self.matches = match_joints(names, joint_map)
+        self.mapping = {canon: n for canon, (n, _) in self.matches.items()}
         idx = {canon: names.index(n) for canon, n in self.mapping.items()}
 
         # Rest pose (all rotations identity): cumulative offsets, file units and axes.
@@ -191,6 +168,7 @@ class BvhRecording:
             while np.linalg.norm(rest[idx[distal]] - rest[idx[seg]]) < 1e-9 and parent_index[idx[seg]] >= 0:
                 idx[seg] = parent_index[idx[seg]]
                 self.mapping[seg] = names[idx[seg]]
+                self.matches[seg] = (names[idx[seg]], f"parent of {self.matches[seg][0]} (which sits on {distal})")
         ankles = 0.5 * (rest[idx["ANKLE_LEFT"]] + rest[idx["ANKLE_RIGHT"]])
         up_vec = rest[idx["HEAD"]] - ankles
         if up_axis is None:

@@ -1,0 +1,117 @@
+"""Skeleton naming conventions: names read as (side, segment), and renamed variants of one CMU clip give the same
+operator joints as the original."""
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from stylesync.errors import SourceError
+from stylesync.sources.bvh import BvhRecording, match_joints
+from stylesync.sources.skeleton_names import ParsedName, match_by_name, parse_name
+
+MOCAP = Path(__file__).resolve().parents[2] / "shared" / "mocap"
+needs_cmu = pytest.mark.skipif(not (MOCAP / "cmu").is_dir(),
+                               reason="../shared/mocap/cmu (CMU BVH clips) is not present")
+needs_cmu_dev = pytest.mark.skipif(not (MOCAP / "cmu-dev").is_dir(),
+                                   reason="../shared/mocap/cmu-dev (Poser/DAZ CMU clips) is not present")
+
+
+@pytest.mark.parametrize("name, side, word, helper", [
+    ("mixamorig:LeftUpLeg", "left", "upleg", False),
+    ("UpperLeg_L", "left", "upperleg", False),
+    ("LowerLeg_R", "right", "lowerleg", False),
+    ("Bip01 L Thigh", "left", "thigh", False),
+    ("thigh.L", "left", "thigh", False),
+    ("DEF-shin.R", "right", "shin", False),
+    ("lThighBend", "left", "thigh", False),
+    ("lThighTwist", "left", "thightwist", True),
+    ("rShldr", "right", "shldr", False),
+    ("CC_Base_L_Calf", "left", "calf", False),
+    ("J_Bip_C_Hips", None, "hips", False),
+    ("J_Bip_L_UpperArm", "left", "upperarm", False),
+    ("Armature|Spine2", None, "spine2", False),
+    ("lowerback", None, "lowerback", False),
+    ("lhand", "left", "hand", False),
+    ("rightforearm", "right", "forearm", False),
+    ("hip", None, "hip", False),
+    ("LHipJoint", "left", "hipjoint", False),
+    ("lFootEnd", "left", "footend", False),
+])
+def test_parse_name(name, side, word, helper):
+    assert parse_name(name) == ParsedName(side, word, helper)
+
+
+def test_first_ranked_synonym_wins_and_helpers_are_skipped():
+    # MotionBuilder: LeftShoulder is the clavicle, LeftArm the upper arm.
+    m = match_by_name(["Hips", "LeftShoulder", "LeftArm"])
+    assert m["SHOULDER_LEFT"][0] == "LeftArm" and m["PELVIS"][0] == "Hips"
+    # 3ds Max (CMU 131): LeftShoulder is the upper arm.
+    assert match_by_name(["Hips", "LeftCollar", "LeftShoulder"])["SHOULDER_LEFT"][0] == "LeftShoulder"
+    m = match_by_name(["lThighBend", "lThighTwist", "lShin"])
+    assert m["HIP_LEFT"][0] == "lThighBend" and m["KNEE_LEFT"][0] == "lShin"
+
+
+# Renamings of CMU 02_01's MotionBuilder names into the conventions users bring (toe, clavicle and neck joints kept).
+_SEGMENTS = {  # MotionBuilder name (side "Left"/"Right" or none) -> convention -> name pattern ({L}/{Left}: side)
+    "Hips": {"unity": "Hips", "poser": "hip", "blender": "pelvis", "biped": "Bip01 Pelvis", "vrm": "J_Bip_C_Hips"},
+    "UpLeg": {"unity": "UpperLeg_{L}", "poser": "{l}ThighBend", "blender": "thigh.{L}", "biped": "Bip01 {L} Thigh",
+              "vrm": "J_Bip_{L}_UpperLeg"},
+    "Leg": {"unity": "LowerLeg_{L}", "poser": "{l}Shin", "blender": "DEF-shin.{L}", "biped": "Bip01 {L} Calf",
+            "vrm": "J_Bip_{L}_LowerLeg"},
+    "Foot": {"unity": "Foot_{L}", "poser": "{l}Foot", "blender": "foot.{L}", "biped": "Bip01 {L} Foot",
+             "vrm": "J_Bip_{L}_Foot"},
+    "ToeBase": {"unity": "Toes_{L}", "poser": "{l}Toe", "blender": "toe.{L}", "biped": "Bip01 {L} Toe0",
+                "vrm": "J_Bip_{L}_ToeBase"},
+    "Arm": {"unity": "UpperArm_{L}", "poser": "{l}ShldrBend", "blender": "upper_arm.{L}",
+            "biped": "Bip01 {L} UpperArm", "vrm": "J_Bip_{L}_UpperArm"},
+    "ForeArm": {"unity": "LowerArm_{L}", "poser": "{l}ForearmBend", "blender": "forearm.{L}",
+                "biped": "Bip01 {L} Forearm", "vrm": "J_Bip_{L}_LowerArm"},
+    "Hand": {"unity": "Hand_{L}", "poser": "{l}Hand", "blender": "hand.{L}", "biped": "Bip01 {L} Hand",
+             "vrm": "J_Bip_{L}_Hand"},
+    "Shoulder": {"unity": "Shoulder_{L}", "poser": "{l}Collar", "blender": "shoulder.{L}",
+                 "biped": "Bip01 {L} Clavicle", "vrm": "J_Bip_{L}_Shoulder"},
+    "Spine": {"unity": "Spine", "poser": "abdomen", "blender": "spine", "biped": "Bip01 Spine", "vrm": "J_Bip_C_Spine"},
+    "Spine1": {"unity": "Chest", "poser": "chest", "blender": "chest", "biped": "Bip01 Spine1",
+               "vrm": "J_Bip_C_Chest"},
+    "Neck": {"unity": "Neck", "poser": "neck", "blender": "neck", "biped": "Bip01 Neck", "vrm": "J_Bip_C_Neck"},
+    "Head": {"unity": "Head", "poser": "head", "blender": "head", "biped": "Bip01 Head", "vrm": "J_Bip_C_Head"},
+}
+
+
+def _renamed(text: str, convention: str) -> str:
+    def one(m: re.Match) -> str:
+        kind, name = m.group(1), m.group(2)
+        side = next((s for s in ("Left", "Right") if name.startswith(s)), None)
+        base = name[len(side):] if side and name[len(side):] in _SEGMENTS else name
+        if base not in _SEGMENTS or (side is None and base != name):
+            return f"{kind} x_{name}"  # a joint the convention does not name (finger, hip joint, neck1)
+        pattern = _SEGMENTS[base][convention]
+        s = side or "Left"
+        return f"{kind} " + pattern.format(L=s[0], l=s[0].lower(), Left=s)
+    return re.sub(r"\b(ROOT|JOINT) (\S+)", one, text)
+
+
+@needs_cmu
+@pytest.mark.parametrize("convention", ["unity", "poser", "blender", "biped", "vrm"])
+def test_renamed_cmu_clip_gives_the_same_operator(tmp_path, convention):
+    original = (MOCAP / "cmu" / "02_01.bvh").read_text()
+    path = tmp_path / f"02_01_{convention}.bvh"
+    path.write_text(_renamed(original, convention))
+    ref, rec = BvhRecording(MOCAP / "cmu" / "02_01.bvh"), BvhRecording(path)
+    assert np.abs(rec.performer.pos_world - ref.performer.pos_world).max() < 1e-3  # [m], whole clip
+    assert np.abs(rec.performer.quat_wxyz - ref.performer.quat_wxyz).max() < 1e-6
+
+
+def test_missing_segments_are_named(tmp_path):
+    with pytest.raises(SourceError, match="KNEE_LEFT"):
+        match_joints(["Hips", "Spine", "Neck", "Head", "LeftUpLeg"])
+
+
+@needs_cmu_dev
+def test_every_shared_bvh_loads():
+    for path in sorted(MOCAP.glob("*/*.bvh")):
+        rec = BvhRecording(path)
+        assert 1.2 < rec.stature_m < 2.0, path.name
+        assert rec.performer.duration_s > 1.0, path.name
