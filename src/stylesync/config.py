@@ -253,6 +253,16 @@ class OperatorConfig:
     timestamp_jitter_s: float = 0.004  # sample-time jitter (1 sigma) [s]
     standing_lead_in_s: float = 1.0  # operator stands in the first frame's pose before the clip plays [s]
     start_ramp_s: float = 1.5  # a looping clip's strides grow from standing to full over this time [s]
+    # A recorded file (BVH, k4a JSON) starts the character in its first frame's pose and velocities
+    # (motion/initial_state.py) instead of the standing lead-in, and the operator holds the last frame for
+    # rest_after_clip_s while the character comes to rest (part of the run).
+    start_in_motion: bool = True
+    rest_after_clip_s: float = 3.0
+    # Started in motion, the character also takes the clip's velocities (DeepMimic's full reference-state
+    # initialisation). Off: measured on the shared walks, a character started at the clip's speed falls within 1 s
+    # on 5 of 6 (its COM ahead of the reference, which lags the operator by the processing delay), while one
+    # started at rest in the clip's pose accelerates behind the reference and walks the clip (docs/decisions.md).
+    start_with_clip_velocity: bool = False
 
     def __post_init__(self) -> None:
         _positive("OperatorConfig.height_m", self.height_m)
@@ -262,6 +272,7 @@ class OperatorConfig:
         _non_negative("OperatorConfig.timestamp_jitter_s", self.timestamp_jitter_s)
         _non_negative("OperatorConfig.standing_lead_in_s", self.standing_lead_in_s)
         _non_negative("OperatorConfig.start_ramp_s", self.start_ramp_s)
+        _non_negative("OperatorConfig.rest_after_clip_s", self.rest_after_clip_s)
 
 
 @dataclass(frozen=True)

@@ -22,10 +22,18 @@ from stylesync.control.controller import BalanceController, ControllerBase
 from stylesync.control.pid import joint_error
 from stylesync.control.whole_body import WholeBodyController
 from stylesync.errors import SourceError
-from stylesync.model.character import CHARACTER_LINKS, LINK_NAMES, OPERATOR_JOINTS, STANDING_ROOT_HEIGHT_M
+from stylesync.model.character import (
+    ANKLE_HEIGHT_M,
+    CHARACTER_LINKS,
+    LINK_NAMES,
+    OPERATOR_JOINTS,
+    STANDING_ROOT_HEIGHT_M,
+)
 from stylesync.model.character_model import CharacterModel
 from stylesync.model.state import CharacterState
 from stylesync.motion.bounds import BoundsMonitor
+from stylesync.motion.initial_state import initial_state
+from stylesync.motion.operator_analysis import analyse_operator
 from stylesync.motion.pose_optimization import MotionOptimizer
 from stylesync.motion.stance_fsm import Stance
 from stylesync.motion.style_features import ROW_NAMES as _FEATURES
@@ -35,6 +43,7 @@ from stylesync.processing.operator_processing import OperatorProcessing, Operato
 from stylesync.sim.backend import PhysicsBackend
 from stylesync.sim.factory import make_backend
 from stylesync.sources.base import OperatorSource
+from stylesync.sources.frame import OperatorFrame
 
 log = logging.getLogger("stylesync.session")
 FALL_ROOT_HEIGHT_M = 0.5  # a fall: pelvis below this height, or a non-foot link on the ground
@@ -177,8 +186,34 @@ class Session:
             raise SourceError("the operator source delivered no frame at start (t = 0 s)")
         for f in frames:
             self.processing.push(f)
+        if getattr(self.source, "starts_in_motion", False) and len(frames) > 1:
+            if self._start_in_motion(frames[-2], frames[-1]):
+                return
         f0 = frames[-1]
         self._stand_at(f0.pos("PELVIS"), f0.quat("PELVIS"))
+
+    def _start_in_motion(self, f0: OperatorFrame, f1: OperatorFrame) -> bool:
+        """The character in the operator's pose of frame ``f0`` (the reference-state initialisation of
+        motion/initial_state.py), its lower foot on the ground; with ``start_with_clip_velocity``, moving with the
+        velocities from ``f0`` to ``f1``. False when a frame lacks joints. A source that starts in motion delivers
+        both at t = 0 (sources/registry.py)."""
+        samples = []
+        for f in (f0, f1):
+            processing = OperatorProcessing(self.cfg.clocks, self.cfg.filters)
+            processing.push(f)
+            if not processing.ready:
+                return False
+            samples.append(processing.step(f.timestamp_s))
+        s0, s1 = samples
+        init = initial_state(s0, analyse_operator(s0), s1, analyse_operator(s1))
+        self.backend.reset(init.root_pos_world, init.root_quat_wxyz, init.joint_pos)
+        ankle_z = self.backend.read_state(0.0).link_origin_world[_LEG_LINKS[:, 2], 2]
+        root = init.root_pos_world + np.array([0.0, 0.0, ANKLE_HEIGHT_M + 0.002 - float(ankle_z.min())])
+        self.backend.reset(root, init.root_quat_wxyz, init.joint_pos)
+        if self.cfg.operator.start_with_clip_velocity:
+            self.backend.set_velocities(init.root_lin_vel_world, init.root_ang_vel_world, init.joint_vel)
+            self.motion.start_in_motion(self.mass.com_velocity(self.backend.read_state(0.0)), init.scale)
+        return True
 
     def run(self, progress: Callable[[float, float], None] | None = None,
             render_every_s: float | None = None) -> SessionResult:

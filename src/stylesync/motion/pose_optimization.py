@@ -98,6 +98,10 @@ class _SmoothedRate:
         self._prev: np.ndarray | None = None
         self._rate = np.zeros(3)
 
+    def seed(self, rate: np.ndarray) -> None:
+        """Start from this rate instead of rest (a character started in motion)."""
+        self._rate = np.array(rate, dtype=float)
+
     def __call__(self, x: np.ndarray) -> np.ndarray:
         if self._prev is not None:
             self._rate += _VELOCITY_SMOOTHING * ((x - self._prev) / self.dt_s - self._rate)
@@ -162,6 +166,14 @@ class MotionOptimizer:
         self._op_swing_s = OPERATOR_SWING_S  # the operator's swing time, averaged over his swings [s]
         self._op_state: Stance | None = None
         self._op_state_t0_s = 0.0
+
+    def start_in_motion(self, com_vel_world: np.ndarray, scale: float) -> None:
+        """The character starts moving at ``com_vel_world`` [m/s] with the operator (reference-state initialisation,
+        motion/initial_state.py): the desired COM velocity and the operator's (``com_vel_world / scale``, scale =
+        h_C / h_H) start from it, not from rest."""
+        v = np.array([com_vel_world[0], com_vel_world[1], 0.0])
+        self._com_d_rate.seed(v)
+        self._com_h_rate.seed(v / scale)
 
     def update(self, sample: OperatorSample, state: CharacterState, mass: MassProperties,
                analysis: OperatorAnalysis | None = None) -> ReferencePose:

@@ -24,6 +24,12 @@ class PhysicsBackend(ABC):
     ) -> None: ...
 
     @abstractmethod
+    def set_velocities(self, root_lin_vel_world: np.ndarray, root_ang_vel_world: np.ndarray,
+                       joint_vel: np.ndarray) -> None:
+        """Initial velocities after :meth:`reset`: root [m/s], [rad/s] (world), joints as
+        ``CharacterState.joint_vel``."""
+
+    @abstractmethod
     def mass_properties(self) -> MassProperties: ...
 
     @abstractmethod

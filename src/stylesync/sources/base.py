@@ -49,8 +49,10 @@ class RecordedSource(OperatorSource):
     Frames with non-finite values or going back in time are rejected, counted and logged, never passed on.
     """
 
-    def __init__(self, frames: list[OperatorFrame], name: str = "recorded"):
+    def __init__(self, frames: list[OperatorFrame], name: str = "recorded", starts_in_motion: bool = False):
         self.name = name
+        # The character starts in the first frame's pose and velocities (motion/initial_state.py), not standing.
+        self.starts_in_motion = starts_in_motion
         self.rejected_frames = 0
         clean: list[OperatorFrame] = []
         last_t = -np.inf

@@ -14,6 +14,7 @@ in the rest pose. The floor is placed by :func:`place_on_floor`.
 
 from __future__ import annotations
 
+import logging
 from pathlib import Path
 from typing import Any
 
@@ -35,6 +36,16 @@ from stylesync.sources.skeleton_tracks import (
 
 UNIT_SCALES_M: dict[str, float] = {"m": 1.0, "cm": 0.01, "mm": 0.001, "inch": 0.0254, "cmu": 0.056444}
 STATURE_RANGE_M = (1.0, 2.3)
+# Leading frames that blend from the skeleton's bind pose into the motion: converted files (the CMU Poser/DAZ
+# conversions, some CMU originals) write the bind pose as frame 0, some with a few frames of blend, joints sweeping
+# at 15-30 m/s relative to the pelvis, which no person did. Left out: leading frames, within the first
+# BIND_BLEND_MAX_S, whose largest joint move to the next frame (relative to the pelvis) exceeds both
+# BIND_BLEND_RATIO times the median move over the first BIND_BLEND_WINDOW_S and BIND_BLEND_MIN_MOVE_M.
+BIND_BLEND_RATIO = 3.0
+BIND_BLEND_WINDOW_S = 1.0
+BIND_BLEND_MAX_S = 0.25
+BIND_BLEND_MIN_MOVE_M = 0.01
+log = logging.getLogger("stylesync.sources")
 
 
 def load_joint_map(path: str | Path) -> dict[str, str]:
@@ -105,6 +116,22 @@ def _depth_first(root: Any) -> list[tuple[Any, int]]:
         me = len(out) - 1
         stack.extend((child, me) for child in reversed(joint.Children))
     return out
+
+
+def bind_blend_frames(pos: np.ndarray, frame_time_s: float) -> int:
+    """How many leading frames of (T, 32, 3) canonical joint positions [m] blend from a bind pose (see
+    BIND_BLEND_RATIO)."""
+    n_window = min(len(pos), int(round(BIND_BLEND_WINDOW_S / frame_time_s)) + 1)
+    if n_window < 4:
+        return 0
+    rel = pos[:n_window] - pos[:n_window, JOINT_INDEX["PELVIS"]][:, None]
+    moves = np.linalg.norm(np.diff(rel, axis=0), axis=-1).max(axis=1)  # largest joint move per frame [m]
+    limit = max(BIND_BLEND_RATIO * float(np.median(moves)), BIND_BLEND_MIN_MOVE_M)
+    n_max = min(int(BIND_BLEND_MAX_S / frame_time_s), len(moves) - 1)
+    n = 0
+    while n < n_max and moves[n] > limit:
+        n += 1
+    return n
 
 
 class BvhRecording:
@@ -223,5 +250,9 @@ class BvhRecording:
                 q_ours = rot.batch_multiply(rot.batch_multiply(qa, world_q[i]), qa_inv)
                 quat[:, k] = rot.batch_multiply(q_ours, np.tile(q_rest[canon], (T, 1)))
         fill_canonical(pos, quat, conf)
+        n_bind = self.bind_frames_skipped = bind_blend_frames(pos, frame_time)
+        if n_bind:
+            log.info("BVH file %s: %d leading frame(s) blend from a bind pose; left out", p, n_bind)
+            pos, quat, conf, T = pos[n_bind:], quat[n_bind:], conf[n_bind:], T - n_bind
         place_on_floor(pos)
         self.performer = TrackPerformer(np.arange(T) * frame_time, pos, quat, conf, name=f"bvh:{p.name}")

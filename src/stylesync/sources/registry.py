@@ -4,7 +4,9 @@ Specs: ``bvh:PATH``, ``k4a-json:PATH``, ``deepmimic:NAME|PATH`` (pybullet_data c
 ``builtin:NAME`` (same as the demo), ``vmc://HOST:PORT``, ``webcam:INDEX``, ``video:PATH``, ``k4a:DEVICE`` (live Azure
 Kinect). Recorded sources pass through the sensor model: ``kinect`` resamples to the mocap rate (16 Hz) with noise,
 jitter and dropouts from the seed; ``none`` passes the recorded frames at their own rate (the processing stage then
-interpolates from that rate). A recorded operator first holds its first pose for ``lead_in_s``.
+interpolates from that rate). A recorded file starts in motion (the character in the first frame's state) and ends
+with the operator holding the last frame for ``rest_after_clip_s``; with ``start_in_motion`` off, and for clips
+(deepmimic, builtin), the operator first holds the first pose for ``standing_lead_in_s``.
 """
 
 from __future__ import annotations
@@ -12,13 +14,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from stylesync.config import ClockConfig, OperatorConfig
 from stylesync.errors import SourceError
 from stylesync.sources.base import OperatorSource, RecordedSource
-from stylesync.sources.frame import OperatorFrame
+from stylesync.sources.frame import JOINT_INDEX, OperatorFrame
 from stylesync.sources.sensor_model import SensorModel
 
 SENSORS = ("kinect", "none")
+FEET_DOWN_S = 0.5  # a held last pose's raised foot is lowered onto the ground over this time [s]
 KINECT_DROPOUT_PROBABILITY = 0.002  # per joint and frame: occasional lost joints, as a depth sensor has
 
 
@@ -32,32 +37,58 @@ class OpenedSource:
 
 
 class _LeadIn:
-    """Holds a performer's first pose for ``lead_in_s`` seconds, then plays it."""
+    """Holds a performer's first pose for ``lead_in_s`` seconds, then plays it, then holds its last pose for
+    ``rest_s`` seconds."""
 
-    def __init__(self, performer, lead_in_s: float):
+    def __init__(self, performer, lead_in_s: float, rest_s: float = 0.0):
         self.performer, self.lead_in_s = performer, lead_in_s
-        self.duration_s = performer.duration_s + lead_in_s
+        self.duration_s = performer.duration_s + lead_in_s + rest_s
 
     def frame_at(self, t_s: float) -> OperatorFrame:
-        f = self.performer.frame_at(max(0.0, t_s - self.lead_in_s))
+        clip_t = t_s - self.lead_in_s
+        f = self.performer.frame_at(max(0.0, clip_t))
         f.timestamp_s = t_s
+        if clip_t > self.performer.duration_s:
+            x = min((clip_t - self.performer.duration_s) / FEET_DOWN_S, 1.0)
+            _put_feet_down(f, 0.5 - 0.5 * float(np.cos(np.pi * x)))  # from 0 to 1 with zero slope at both ends
         return f
+
+
+def _put_feet_down(f: OperatorFrame, fraction: float) -> None:
+    """In place: the operator holding a pose comes to rest on both feet. The higher foot (ankle, toe, and the knee
+    by half) is lowered by ``fraction`` of its height over the lower one, where it is over the ground: a clip that
+    ends mid-stride would otherwise leave the character standing on one leg for as long as the pose is held."""
+    z = {side: f.pos(f"ANKLE_{side}")[2] for side in ("LEFT", "RIGHT")}
+    low = min(z.values())
+    for side, ankle_z in z.items():
+        drop = fraction * (ankle_z - low)
+        for joint, share in (("ANKLE", 1.0), ("FOOT", 1.0), ("KNEE", 0.5)):
+            f.joint_pos_world[JOINT_INDEX[f"{joint}_{side}"], 2] -= share * drop
 
 
 def _recorded(performer, label: str, sensor: str, clocks: ClockConfig, op: OperatorConfig, seed: int,
               duration_s: float | None) -> OpenedSource:
-    lead = _LeadIn(performer, op.standing_lead_in_s)
+    if op.start_in_motion:
+        lead = _LeadIn(performer, 0.0, op.rest_after_clip_s)
+    else:
+        lead = _LeadIn(performer, op.standing_lead_in_s)
     total = lead.duration_s if duration_s is None else duration_s
     if sensor == "kinect":
         model = SensorModel.kinect(op, clocks, seed, KINECT_DROPOUT_PROBABILITY)
-        return OpenedSource(RecordedSource(model.sample(lead.frame_at, total), name=label), clocks.mocap_hz,
-                            lead.duration_s, label, lead)
-    if sensor != "none":
+        frames, rate = model.sample(lead.frame_at, total), clocks.mocap_hz
+    elif sensor == "none":
+        rate = getattr(performer, "rate_hz", 0.0) or clocks.mocap_hz
+        frames = [lead.frame_at(k / rate) for k in range(int(total * rate) + 1)]
+    else:
         raise SourceError(f"unknown sensor model '{sensor}'; expected one of {', '.join(SENSORS)}")
-    rate = getattr(performer, "rate_hz", 0.0) or clocks.mocap_hz
-    n = int(total * rate) + 1
-    frames = [lead.frame_at(k / rate) for k in range(n)]
-    return OpenedSource(RecordedSource(frames, name=label), rate, lead.duration_s, label, lead)
+    if op.start_in_motion:
+        # The run starts when the second frame arrives: the processing stage (Eq. 7) then moves from the first
+        # frame towards it, and the character starts in the first frame's state moving at the clip's velocity
+        # (session.py). Started at the first frame, the reference would hold still for a frame period.
+        for f in frames:
+            f.timestamp_s -= 1.0 / rate
+    return OpenedSource(RecordedSource(frames, name=label, starts_in_motion=op.start_in_motion), rate,
+                        lead.duration_s, label, lead)
 
 
 def open_source(spec: str, clocks: ClockConfig | None = None, operator: OperatorConfig | None = None,

@@ -1,0 +1,108 @@
+"""Reference-state initialisation: the character starts a recorded clip in the clip's own first pose and velocities.
+
+A recorded clip usually starts mid-motion (a walk mid-stride, a run at full speed). Starting the character standing
+and still, the clip would start at full speed against a body that is not moving (DeepMimic's "reference state
+initialisation" answers the same problem in training). Here the first operator samples are retargeted as the motion
+stage does, without the character's state:
+
+- root: level, with the operator's heading H (Sec. 5.4), at the operator's pelvis over the ground, at the height of
+  Eq. 9 above the lower of his ankles;
+- legs: the leg IK of Sec. 5.3 in the motion plane N of each leg, each ankle where the operator's is relative to
+  his pelvis, scaled (h_C / h_H, Eq. 9), never below the ground; feet flat with the operator's foot heading;
+- upper body: the joint map (as the motion stage).
+
+Velocities are the forward differences of two such poses: the root's linear velocity is the operator's pelvis
+velocity scaled by h_C / h_H (the character's strides are shorter by that ratio), angular velocities come from the
+relative rotations (world frame for the root, child frame for ball joints, as ``CharacterState.joint_vel``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from stylesync import rotations as rot
+from stylesync.model.character import (
+    ANKLE_HEIGHT_M,
+    HIP_HALF_WIDTH_M,
+    JOINTS,
+    SHANK_LENGTH_M,
+    THIGH_LENGTH_M,
+    JointKind,
+    batch_model_quat_from_canonical,
+)
+from stylesync.motion.leg_ik import solve_leg
+from stylesync.motion.operator_analysis import UPPER_JOINTS, OperatorAnalysis
+from stylesync.processing.joint_map import hinge_angle
+from stylesync.processing.operator_processing import OperatorSample
+
+_UP = np.array([0.0, 0.0, 1.0])
+_BALL = [k for k, j in enumerate(JOINTS) if j.kind is JointKind.BALL]
+_HINGE = [k for k, j in enumerate(JOINTS) if j.kind is not JointKind.BALL]
+CHAR_LEG_LENGTH_M = THIGH_LENGTH_M + SHANK_LENGTH_M
+
+
+@dataclass(frozen=True)
+class InitialState:
+    """A full character state (world frame, z up): root pose and velocities, joints in ``CharacterState`` layout."""
+
+    root_pos_world: np.ndarray  # (3,) [m]
+    root_quat_wxyz: np.ndarray  # (4,)
+    joint_pos: np.ndarray  # (n_joints, 4): ball joints model-frame quaternions, hinge angle [rad] in column 0
+    root_lin_vel_world: np.ndarray  # (3,) [m/s]
+    root_ang_vel_world: np.ndarray  # (3,) [rad/s]
+    joint_vel: np.ndarray  # (n_joints, 3): ball joints child-frame angular velocity [rad/s], hinge rate in column 0
+    scale: float  # h_C / h_H, Eq. 9
+
+
+def retargeted_pose(s: OperatorSample, analysis: OperatorAnalysis) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(root position [m], root quaternion, joint positions) of the character for one operator sample, the pelvis
+    over the ground at the operator's, scaled by h_C / h_H from the world origin (differences give velocities)."""
+    scale = CHAR_LEG_LENGTH_M / analysis.leg_m  # Eq. 9
+    q_root = analysis.root_quat_wxyz
+    R_root = rot.matrix_from_quat(q_root)
+    p_h = s.pos["PELVIS"]
+    ankles = {side: s.pos[f"ANKLE_{side.upper()}"] for side in ("left", "right")}
+    ankle_h_z = min(a[2] for a in ankles.values())
+    pelvis = np.array([scale * p_h[0], scale * p_h[1], ANKLE_HEIGHT_M + scale * (p_h[2] - ankle_h_z)])  # Eq. 9
+    local: dict[str, np.ndarray] = {}
+    hinge: dict[str, float] = {}
+    for side, sign in (("left", 1.0), ("right", -1.0)):
+        hip = pelvis + R_root @ np.array([0.0, sign * HIP_HALF_WIDTH_M, 0.0])
+        target = pelvis + scale * (ankles[side] - p_h)
+        target[2] = max(target[2], ANKLE_HEIGHT_M)
+        N = analysis.features.N_l if side == "left" else analysis.features.N_r
+        ik = solve_leg(hip, target, THIGH_LENGTH_M, SHANK_LENGTH_M, N)
+        local[f"{side}_hip"] = rot.multiply(rot.conjugate(q_root), ik.thigh_quat_wxyz)
+        hinge[f"{side}_knee"] = ik.knee_angle_rad
+        q_foot = rot.quat_from_yaw(rot.twist_angle(s.quat[f"ANKLE_{side.upper()}"], _UP))  # flat (Sec. 5.3)
+        local[f"{side}_ankle"] = rot.multiply(rot.conjugate(ik.shank_quat_wxyz), q_foot)
+    for j, q in zip(UPPER_JOINTS, analysis.upper_local_wxyz, strict=True):
+        if j.endswith("elbow"):
+            hinge[j] = hinge_angle(q, j)
+        else:
+            local[j] = q
+    joint_pos = np.zeros((len(JOINTS), 4))
+    joint_pos[_BALL] = batch_model_quat_from_canonical(np.array([local[JOINTS[k].name] for k in _BALL]))
+    for k in _HINGE:
+        joint_pos[k, 0] = hinge[JOINTS[k].name]
+    return pelvis, q_root, joint_pos
+
+
+def initial_state(s0: OperatorSample, a0: OperatorAnalysis, s1: OperatorSample, a1: OperatorAnalysis
+                  ) -> InitialState:
+    """The character's state at ``s0``, with velocities from the forward difference to ``s1`` (later)."""
+    dt = s1.time_s - s0.time_s
+    if not dt > 0:
+        raise ValueError("initial_state needs a second sample later than the first")
+    p0, q0, j0 = retargeted_pose(s0, a0)
+    p1, q1, j1 = retargeted_pose(s1, a1)
+    q1 = rot.align_sign(q1, q0)
+    ang_root = rot.rotvec_from_quat(rot.multiply(q1, rot.conjugate(q0))) / dt
+    joint_vel = np.zeros((len(JOINTS), 3))
+    for k in _BALL:
+        joint_vel[k] = rot.rotvec_from_quat(rot.multiply(rot.conjugate(j0[k]), rot.align_sign(j1[k], j0[k]))) / dt
+    joint_vel[_HINGE, 0] = (j1[_HINGE, 0] - j0[_HINGE, 0]) / dt
+    origin = np.array([s0.pos["PELVIS"][0] - p0[0], s0.pos["PELVIS"][1] - p0[1], 0.0])  # at the operator's pelvis
+    return InitialState(p0 + origin, q0, j0, (p1 - p0) / dt, ang_root, joint_vel, CHAR_LEG_LENGTH_M / a0.leg_m)
