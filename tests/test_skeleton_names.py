@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from stylesync.cli import main as cli_main
 from stylesync.errors import SourceError
 from stylesync.sources.bvh import BvhRecording, match_joints
 from stylesync.sources.skeleton_names import ParsedName, match_by_name, parse_name
@@ -115,3 +116,17 @@ def test_every_shared_bvh_loads():
         rec = BvhRecording(path)
         assert 1.2 < rec.stature_m < 2.0, path.name
         assert rec.performer.duration_s > 1.0, path.name
+
+
+@needs_cmu_dev
+def test_inspect_shows_the_map_and_names_what_is_missing(tmp_path, capsys):
+    assert cli_main(["inspect", str(MOCAP / "cmu-dev" / "02_02.bvh")]) == 0
+    out = capsys.readouterr().out
+    assert "KNEE_LEFT       <- lShin" in out and "up axis: +y" in out and "120.0 Hz" in out
+    bad = tmp_path / "one_joint.bvh"
+    bad.write_text("HIERARCHY\nROOT a\n{\nOFFSET 0 0 0\nCHANNELS 6 Xposition Yposition Zposition Zrotation "
+                   "Xrotation Yrotation\nEnd Site\n{\nOFFSET 0 1 0\n}\n}\nMOTION\nFrames: 1\nFrame Time: 0.1\n"
+                   "0 0 0 0 0 0\n")
+    assert cli_main(["inspect", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "KNEE_LEFT" in err and "HIP_RIGHT" in err

@@ -277,6 +277,25 @@ def _interrupt(signum: int, frame: object) -> None:
     raise KeyboardInterrupt
 
 
+def _inspect(args: argparse.Namespace) -> int:
+    """Print what the BVH reader understood of a file; a skeleton that cannot be mapped is an error (exit 2)."""
+    from stylesync.sources.bvh import BvhRecording, load_joint_map
+    from stylesync.sources.frame import JOINT_INDEX
+
+    jm = load_joint_map(args.joint_map) if args.joint_map else None
+    rec = BvhRecording(args.file, joint_map=jm, scale_m=args.bvh_scale, up_axis=args.up_axis)
+    perf = rec.performer
+    print(f"file: {rec.path}")
+    print(f"joints in file: {len(rec.joint_names)}; units: 1 file unit = {rec.scale_m:g} m; up axis: {rec.up_axis}; "
+          f"rest-pose stature {rec.stature_m:.2f} m")
+    print(f"frames: {len(perf.times_s)} at {1.0 / rec.frame_time_s:.1f} Hz, {perf.duration_s:.2f} s"
+          + (f" ({rec.bind_frames_skipped} leading bind-pose frames left out)" if rec.bind_frames_skipped else ""))
+    print("joint map (canonical <- file joint: how matched):")
+    for canon, (name, how) in sorted(rec.matches.items(), key=lambda kv: JOINT_INDEX[kv[0]]):
+        print(f"  {canon:15s} <- {name:24s} {how}")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="stylesync", description="Style-preserving humanoid teleoperation")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -311,6 +330,12 @@ def main(argv: list[str] | None = None) -> int:
     bench.add_argument("--out", default="out/bench", help="output folder (bench.md, bench.json)")
     bench.add_argument("--shared", help="folder holding mocap/cmu (default: ../shared beside the checkout)")
     bench.set_defaults(func=_bench)
+    inspect = sub.add_parser("inspect", help="show how a BVH file is understood: joint map, units, axes, frames")
+    inspect.add_argument("file", help="BVH file")
+    inspect.add_argument("--joint-map", help="JSON object canonical joint -> BVH joint name, overriding the matching")
+    inspect.add_argument("--bvh-scale", type=float, help="file units to metres (default: found from the stature)")
+    inspect.add_argument("--up-axis", help="the file's up axis, e.g. y or -z (default: found from the rest pose)")
+    inspect.set_defaults(func=_inspect)
     replay = sub.add_parser("replay", help="replay a session file (no re-simulation) into BVH and/or MP4")
     replay.add_argument("file", help="session file (.jsonl) written by run or demo")
     replay.add_argument("--speed", type=float, default=1.0, help="viewer playback speed (1 = real time)")

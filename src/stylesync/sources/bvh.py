@@ -215,6 +215,8 @@ class BvhRecording:
         if not (np.isfinite(scale_m) and scale_m > 0):
             raise SourceError(f"BVH scale to metres must be > 0, got {scale_m}")
         self.scale_m = float(scale_m)
+        self.up_axis = ("+" if sign > 0 else "-") + "xyz"[ax]  # the file's up axis
+        self.frame_time_s = frame_time
         self.stature_m = stature_units * self.scale_m
         A = _axes_matrix(ax, sign)
         q_axes = rot.quat_from_matrix(A)
