@@ -253,8 +253,8 @@ class OperatorConfig:
     timestamp_jitter_s: float = 0.004  # sample-time jitter (1 sigma) [s]
     standing_lead_in_s: float = 1.0  # operator stands in the first frame's pose before the clip plays [s]
     start_ramp_s: float = 1.5  # a looping clip's strides grow from standing to full over this time [s]
-    # A recorded file (BVH, k4a JSON) starts the character in its first frame's pose and velocities
-    # (motion/initial_state.py) instead of the standing lead-in, and the operator holds the last frame for
+    # A recorded file (BVH, k4a JSON) starts the character in its first frame's pose (motion/initial_state.py)
+    # instead of the standing lead-in, and the operator holds the last frame for
     # rest_after_clip_s while the character comes to rest (part of the run).
     start_in_motion: bool = True
     rest_after_clip_s: float = 3.0

@@ -212,7 +212,6 @@ class Session:
         self.backend.reset(root, init.root_quat_wxyz, init.joint_pos)
         if self.cfg.operator.start_with_clip_velocity:
             self.backend.set_velocities(init.root_lin_vel_world, init.root_ang_vel_world, init.joint_vel)
-            self.motion.start_in_motion(self.mass.com_velocity(self.backend.read_state(0.0)), init.scale)
         return True
 
     def run(self, progress: Callable[[float, float], None] | None = None,

@@ -30,17 +30,15 @@ from stylesync.model.character import (
     SHANK_LENGTH_M,
     THIGH_LENGTH_M,
     JointKind,
-    batch_model_quat_from_canonical,
 )
 from stylesync.motion.leg_ik import solve_leg
-from stylesync.motion.operator_analysis import UPPER_JOINTS, OperatorAnalysis
-from stylesync.processing.joint_map import hinge_angle
+from stylesync.motion.operator_analysis import OperatorAnalysis
+from stylesync.motion.pose_optimization import CHAR_LEG_LENGTH_M, joint_targets, map_upper_body
 from stylesync.processing.operator_processing import OperatorSample
 
 _UP = np.array([0.0, 0.0, 1.0])
 _BALL = [k for k, j in enumerate(JOINTS) if j.kind is JointKind.BALL]
 _HINGE = [k for k, j in enumerate(JOINTS) if j.kind is not JointKind.BALL]
-CHAR_LEG_LENGTH_M = THIGH_LENGTH_M + SHANK_LENGTH_M
 
 
 @dataclass(frozen=True)
@@ -53,7 +51,6 @@ class InitialState:
     root_lin_vel_world: np.ndarray  # (3,) [m/s]
     root_ang_vel_world: np.ndarray  # (3,) [rad/s]
     joint_vel: np.ndarray  # (n_joints, 3): ball joints child-frame angular velocity [rad/s], hinge rate in column 0
-    scale: float  # h_C / h_H, Eq. 9
 
 
 def retargeted_pose(s: OperatorSample, analysis: OperatorAnalysis) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -78,16 +75,8 @@ def retargeted_pose(s: OperatorSample, analysis: OperatorAnalysis) -> tuple[np.n
         hinge[f"{side}_knee"] = ik.knee_angle_rad
         q_foot = rot.quat_from_yaw(rot.twist_angle(s.quat[f"ANKLE_{side.upper()}"], _UP))  # flat (Sec. 5.3)
         local[f"{side}_ankle"] = rot.multiply(rot.conjugate(ik.shank_quat_wxyz), q_foot)
-    for j, q in zip(UPPER_JOINTS, analysis.upper_local_wxyz, strict=True):
-        if j.endswith("elbow"):
-            hinge[j] = hinge_angle(q, j)
-        else:
-            local[j] = q
-    joint_pos = np.zeros((len(JOINTS), 4))
-    joint_pos[_BALL] = batch_model_quat_from_canonical(np.array([local[JOINTS[k].name] for k in _BALL]))
-    for k in _HINGE:
-        joint_pos[k, 0] = hinge[JOINTS[k].name]
-    return pelvis, q_root, joint_pos
+    map_upper_body(analysis.upper_local_wxyz, local, hinge)
+    return pelvis, q_root, joint_targets(local, hinge)
 
 
 def initial_state(s0: OperatorSample, a0: OperatorAnalysis, s1: OperatorSample, a1: OperatorAnalysis
@@ -105,4 +94,4 @@ def initial_state(s0: OperatorSample, a0: OperatorAnalysis, s1: OperatorSample, 
         joint_vel[k] = rot.rotvec_from_quat(rot.multiply(rot.conjugate(j0[k]), rot.align_sign(j1[k], j0[k]))) / dt
     joint_vel[_HINGE, 0] = (j1[_HINGE, 0] - j0[_HINGE, 0]) / dt
     origin = np.array([s0.pos["PELVIS"][0] - p0[0], s0.pos["PELVIS"][1] - p0[1], 0.0])  # at the operator's pelvis
-    return InitialState(p0 + origin, q0, j0, (p1 - p0) / dt, ang_root, joint_vel, CHAR_LEG_LENGTH_M / a0.leg_m)
+    return InitialState(p0 + origin, q0, j0, (p1 - p0) / dt, ang_root, joint_vel)

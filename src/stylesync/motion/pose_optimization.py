@@ -90,6 +90,26 @@ def _heading_frame_fraction(p_h, al_h, ar_h, al_c, ar_c, scale: float, R: np.nda
     return R @ np.array(out)
 
 
+def map_upper_body(upper_local_wxyz: np.ndarray, local: dict[str, np.ndarray], hinge: dict[str, float]) -> None:
+    """In place: the joint map's upper-body rotations (UPPER_JOINTS order) as ball-joint local rotations and elbow
+    hinge angles [rad]."""
+    for j, q in zip(UPPER_JOINTS, upper_local_wxyz, strict=True):
+        if j.endswith("elbow"):
+            hinge[j] = hinge_angle(q, j)
+        else:
+            local[j] = q
+
+
+def joint_targets(local: dict[str, np.ndarray], hinge: dict[str, float]) -> np.ndarray:
+    """(n_joints, 4) in the character's joint layout: ball joints' canonical local rotations as model-frame
+    quaternions, hinge angles [rad] in column 0."""
+    joint_pos = np.zeros((len(JOINTS), 4))
+    joint_pos[_BALL_JOINTS] = batch_model_quat_from_canonical(np.array([local[JOINTS[k].name] for k in _BALL_JOINTS]))
+    for k in _HINGE_JOINTS:
+        joint_pos[k, 0] = hinge[JOINTS[k].name]
+    return joint_pos
+
+
 class _SmoothedRate:
     """Rate of change of a sampled vector: finite difference, exponentially averaged (_VELOCITY_SMOOTHING)."""
 
@@ -97,10 +117,6 @@ class _SmoothedRate:
         self.dt_s = dt_s
         self._prev: np.ndarray | None = None
         self._rate = np.zeros(3)
-
-    def seed(self, rate: np.ndarray) -> None:
-        """Start from this rate instead of rest (a character started in motion)."""
-        self._rate = np.array(rate, dtype=float)
 
     def __call__(self, x: np.ndarray) -> np.ndarray:
         if self._prev is not None:
@@ -166,14 +182,6 @@ class MotionOptimizer:
         self._op_swing_s = OPERATOR_SWING_S  # the operator's swing time, averaged over his swings [s]
         self._op_state: Stance | None = None
         self._op_state_t0_s = 0.0
-
-    def start_in_motion(self, com_vel_world: np.ndarray, scale: float) -> None:
-        """The character starts moving at ``com_vel_world`` [m/s] with the operator (reference-state initialisation,
-        motion/initial_state.py): the desired COM velocity and the operator's (``com_vel_world / scale``, scale =
-        h_C / h_H) start from it, not from rest."""
-        v = np.array([com_vel_world[0], com_vel_world[1], 0.0])
-        self._com_d_rate.seed(v)
-        self._com_h_rate.seed(v / scale)
 
     def update(self, sample: OperatorSample, state: CharacterState, mass: MassProperties,
                analysis: OperatorAnalysis | None = None) -> ReferencePose:
@@ -403,23 +411,14 @@ class MotionOptimizer:
     def _map_upper_body(self, tick: _Tick, local: dict[str, np.ndarray], hinge: dict[str, float]) -> None:
         """Upper body from the joint map; the chest keeps the operator's torso orientation in the world."""
         s = tick.s
-        upper = tick.analysis.upper_local_wxyz if s is tick.sample else upper_local(s, tick.q_root_d)
-        for j, q in zip(UPPER_JOINTS, upper, strict=True):
-            if j.endswith("elbow"):
-                hinge[j] = hinge_angle(q, j)
-            else:
-                local[j] = q
+        map_upper_body(tick.analysis.upper_local_wxyz if s is tick.sample else upper_local(s, tick.q_root_d),
+                       local, hinge)
 
     def _reference(self, tick: _Tick, state: CharacterState, local: dict[str, np.ndarray],
                    hinge: dict[str, float]) -> ReferencePose:
         """The targets in the character's joint layout, with the LIPM map of Eq. 23 in single stance."""
-        q_cur = state.joint_pos
-        joint_pos = np.zeros((len(JOINTS), 4))
-        joint_pos[_BALL_JOINTS] = rot.batch_align_sign(
-            batch_model_quat_from_canonical(np.array([local[JOINTS[k].name] for k in _BALL_JOINTS])),
-            q_cur[_BALL_JOINTS])
-        for k in _HINGE_JOINTS:
-            joint_pos[k, 0] = hinge[JOINTS[k].name]
+        joint_pos = joint_targets(local, hinge)
+        joint_pos[_BALL_JOINTS] = rot.batch_align_sign(joint_pos[_BALL_JOINTS], state.joint_pos[_BALL_JOINTS])
         lipm = None
         if tick.ch_state is not Stance.DS:
             st = "left" if tick.ch_state is Stance.LS else "right"

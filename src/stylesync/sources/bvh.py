@@ -137,6 +137,11 @@ def bind_blend_frames(pos: np.ndarray, frame_time_s: float) -> int:
 class BvhRecording:
     """A BVH file on the canonical skeleton; ``performer`` replays it."""
 
+    @property
+    def mapping(self) -> dict[str, str]:
+        """Canonical joint -> the BVH joint it was matched to (``matches`` also says how)."""
+        return {canon: name for canon, (name, _) in self.matches.items()}
+
     def __init__(self, path: str | Path, joint_map: dict[str, str] | None = None, scale_m: float | None = None,
                  up_axis: str | None = None):
         bvhio = _bvhio()
@@ -183,8 +188,7 @@ class BvhRecording:
         self.path = p
         self.joint_names = names
         self.matches = match_joints(names, joint_map)
-        self.mapping = {canon: n for canon, (n, _) in self.matches.items()}
-        idx = {canon: names.index(n) for canon, n in self.mapping.items()}
+        idx = {canon: names.index(n) for canon, (n, _) in self.matches.items()}
 
         # Rest pose (all rotations identity): cumulative offsets, file units and axes.
         rest = np.zeros((len(names), 3))
@@ -194,7 +198,6 @@ class BvhRecording:
         for seg, (distal, _) in SEGMENT_DIRECTIONS.items():
             while np.linalg.norm(rest[idx[distal]] - rest[idx[seg]]) < 1e-9 and parent_index[idx[seg]] >= 0:
                 idx[seg] = parent_index[idx[seg]]
-                self.mapping[seg] = names[idx[seg]]
                 self.matches[seg] = (names[idx[seg]], f"parent of {self.matches[seg][0]} (which sits on {distal})")
         ankles = 0.5 * (rest[idx["ANKLE_LEFT"]] + rest[idx["ANKLE_RIGHT"]])
         up_vec = rest[idx["HEAD"]] - ankles

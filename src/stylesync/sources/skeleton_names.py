@@ -12,10 +12,10 @@ A joint name is read as (side, segment word):
    that are never matched (``lThighTwist``, ``upperarm_twist_01_l``).
 
 Each canonical joint then takes the first joint, in the file's depth-first order, whose word is the best-ranked of
-its synonyms (``SYNONYMS``). The ranking resolves names whose meaning differs between conventions: MotionBuilder's
-``LeftShoulder`` is the clavicle and ``LeftArm`` the upper arm, 3ds Max's ``LeftShoulder`` is the upper arm; "arm"
-is tried before "shoulder", so each file gets its own meaning. End sites appear as words ending in ``end``
-(``lFoot`` end site → ``footend``), the toe of a skeleton without toe joints.
+its synonyms (``SIDE_SYNONYMS``, ``CENTRE_SYNONYMS``). The ranking resolves names whose meaning differs between
+conventions: MotionBuilder's ``LeftShoulder`` is the clavicle and ``LeftArm`` the upper arm, 3ds Max's
+``LeftShoulder`` is the upper arm; "arm" is tried before "shoulder", so each file gets its own meaning. End sites
+appear as words ending in ``end`` (``lFoot`` end site → ``footend``), the toe of a skeleton without toe joints.
 """
 
 from __future__ import annotations
