@@ -134,6 +134,14 @@ class MotionConfig:
     # and this far outside it, sideways (min, max): a foot further out throws the body back harder than the
     # next step can catch, and the sway grows from step to step [m]
     step_outside_capture_point_m: tuple[float, float] = (0.0, 0.04)
+    # Recovery steps (motion/recovery_step.py): while the operator stands, the character steps on its own when its
+    # capture point is further than the margin outside the support polygon of its soles [m]; the step's nominal
+    # swing time [s] and height [m]; the double stance kept after one before another [s].
+    recovery_steps: bool = True
+    recovery_step_margin_m: float = 0.02
+    recovery_swing_s: float = 0.3
+    recovery_step_height_m: float = 0.05
+    recovery_min_stance_s: float = 0.1
 
     def __post_init__(self) -> None:
         lo, hi = self.step_outside_capture_point_m
@@ -144,6 +152,10 @@ class MotionConfig:
             raise ConfigError(f"MotionConfig.swing_placement must be one of {', '.join(SWING_PLACEMENTS)}, "
                               f"got '{self.swing_placement}'")
         _positive("MotionConfig.stance_height_threshold_m", self.stance_height_threshold_m)
+        _non_negative("MotionConfig.recovery_step_margin_m", self.recovery_step_margin_m)
+        _positive("MotionConfig.recovery_swing_s", self.recovery_swing_s)
+        _non_negative("MotionConfig.recovery_step_height_m", self.recovery_step_height_m)
+        _non_negative("MotionConfig.recovery_min_stance_s", self.recovery_min_stance_s)
         _non_negative("MotionConfig.stance_hysteresis_m", self.stance_hysteresis_m)
         _positive("MotionConfig.late_contact_timeout_s", self.late_contact_timeout_s)
         _non_negative("MotionConfig.min_swing_s", self.min_swing_s)

@@ -15,9 +15,9 @@ import functools
 
 import numpy as np
 
-from stylesync import rotations as rot
-from stylesync.model.character import ANKLE_HEIGHT_M, FOOT_CENTER_AHEAD_OF_ANKLE_M, FOOT_LENGTH_M, FOOT_WIDTH_M
 from stylesync.model.character_model import SOLE_FRAMES, CharacterModel
+from stylesync.model.sole import sole_corners_in_foot
+from stylesync.model.sole import sole_corners_world as model_sole_corners_world
 
 SOLE_MARGIN = 0.9  # fraction of the sole's length and width the corner forces may use
 FRICTION_MARGIN = 0.8  # fraction of the friction coefficient the pyramid uses
@@ -29,17 +29,16 @@ MIN_WEIGHT = 0.05  # a stance weight below this is treated as this (ε = REGULAR
 MAX_NORMAL_FORCE_BODY_WEIGHTS = 3.0
 RAMP_WEIGHT = 0.1
 FORCES_PER_SOLE = 16  # 4 corners x 4 pyramid edges
-_HALF_L, _HALF_W = SOLE_MARGIN * FOOT_LENGTH_M / 2, SOLE_MARGIN * FOOT_WIDTH_M / 2
-# Sole corners relative to the sole's centre in the foot's canonical frame (x forward, y left, z up) [m], (4, 3).
-SOLE_CORNERS_IN_SOLE = np.array([[sx * _HALF_L, sy * _HALF_W, 0.0] for sx in (1.0, -1.0) for sy in (1.0, -1.0)])
-# The same relative to the ankle joint [m], (4, 3).
-SOLE_CORNERS_IN_FOOT = SOLE_CORNERS_IN_SOLE + np.array([FOOT_CENTER_AHEAD_OF_ANKLE_M, 0.0, -ANKLE_HEIGHT_M])
+# The corners the forces act at, relative to the ankle joint in the foot's canonical frame [m], (4, 3).
+SOLE_CORNERS_IN_FOOT = sole_corners_in_foot(SOLE_MARGIN)
+# The same relative to the sole's centre [m], (4, 3).
+SOLE_CORNERS_IN_SOLE = SOLE_CORNERS_IN_FOOT - SOLE_CORNERS_IN_FOOT.mean(axis=0)
 _EDGE_DIRS = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]])
 
 
 def sole_corners_world(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray) -> np.ndarray:
-    """(4, 3) world positions of a foot's sole corners [m]."""
-    return np.asarray(ankle_world, dtype=float) + SOLE_CORNERS_IN_FOOT @ rot.matrix_from_quat(foot_quat_wxyz).T
+    """(4, 3) world positions of the corners the sole's forces act at [m]."""
+    return model_sole_corners_world(ankle_world, foot_quat_wxyz, SOLE_CORNERS_IN_FOOT)
 
 
 def sole_touches(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray, pressing: bool, gap_m: float) -> bool:

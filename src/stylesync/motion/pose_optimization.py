@@ -40,6 +40,7 @@ from stylesync.motion.balance_strategy import stance_hip_blend, swing_hip_feedba
 from stylesync.motion.bounds import BoundsMonitor, step_length_bound_m
 from stylesync.motion.leg_ik import solve_leg
 from stylesync.motion.operator_analysis import UPPER_JOINTS, OperatorAnalysis, analyse_operator, upper_local
+from stylesync.motion.recovery_step import RecoveryStepper, operator_stands, sole_on_ground
 from stylesync.motion.reference import LipmMap, ReferencePose
 from stylesync.motion.stance_fsm import (
     CharacterStanceFsm,
@@ -182,6 +183,8 @@ class MotionOptimizer:
         self._op_swing_s = OPERATOR_SWING_S  # the operator's swing time, averaged over his swings [s]
         self._op_state: Stance | None = None
         self._op_state_t0_s = 0.0
+        self.recovery = RecoveryStepper(cfg, CHAR_LEG_LENGTH_M, gravity_mps2)
+        self._operator_stands_since_s: float | None = None
 
     def update(self, sample: OperatorSample, state: CharacterState, mass: MassProperties,
                analysis: OperatorAnalysis | None = None) -> ReferencePose:
@@ -281,12 +284,19 @@ class MotionOptimizer:
 
     # ---- 3. foot targets: planted feet, swing-foot planning (Eq. 28) -----------------------------------------
     def _plan_feet(self, tick: _Tick, state: CharacterState) -> None:
-        """A planted foot where it is, the swing foot where the operator's is; the pelvis lowered as far as a
-        foot that must land needs."""
+        """A planted foot where it is, the swing foot where the operator's is (or where a recovery step lands); the
+        pelvis lowered as far as a foot that must land needs."""
+        self._recovery_step(tick, state)
         tick.weights = stance_weights(tick.ch_state, self._ds_left_share(tick.com_c, tick.a_c))
         sw = tick.swing = swing_side(tick.ch_state)
         for side in ("left", "right"):
-            if side == sw:
+            if side == sw and self.char_fsm.recovery_step:
+                other = _OTHER_SIDE[side]
+                tick.targets[side] = self.recovery.swing_target(
+                    state.time_s, tick.com_c, tick.com_vel_c, tick.a_c[other],
+                    state.link_quat_wxyz[_LINK[f"{other}_ankle"]], tick.R_root_d)
+                tick.foot_yaw[side] = rot.twist_angle(state.link_quat_wxyz[_LINK[f"{side}_ankle"]], _UP)
+            elif side == sw:
                 tick.targets[side] = self._swing_target(tick, state, side)
                 tick.foot_yaw[side] = rot.twist_angle(tick.s.quat[f"ANKLE_{_SIDE_UP[side]}"], _UP)
             else:
@@ -309,6 +319,39 @@ class MotionOptimizer:
                 tick.pelvis_d[2] = min(tick.pelvis_d[2],
                                        tick.targets[side][2] + float(np.sqrt(max(reach * reach - d2, 0.0))))
 
+    def _operator_capture_point(self, tick: _Tick) -> np.ndarray:
+        """(3,) the operator's capture point, his COM height taken above his ankles plus the character's ankle
+        height scaled to him [m]."""
+        h_h = max(tick.com_h[2] - tick.ankle_h_z + ANKLE_HEIGHT_M / tick.scale, 0.1)
+        return tick.com_h + tick.com_vel_h * np.sqrt(h_h / self.g)
+
+    def _recovery_step(self, tick: _Tick, state: CharacterState) -> None:
+        """Ends a recovery step the stance FSM has ended; begins one when the operator and the character both stand
+        and the character's capture point has left its support polygon (recovery_step.py)."""
+        stepper = self.recovery
+        if stepper.step is not None and not self.char_fsm.recovery_step:
+            stepper.end(state.time_s)
+        if tick.op_state is not Stance.DS:
+            self._operator_stands_since_s = None
+        if (stepper.step is not None or tick.ch_state is not Stance.DS or tick.op_state is not Stance.DS
+                or self.char_fsm.hold_reference):
+            return
+        yaw_h = {k: rot.twist_angle(tick.s.quat[f"ANKLE_{v}"], _UP) for k, v in _SIDE_UP.items()}
+        if not operator_stands(self._operator_capture_point(tick), tick.a_h, yaw_h, tick.scale):
+            self._operator_stands_since_s = None  # he moves over his feet (a walk's double stance)
+            return
+        if self._operator_stands_since_s is None:
+            self._operator_stands_since_s = state.time_s
+        if state.time_s - self._operator_stands_since_s < self.cfg.recovery_min_stance_s:
+            return  # a double stance shorter than this is a walk's: his next step is the character's
+        quats = {s: state.link_quat_wxyz[_LINK[f"{s}_ankle"]] for s in _SIDE_UP}
+        step = stepper.trigger(state.time_s, tick.com_c, tick.com_vel_c, tick.a_c, quats,
+                               [s for s in _SIDE_UP if tick.contact[s] or sole_on_ground(tick.a_c[s], quats[s])])
+        if step is not None:
+            timeout_s = self.cfg.recovery_swing_s + self.cfg.late_contact_timeout_s
+            tick.ch_state = self.char_fsm.begin_recovery_step(step.side, state.time_s, timeout_s)
+            self._swing_t0_s = state.time_s
+
     def _swing_target(self, tick: _Tick, state: CharacterState, side: str) -> np.ndarray:
         """Where the swing foot goes this tick.
 
@@ -326,11 +369,10 @@ class MotionOptimizer:
         a_h, a_c, scale, R_root_d = tick.a_h, tick.a_c, tick.scale, tick.R_root_d
         target = tick.pelvis_d + scale * (a_h[side] - tick.p_h)
         if cfg.swing_placement == "capture_point":
-            com_c, com_h = tick.com_c, tick.com_h
+            com_c = tick.com_c
             from_stance = a_c[other] + scale * (a_h[side] - a_h[other])
             xi_c = com_c + tick.com_vel_c * np.sqrt(max(com_c[2], 0.1) / self.g)
-            h_h = max(com_h[2] - tick.ankle_h_z + ANKLE_HEIGHT_M / scale, 0.1)
-            xi_h = com_h + tick.com_vel_h * np.sqrt(h_h / self.g)
+            xi_h = self._operator_capture_point(tick)
             land = R_root_d.T @ (scale * (a_h[side] - xi_h))  # heading frame, from the capture point
             land[0] = min(land[0], -cfg.step_behind_capture_point_m)
             out = 1.0 if side == "left" else -1.0
@@ -420,7 +462,7 @@ class MotionOptimizer:
         joint_pos = joint_targets(local, hinge)
         joint_pos[_BALL_JOINTS] = rot.batch_align_sign(joint_pos[_BALL_JOINTS], state.joint_pos[_BALL_JOINTS])
         lipm = None
-        if tick.ch_state is not Stance.DS:
+        if tick.ch_state is not Stance.DS and not self.char_fsm.recovery_step:
             st = "left" if tick.ch_state is Stance.LS else "right"
             dh, dc = tick.com_h - tick.a_h[st], tick.com_c - tick.a_c[st]
             lipm = LipmMap(np.array([dh[0], dh[1], 0.0]), float(max(dh[2], 0.1)),

@@ -6,7 +6,11 @@ transitions of Sec. 5.1:
 * early contact: the swing foot touches down before the operator's state changes -> DS at once (held until the
   operator's state changes, so that it does not flip back);
 * late contact: the operator is back in DS but the character's swing foot is still in the air -> the reference
-  is held (``hold_reference``) until the foot touches down (or a timeout passes).
+  is held (``hold_reference``) until the foot touches down (or a timeout passes);
+* recovery step (recovery_step.py): the operator stands, the character lifts a foot on its own
+  (:meth:`CharacterStanceFsm.begin_recovery_step`); the step ends when the foot touches down after the minimum
+  swing time (or a timeout passes), whatever the operator does meanwhile; if he lifted the same foot, his step
+  counts as taken (as an early contact).
 """
 
 from __future__ import annotations
@@ -67,9 +71,34 @@ class CharacterStanceFsm:
         self._hold_start_s = 0.0
         self._holding = False
         self._early_latched_for: Stance | None = None
+        self.recovery_step = False  # the current single stance is the character's own recovery step
+        self._recovery_timeout_s = 0.0
+
+    def begin_recovery_step(self, swing: str, time_s: float, timeout_s: float) -> Stance:
+        """From double stance, lift ``swing`` on the character's own decision; the step ends at its contact, or
+        after ``timeout_s``."""
+        self._early_latched_for = None
+        self._enter(Stance.RS if swing == "left" else Stance.LS, time_s)
+        self.recovery_step, self._recovery_timeout_s = True, timeout_s
+        return self.state
 
     def update(self, op: Stance, contact: dict[str, bool], time_s: float) -> Stance:
         self.hold_reference = False
+        if self.recovery_step:
+            # The character's own step goes on until its foot lands (or the timeout), whatever the operator does
+            # meanwhile: the balance decides where and when it lands.
+            sw = swing_side(self.state)
+            assert sw is not None
+            landed = contact[sw] and time_s - self._swing_start_s >= self.min_swing_s
+            if not landed and time_s - self._swing_start_s < self._recovery_timeout_s:
+                return self.state
+            self.recovery_step = False
+            if op is self.state:  # he lifted the same foot meanwhile: his step counts as taken (early contact)
+                self._early_latched_for = op
+                self._enter(Stance.DS, time_s)
+            else:
+                self._enter(op, time_s)
+            return self.state
         if self._early_latched_for is not None:
             if op is self._early_latched_for:
                 return self.state  # early contact: stay in DS until the operator's state changes

@@ -1,0 +1,170 @@
+"""Recovery steps on the capture point: the character steps when its feet can no longer stop its body.
+
+The balance state is the divergent component of motion (capture point) of the linear inverted pendulum of
+Eq. 21, ``ξ = c + ċ / ω`` with ``ω = sqrt(g / h)`` (h the COM height above the ground): with the centre of
+pressure at ``p``, ``ξ̇ = ω (ξ - p)``. A centre of pressure can only lie in the support polygon of the soles on
+the ground, so once ξ is outside that polygon the body cannot be stopped where it stands: it must step.
+
+The operator's steps are followed as they come (pose_optimization.py). When the operator stands (his stance
+FSM in double stance, and his own capture point within the polygon of his soles, :func:`operator_stands`: in the
+double stance of a walk it is ahead of them) the character may still carry momentum he does not have: the
+operator of a recorded file holds his last pose at its end, mid-stride; a live operator stops faster than the
+smaller body can; a push moves the character, not him. Then, when the character's ξ is further than
+``MotionConfig.recovery_step_margin_m`` outside the support polygon of its soles on the ground, it steps on its
+own:
+
+* the stance foot is the one whose sole is nearer ξ (the centre of pressure moves there), the other swings;
+* the landing is planned each tick where ξ will be when the foot lands: with the centre of pressure held at the
+  stance sole's point nearest ξ, ``ξ(t + τ) = p + (ξ(t) - p) e^(ω τ)``, τ the swing time left; the sole is placed
+  with its trailing edge there (trailing along ξ's direction of divergence from p), so that every centre of
+  pressure on the new sole drives ξ back;
+* within the leg's reach (``MAX_STEP_SHARE`` of its length from the stance ankle) and never across the stance
+  foot (at least ``MIN_FOOT_SEPARATION_M`` outwards of it, in the heading frame);
+* the foot rises ``recovery_step_height_m`` at mid-swing, follows a smooth step from its lift-off point to the
+  landing, and after ``recovery_swing_s`` is lowered below the ground until it touches (the stance FSM ends the
+  step on its contact).
+
+The step's timing is the nominal swing time; its position is what adapts, each tick, to the capture point.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from stylesync import rotations as rot
+from stylesync.config import MotionConfig
+from stylesync.model.character import (
+    ANKLE_HEIGHT_M,
+    FOOT_CENTER_AHEAD_OF_ANKLE_M,
+    FOOT_LENGTH_M,
+    FOOT_WIDTH_M,
+    HIP_HALF_WIDTH_M,
+)
+from stylesync.model.sole import convex_hull_xy, outside_distance_m, sole_corners_in_foot, sole_corners_world
+from stylesync.processing.interpolation import smooth_step
+
+MAX_STEP_SHARE = 0.6  # the landing ankle is at most this share of the leg's length from the stance ankle
+MIN_FOOT_SEPARATION_M = 1.2 * HIP_HALF_WIDTH_M  # the swing ankle lands at least this far outwards of the stance one
+LANDING_PRESS_M = 0.02  # after the nominal swing time the foot is aimed this far below the ground [m]
+# The foot reaches the landing point horizontally at this share of the nominal swing time (the remaining share
+# lowers it there).
+HORIZONTAL_SHARE = 0.8
+ON_GROUND_GAP_M = 0.01  # a sole whose lowest corner is this close to the ground counts in the support polygon [m]
+_OTHER = {"left": "right", "right": "left"}
+_OUT = {"left": 1.0, "right": -1.0}
+
+
+def capture_point(com_world: np.ndarray, com_vel_world: np.ndarray, gravity_mps2: float) -> tuple[np.ndarray, float]:
+    """ξ = c + ċ / ω (horizontal, (2,)) [m] and ω = sqrt(g / h) [1/s] of the linear inverted pendulum (Eq. 21),
+    h the COM height above the ground."""
+    omega = float(np.sqrt(gravity_mps2 / max(float(com_world[2]), 0.1)))
+    return np.asarray(com_world, dtype=float)[:2] + np.asarray(com_vel_world, dtype=float)[:2] / omega, omega
+
+
+def operator_stands(xi_h_world: np.ndarray, ankles_h_world: dict[str, np.ndarray], foot_yaw_h_rad: dict[str, float],
+                    scale: float) -> bool:
+    """Whether the operator's capture point (horizontal) is within the support polygon of his soles, each the
+    character's sole scaled by 1 / ``scale`` (h_C / h_H, Eq. 9) at his ankle, turned by his foot's yaw."""
+    in_foot = sole_corners_in_foot() / scale
+    corners = [sole_corners_world(ankles_h_world[s], rot.quat_from_yaw(foot_yaw_h_rad[s]), in_foot)[:, :2]
+               for s in ankles_h_world]
+    return outside_distance_m(xi_h_world, convex_hull_xy(np.vstack(corners)))[0] <= 0.0
+
+
+def sole_on_ground(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray) -> bool:
+    """Whether the lowest corner of a foot's sole is within ON_GROUND_GAP_M of the (level) ground."""
+    return float(sole_corners_world(ankle_world, foot_quat_wxyz)[:, 2].min()) < ON_GROUND_GAP_M
+
+
+@dataclass
+class RecoveryStep:
+    """A step the character takes on its own (world frame) [m, s]."""
+
+    side: str  # the swinging foot
+    start_s: float
+    lift_off_world: np.ndarray  # (3,) swing ankle at lift-off
+    landing_world: np.ndarray  # (3,) the planned landing of the swing ankle, re-planned each tick
+
+
+class RecoveryStepper:
+    """Decides when the character steps on its own, with which foot, and where the swing foot goes each tick."""
+
+    def __init__(self, cfg: MotionConfig, leg_length_m: float, gravity_mps2: float):
+        self.cfg = cfg
+        self.g = gravity_mps2
+        self.max_step_m = MAX_STEP_SHARE * leg_length_m
+        self.step: RecoveryStep | None = None
+        self.count = 0  # recovery steps taken
+        self._last_end_s = -np.inf
+
+    def trigger(self, time_s: float, com_world: np.ndarray, com_vel_world: np.ndarray,
+                ankles_world: dict[str, np.ndarray], feet_quat_wxyz: dict[str, np.ndarray],
+                on_ground: list[str]) -> RecoveryStep | None:
+        """A new step when the capture point is outside the support polygon of the soles ``on_ground`` by more
+        than the margin (and the last recovery step ended at least ``recovery_min_stance_s`` ago). The stance
+        foot is the one on the ground whose sole is nearer the capture point."""
+        cfg = self.cfg
+        if not cfg.recovery_steps or not on_ground or time_s - self._last_end_s < cfg.recovery_min_stance_s:
+            return None
+        xi, _ = capture_point(com_world, com_vel_world, self.g)
+        corners = {s: sole_corners_world(ankles_world[s], feet_quat_wxyz[s])[:, :2] for s in on_ground}
+        outside, _ = outside_distance_m(xi, convex_hull_xy(np.vstack(list(corners.values()))))
+        if outside <= cfg.recovery_step_margin_m:
+            return None
+        dist = {s: outside_distance_m(xi, convex_hull_xy(c))[0] for s, c in corners.items()}
+        stance = min(dist, key=lambda s: dist[s])
+        side = _OTHER[stance]
+        self.step = RecoveryStep(side, time_s, np.array(ankles_world[side], dtype=float),
+                                 np.array(ankles_world[side], dtype=float))
+        self.count += 1
+        return self.step
+
+    def end(self, time_s: float) -> None:
+        """The step is over (the stance FSM saw the foot land, or the operator took over)."""
+        if self.step is not None:
+            self.step = None
+            self._last_end_s = time_s
+
+    def swing_target(self, time_s: float, com_world: np.ndarray, com_vel_world: np.ndarray,
+                     stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray,
+                     heading_world: np.ndarray) -> np.ndarray:
+        """(3,) this tick's target of the swing ankle [m]; the landing re-planned on the capture point.
+        ``heading_world``: (3, 3) the heading frame's rotation (x forward, y left)."""
+        step, cfg = self.step, self.cfg
+        assert step is not None
+        elapsed = time_s - step.start_s
+        remaining = max(cfg.recovery_swing_s - elapsed, 0.0)
+        xi, omega = capture_point(com_world, com_vel_world, self.g)
+        _, cop = outside_distance_m(xi, convex_hull_xy(sole_corners_world(stance_ankle_world,
+                                                                          stance_foot_quat_wxyz)[:, :2]))
+        xi_land = cop + (xi - cop) * np.exp(omega * remaining)
+        R = heading_world
+        # The sole's centre beyond ξ along its direction of divergence u by the sole's half-extent along u: ξ lands
+        # on the sole's trailing edge, and every centre of pressure on the sole then drives it back.
+        away = xi - cop
+        norm = float(np.linalg.norm(away))
+        u = np.array([*(away / norm), 0.0]) if norm > 1e-6 else np.zeros(3)
+        u_heading = R.T @ u
+        half_extent = abs(u_heading[0]) * FOOT_LENGTH_M / 2 + abs(u_heading[1]) * FOOT_WIDTH_M / 2
+        centre = np.array([xi_land[0], xi_land[1], 0.0]) + half_extent * u
+        ankle = centre - R @ np.array([FOOT_CENTER_AHEAD_OF_ANKLE_M, 0.0, 0.0])
+        # Within reach, and never across the stance foot (heading frame, relative to the stance ankle).
+        rel = R.T @ (ankle - np.array([stance_ankle_world[0], stance_ankle_world[1], 0.0]))
+        out = _OUT[step.side]
+        rel[1] = out * max(out * rel[1], MIN_FOOT_SEPARATION_M)
+        rel[2] = 0.0
+        length = float(np.linalg.norm(rel[:2]))
+        if length > self.max_step_m:
+            rel[:2] *= self.max_step_m / length
+        landing = np.array([stance_ankle_world[0], stance_ankle_world[1], 0.0]) + R @ rel
+        landing[2] = ANKLE_HEIGHT_M
+        step.landing_world = landing
+        phase = elapsed / cfg.recovery_swing_s
+        target = step.lift_off_world + smooth_step(min(phase / HORIZONTAL_SHARE, 1.0)) * (landing - step.lift_off_world)
+        if phase < 1.0:
+            target[2] = ANKLE_HEIGHT_M + cfg.recovery_step_height_m * np.sin(np.pi * phase)
+        else:
+            target[2] = ANKLE_HEIGHT_M - LANDING_PRESS_M
+        return target
