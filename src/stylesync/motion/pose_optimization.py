@@ -40,7 +40,7 @@ from stylesync.motion.balance_strategy import stance_hip_blend, swing_hip_feedba
 from stylesync.motion.bounds import BoundsMonitor, step_length_bound_m
 from stylesync.motion.leg_ik import solve_leg
 from stylesync.motion.operator_analysis import UPPER_JOINTS, OperatorAnalysis, analyse_operator, upper_local
-from stylesync.motion.recovery_step import RecoveryStepper, operator_stands, sole_on_ground
+from stylesync.motion.recovery_step import RecoveryStepper, operator_stands, sole_on_ground, stands_on
 from stylesync.motion.reference import LipmMap, ReferencePose
 from stylesync.motion.stance_fsm import (
     CharacterStanceFsm,
@@ -325,6 +325,24 @@ class MotionOptimizer:
         h_h = max(tick.com_h[2] - tick.ankle_h_z + ANKLE_HEIGHT_M / tick.scale, 0.1)
         return tick.com_h + tick.com_vel_h * np.sqrt(h_h / self.g)
 
+    def _stopping_landing(self, tick: _Tick, state: CharacterState, side: str, xi_h: np.ndarray,
+                          landing: np.ndarray) -> np.ndarray:
+        """The swing foot's landing when the operator stops on this step (his capture point within his soles,
+        the swinging one where it is): if the character's capture point, when the foot lands, would be outside its
+        stance sole and the planned landing, the landing of a recovery step (recovery_step.py) instead, so that
+        the character can stop where he does."""
+        yaw_h = {k: rot.twist_angle(tick.s.quat[f"ANKLE_{v}"], _UP) for k, v in _SIDE_UP.items()}
+        if not operator_stands(xi_h, tick.a_h, yaw_h, tick.scale):
+            return landing
+        other = _OTHER_SIDE[side]
+        stance_q = state.link_quat_wxyz[_LINK[f"{other}_ankle"]]
+        remaining_s = max(self._op_swing_s - (state.time_s - self._swing_t0_s), 0.0)
+        capture, xi_land = self.recovery.capture_landing(remaining_s, tick.com_c, tick.com_vel_c, tick.a_c[other],
+                                                         stance_q, tick.R_root_d, side)
+        if stands_on(xi_land, tick.a_c[other], stance_q, landing, tick.R_root_d):
+            return landing
+        return capture
+
     def _recovery_step(self, tick: _Tick, state: CharacterState) -> None:
         """Ends a recovery step the stance FSM has ended; begins one when the operator and the character both stand
         and the character's capture point has left its support polygon (recovery_step.py)."""
@@ -379,7 +397,10 @@ class MotionOptimizer:
             land[1] = out * min(max(out * land[1], cfg.step_outside_capture_point_m[0]),
                                 cfg.step_outside_capture_point_m[1])
             progress = smooth_step((state.time_s - self._swing_t0_s) / self._op_swing_s)
-            target[:2] = (from_stance + progress * (xi_c + R_root_d @ land - from_stance))[:2]
+            landing = xi_c + R_root_d @ land
+            if cfg.recovery_steps:
+                landing = self._stopping_landing(tick, state, side, xi_h, landing)
+            target[:2] = (from_stance + progress * (landing - from_stance))[:2]
         else:
             target[:2] = (state.root_pos_world + scale * (a_h[side] - tick.p_h))[:2]
         target[2] = min(max(target[2], ANKLE_HEIGHT_M), ANKLE_HEIGHT_M + cfg.max_swing_foot_lift_m)

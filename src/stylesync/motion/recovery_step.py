@@ -78,6 +78,16 @@ def sole_on_ground(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray) -> bool:
     return float(sole_corners_world(ankle_world, foot_quat_wxyz)[:, 2].min()) < ON_GROUND_GAP_M
 
 
+def stands_on(xi_world: np.ndarray, stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray,
+              landing_ankle_world: np.ndarray, heading_world: np.ndarray) -> bool:
+    """Whether a capture point (horizontal) is within the support polygon of the stance sole and a sole landed
+    flat at ``landing_ankle_world`` along the heading (``heading_world``: (3, 3), x forward)."""
+    yaw = float(np.arctan2(heading_world[1, 0], heading_world[0, 0]))
+    corners = np.vstack([sole_corners_world(stance_ankle_world, stance_foot_quat_wxyz)[:, :2],
+                         sole_corners_world(landing_ankle_world, rot.quat_from_yaw(yaw))[:, :2]])
+    return outside_distance_m(xi_world, convex_hull_xy(corners))[0] <= 0.0
+
+
 @dataclass
 class RecoveryStep:
     """A step the character takes on its own (world frame) [m, s]."""
@@ -127,19 +137,16 @@ class RecoveryStepper:
             self.step = None
             self._last_end_s = time_s
 
-    def swing_target(self, time_s: float, com_world: np.ndarray, com_vel_world: np.ndarray,
-                     stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray,
-                     heading_world: np.ndarray) -> np.ndarray:
-        """(3,) this tick's target of the swing ankle [m]; the landing re-planned on the capture point.
+    def capture_landing(self, remaining_s: float, com_world: np.ndarray, com_vel_world: np.ndarray,
+                        stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray, heading_world: np.ndarray,
+                        side: str) -> tuple[np.ndarray, np.ndarray]:
+        """Where the ``side`` ankle lands (3,) so that the capture point, ``remaining_s`` from now, is on the
+        trailing edge of its sole (within reach, not across the stance foot), and that capture point (2,) [m].
         ``heading_world``: (3, 3) the heading frame's rotation (x forward, y left)."""
-        step, cfg = self.step, self.cfg
-        assert step is not None
-        elapsed = time_s - step.start_s
-        remaining = max(cfg.recovery_swing_s - elapsed, 0.0)
         xi, omega = capture_point(com_world, com_vel_world, self.g)
         _, cop = outside_distance_m(xi, convex_hull_xy(sole_corners_world(stance_ankle_world,
                                                                           stance_foot_quat_wxyz)[:, :2]))
-        xi_land = cop + (xi - cop) * np.exp(omega * remaining)
+        xi_land = cop + (xi - cop) * np.exp(omega * remaining_s)
         R = heading_world
         # The sole's centre beyond ξ along its direction of divergence u by the sole's half-extent along u: ξ lands
         # on the sole's trailing edge, and every centre of pressure on the sole then drives it back.
@@ -151,15 +158,28 @@ class RecoveryStepper:
         centre = np.array([xi_land[0], xi_land[1], 0.0]) + half_extent * u
         ankle = centre - R @ np.array([FOOT_CENTER_AHEAD_OF_ANKLE_M, 0.0, 0.0])
         # Within reach, and never across the stance foot (heading frame, relative to the stance ankle).
-        rel = R.T @ (ankle - np.array([stance_ankle_world[0], stance_ankle_world[1], 0.0]))
-        out = _OUT[step.side]
-        rel[1] = out * max(out * rel[1], MIN_FOOT_SEPARATION_M)
+        base = np.array([stance_ankle_world[0], stance_ankle_world[1], 0.0])
+        rel = R.T @ (ankle - base)
+        out = _OUT[side]
         rel[2] = 0.0
         length = float(np.linalg.norm(rel[:2]))
         if length > self.max_step_m:
             rel[:2] *= self.max_step_m / length
-        landing = np.array([stance_ankle_world[0], stance_ankle_world[1], 0.0]) + R @ rel
+        rel[1] = out * max(out * rel[1], MIN_FOOT_SEPARATION_M)
+        landing = base + R @ rel
         landing[2] = ANKLE_HEIGHT_M
+        return landing, xi_land
+
+    def swing_target(self, time_s: float, com_world: np.ndarray, com_vel_world: np.ndarray,
+                     stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray,
+                     heading_world: np.ndarray) -> np.ndarray:
+        """(3,) this tick's target of the swing ankle [m]; the landing re-planned on the capture point.
+        ``heading_world``: (3, 3) the heading frame's rotation (x forward, y left)."""
+        step, cfg = self.step, self.cfg
+        assert step is not None
+        elapsed = time_s - step.start_s
+        landing, _ = self.capture_landing(max(cfg.recovery_swing_s - elapsed, 0.0), com_world, com_vel_world,
+                                          stance_ankle_world, stance_foot_quat_wxyz, heading_world, step.side)
         step.landing_world = landing
         phase = elapsed / cfg.recovery_swing_s
         target = step.lift_off_world + smooth_step(min(phase / HORIZONTAL_SHARE, 1.0)) * (landing - step.lift_off_world)

@@ -1,0 +1,141 @@
+"""Recovery steps on the capture point (motion/recovery_step.py), the support polygon (model/sole.py) and the
+stance FSM's own steps."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from stylesync.config import MotionConfig, OperatorConfig, SessionConfig
+from stylesync.model.character import ANKLE_HEIGHT_M, FOOT_CENTER_AHEAD_OF_ANKLE_M, FOOT_LENGTH_M
+from stylesync.model.sole import convex_hull_xy, outside_distance_m, sole_corners_world
+from stylesync.motion.pose_optimization import CHAR_LEG_LENGTH_M
+from stylesync.motion.recovery_step import (
+    MAX_STEP_SHARE,
+    MIN_FOOT_SEPARATION_M,
+    RecoveryStepper,
+    capture_point,
+    operator_stands,
+    stands_on,
+)
+from stylesync.motion.stance_fsm import CharacterStanceFsm, Stance
+
+G = 9.8
+IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
+ANKLES = {"left": np.array([0.0, 0.1, ANKLE_HEIGHT_M]), "right": np.array([0.0, -0.1, ANKLE_HEIGHT_M])}
+QUATS = {"left": IDENTITY, "right": IDENTITY}
+MOCAP = Path(__file__).resolve().parents[2] / "shared" / "mocap"
+
+
+def test_support_polygon_distance_is_signed_and_finds_the_nearest_point():
+    square = convex_hull_xy(np.array([[0, 0], [1, 0], [1, 1], [0, 1], [0.5, 0.5]], dtype=float))
+    assert len(square) == 4
+    d, p = outside_distance_m(np.array([0.5, 0.25]), square)
+    assert d == pytest.approx(-0.25) and np.allclose(p, [0.5, 0.25])
+    d, p = outside_distance_m(np.array([2.0, 0.5]), square)
+    assert d == pytest.approx(1.0) and np.allclose(p, [1.0, 0.5])
+    d, p = outside_distance_m(np.array([2.0, 2.0]), square)
+    assert d == pytest.approx(np.sqrt(2.0)) and np.allclose(p, [1.0, 1.0])
+
+
+def test_sole_corners_span_the_foot_ahead_of_the_ankle():
+    corners = sole_corners_world(ANKLES["left"], IDENTITY)
+    assert np.allclose(corners[:, 2], 0.0)
+    assert corners[:, 0].max() - corners[:, 0].min() == pytest.approx(FOOT_LENGTH_M)
+    assert corners[:, 0].mean() == pytest.approx(FOOT_CENTER_AHEAD_OF_ANKLE_M)
+
+
+def test_no_step_while_the_capture_point_is_over_the_feet():
+    stepper = RecoveryStepper(MotionConfig(), CHAR_LEG_LENGTH_M, G)
+    com = np.array([0.04, 0.0, 0.8])
+    assert stepper.trigger(1.0, com, np.zeros(3), ANKLES, QUATS, ["left", "right"]) is None
+    # Moving forward slowly: the capture point stays within the soles' toes.
+    assert stepper.trigger(1.0, com, np.array([0.2, 0.0, 0.0]), ANKLES, QUATS, ["left", "right"]) is None
+
+
+def test_a_capture_point_beyond_the_left_foot_lifts_the_right_foot_and_lands_it_beyond_the_capture_point():
+    stepper = RecoveryStepper(MotionConfig(), CHAR_LEG_LENGTH_M, G)
+    com, vel = np.array([0.1, 0.03, 0.8]), np.array([0.45, 0.05, 0.0])  # forward and a little to the left
+    xi, omega = capture_point(com, vel, G)
+    assert omega == pytest.approx(np.sqrt(G / 0.8))
+    step = stepper.trigger(1.0, com, vel, ANKLES, QUATS, ["left", "right"])
+    assert step is not None and step.side == "right" and stepper.count == 1
+    # Planned for "now": the swing sole's trailing edge is where the capture point will be after the swing.
+    landing, xi_land = stepper.capture_landing(0.3, com, vel, ANKLES["left"], IDENTITY, np.eye(3), "right")
+    assert xi_land[0] > xi[0]  # it keeps diverging over the stance sole
+    assert landing[0] > ANKLES["right"][0] + 0.1  # the right foot goes forward
+    assert landing[1] <= ANKLES["left"][1] - MIN_FOOT_SEPARATION_M + 1e-9  # never across the left foot
+    assert np.linalg.norm(landing[:2] - ANKLES["left"][:2]) <= MAX_STEP_SHARE * CHAR_LEG_LENGTH_M + 0.11
+    assert stands_on(xi_land, ANKLES["left"], IDENTITY, landing, np.eye(3))
+    # The swing trajectory: rises mid-swing, then is aimed below the ground until it touches.
+    mid = stepper.swing_target(1.15, com, vel, ANKLES["left"], IDENTITY, np.eye(3))
+    assert mid[2] > ANKLE_HEIGHT_M + 0.03
+    late = stepper.swing_target(1.4, com, vel, ANKLES["left"], IDENTITY, np.eye(3))
+    assert late[2] < ANKLE_HEIGHT_M and np.allclose(late[:2], step.landing_world[:2])
+    stepper.end(1.4)
+    assert stepper.step is None
+    # Another only after the minimum double stance.
+    assert stepper.trigger(1.45, com, vel, ANKLES, QUATS, ["left", "right"]) is None
+    assert stepper.trigger(1.55, com, vel, ANKLES, QUATS, ["left", "right"]) is not None
+
+
+def test_recovery_steps_can_be_switched_off():
+    stepper = RecoveryStepper(MotionConfig(recovery_steps=False), CHAR_LEG_LENGTH_M, G)
+    assert stepper.trigger(1.0, np.array([0.3, 0.0, 0.8]), np.array([1.0, 0.0, 0.0]), ANKLES, QUATS,
+                           ["left", "right"]) is None
+
+
+def test_an_operator_mid_stride_at_rest_stands_and_a_walking_one_does_not():
+    ankles = {"left": np.array([-0.3, 0.1, 0.08]), "right": np.array([0.3, -0.1, 0.08])}
+    yaw = {"left": 0.0, "right": 0.0}
+    assert operator_stands(np.array([0.0, 0.0, 0.9]), ankles, yaw, 0.9)
+    assert not operator_stands(np.array([0.7, 0.0, 0.9]), ankles, yaw, 0.9)
+
+
+def test_the_fsm_keeps_a_recovery_step_until_its_foot_lands():
+    fsm = CharacterStanceFsm(late_contact_timeout_s=0.4, min_swing_s=0.12)
+    both = {"left": True, "right": True}
+    assert fsm.update(Stance.DS, both, 0.0) is Stance.DS
+    assert fsm.begin_recovery_step("right", 0.1, timeout_s=0.7) is Stance.LS
+    up = {"left": True, "right": False}
+    assert fsm.update(Stance.DS, up, 0.2) is Stance.LS and fsm.recovery_step and not fsm.hold_reference
+    # The operator lifts the same foot meanwhile: the step goes on, and once it lands his step counts as taken.
+    assert fsm.update(Stance.LS, up, 0.3) is Stance.LS
+    assert fsm.update(Stance.LS, both, 0.35) is Stance.DS and not fsm.recovery_step
+    assert fsm.update(Stance.LS, both, 0.4) is Stance.DS
+    # A touch before the minimum swing time does not end a step; the timeout does.
+    fsm.update(Stance.DS, both, 0.5)
+    fsm.begin_recovery_step("left", 0.6, timeout_s=0.7)
+    assert fsm.update(Stance.DS, both, 0.65) is Stance.RS
+    assert fsm.update(Stance.DS, {"left": False, "right": True}, 1.2) is Stance.RS
+    assert fsm.update(Stance.DS, {"left": False, "right": True}, 1.31) is Stance.DS
+
+
+def _run(spec: str, seconds: float, motion: MotionConfig):
+    from stylesync.session import Session
+    from stylesync.sources.registry import open_source
+
+    opened = open_source(spec, seed=0, duration_s=seconds)
+    cfg = SessionConfig(duration_s=seconds, seed=0, operator=OperatorConfig(), motion=motion,
+                        clocks=dataclasses.replace(SessionConfig().clocks, mocap_hz=opened.mocap_hz))
+    session = Session(cfg, opened.source)
+    result = session.run()
+    opened.source.close()
+    return result, session
+
+
+@pytest.mark.skipif(not (MOCAP / "cmu-dev" / "08_01.bvh").exists(),
+                    reason="../shared/mocap/cmu-dev/08_01.bvh is not available")
+def test_a_walk_cut_mid_stride_comes_to_rest_with_its_own_last_step():
+    """CMU 08_01 ends mid-stride (2.27 s); its operator then holds his last pose. Without the stopping landing and
+    recovery steps the character keeps its momentum and falls in the rest (measured: 3.3 s, seed 0)."""
+    spec = f"bvh:{MOCAP / 'cmu-dev' / '08_01.bvh'}"
+    result, session = _run(spec, 5.27, MotionConfig())
+    assert not result.fell
+    com_vel = session.mass.com_velocity(session.backend.read_state(result.sim_duration_s))
+    assert float(np.linalg.norm(com_vel[:2])) < 0.05  # at rest at the end
+    off, _ = _run(spec, 5.27, MotionConfig(recovery_steps=False))
+    assert off.fell and off.fall_time_s is not None and off.fall_time_s > 2.27
