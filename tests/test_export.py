@@ -82,6 +82,12 @@ def test_bvh_export_reimports_with_the_same_joint_angles(recorded, tmp_path):
     n = export_bvh(s, out, fps=60.0)
     container = bvhio.readAsBvh(str(out))
     assert container.FrameCount == n
+    # Frame Time is the export clock's period, whatever the gaps of the recorded ticks; the file lasts the session.
+    header = next(line for line in out.read_text().splitlines() if line.startswith("Frame Time:"))
+    frame_time = float(header.split()[-1])
+    assert frame_time == pytest.approx(1 / 60, abs=1e-8)
+    t_rec = s.array("t")
+    assert (n - 1) * frame_time == pytest.approx(t_rec[-1] - t_rec[0], abs=1 / 60)
     # the same ticks the exporter picked (nearest to a 60 Hz clock)
     t = s.array("t")
     idx = np.clip(np.searchsorted(t, np.arange(t[0], t[-1] + 1e-9, 1 / 60)), 0, len(t) - 1)

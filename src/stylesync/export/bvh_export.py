@@ -43,8 +43,9 @@ def bvh_local_quats(link_quat_wxyz: np.ndarray) -> dict[str, np.ndarray]:
 
 
 def write_bvh(path: str | Path, times_s: np.ndarray, root_pos_world: np.ndarray, link_quat_wxyz: np.ndarray,
-              rest_link_origin_world: np.ndarray) -> None:
-    """Write the motion sampled at ``times_s`` (uniform) [s]; positions [m] in our world."""
+              rest_link_origin_world: np.ndarray, frame_time_s: float | None = None) -> None:
+    """Write the motion sampled at ``times_s`` (uniform) [s]; positions [m] in our world. ``frame_time_s``: the
+    file's Frame Time, the sampling clock's period (default: the median gap of ``times_s``)."""
     idx = {n: i for i, n in enumerate(LINK_NAMES)}
     children = {n: [c for c in LINK_NAMES if LINK_PARENT[c] == n] for n in LINK_NAMES}
     rest = rest_link_origin_world @ R_BVH_OURS.T * CM_PER_M
@@ -76,7 +77,10 @@ def write_bvh(path: str | Path, times_s: np.ndarray, root_pos_world: np.ndarray,
     local = bvh_local_quats(link_quat_wxyz)
     euler = {n: Rotation.from_quat(q[:, [1, 2, 3, 0]]).as_euler(CHANNEL_ORDER, degrees=True) for n, q in local.items()}
     root_bvh = root_pos_world @ R_BVH_OURS.T * CM_PER_M
-    frame_time = float(np.median(np.diff(times_s))) if len(times_s) > 1 else 1.0 / 30.0
+    if frame_time_s is not None:
+        frame_time = float(frame_time_s)
+    else:
+        frame_time = float(np.median(np.diff(times_s))) if len(times_s) > 1 else 1.0 / 30.0
     lines += ["MOTION", f"Frames: {len(times_s)}", f"Frame Time: {frame_time:.8f}"]
     for k in range(len(times_s)):
         vals = list(root_bvh[k])

@@ -36,10 +36,12 @@ def resample_ticks(session: SessionFile, fps: float) -> list[dict]:
 
 
 def export_bvh(session: SessionFile, path: str | Path, fps: float = 60.0) -> int:
+    """The character's motion as BVH with a Frame Time of exactly 1 / ``fps`` (a player then plays it at the
+    session's speed), one frame per tick of that clock (the recorded tick nearest it). Returns the frame count."""
     ticks = resample_ticks(session, fps)
     times = np.array([tk["t"] for tk in ticks])
     write_bvh(path, times, np.array([tk["root_pos_world"] for tk in ticks]),
-              np.array([tk["link_quat_wxyz"] for tk in ticks]), rest_link_origins())
+              np.array([tk["link_quat_wxyz"] for tk in ticks]), rest_link_origins(), frame_time_s=1.0 / fps)
     return len(ticks)
 
 
