@@ -16,7 +16,7 @@ import functools
 import numpy as np
 
 from stylesync.model.character_model import SOLE_FRAMES, CharacterModel
-from stylesync.model.sole import sole_corners_in_foot
+from stylesync.model.sole import sole_corners_in_foot, sole_within_m
 from stylesync.model.sole import sole_corners_world as model_sole_corners_world
 
 SOLE_MARGIN = 0.9  # fraction of the sole's length and width the corner forces may use
@@ -44,7 +44,7 @@ def sole_corners_world(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray) -> n
 def sole_touches(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray, pressing: bool, gap_m: float) -> bool:
     """Whether a foot can be given ground forces: it presses the ground (``CharacterState.feet_pressing``), or the
     lowest corner of its sole is within ``gap_m`` of the ground (``gap_m`` > 0: a planted foot just unloaded)."""
-    return pressing or (gap_m > 0 and float(sole_corners_world(ankle_world, foot_quat_wxyz)[:, 2].min()) < gap_m)
+    return pressing or (gap_m > 0 and sole_within_m(ankle_world, foot_quat_wxyz, gap_m, SOLE_CORNERS_IN_FOOT))
 
 
 @functools.lru_cache(maxsize=8)

@@ -27,6 +27,13 @@ def sole_corners_world(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray,
     return np.asarray(ankle_world, dtype=float) + corners_in_foot @ rot.matrix_from_quat(foot_quat_wxyz).T
 
 
+def sole_within_m(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray, gap_m: float,
+                  corners_in_foot: np.ndarray = _FULL_SOLE_IN_FOOT) -> bool:
+    """Whether the lowest corner of a foot's sole (the whole sole unless ``corners_in_foot`` is given) is within
+    ``gap_m`` of the (level) ground."""
+    return float(sole_corners_world(ankle_world, foot_quat_wxyz, corners_in_foot)[:, 2].min()) < gap_m
+
+
 def convex_hull_xy(points_xy: np.ndarray) -> np.ndarray:
     """(k, 2) counter-clockwise convex hull of horizontal points (n, 2) (Andrew's monotone chain)."""
     pts = sorted({(float(x), float(y)) for x, y in np.asarray(points_xy, dtype=float)[:, :2]})

@@ -35,12 +35,13 @@ from stylesync.model.character import (
     batch_model_quat_from_canonical,
     canonical_quat_from_model,
 )
+from stylesync.model.sole import sole_within_m
 from stylesync.model.state import CharacterState, MassProperties
 from stylesync.motion.balance_strategy import stance_hip_blend, swing_hip_feedback
 from stylesync.motion.bounds import BoundsMonitor, step_length_bound_m
 from stylesync.motion.leg_ik import solve_leg
 from stylesync.motion.operator_analysis import UPPER_JOINTS, OperatorAnalysis, analyse_operator, upper_local
-from stylesync.motion.recovery_step import RecoveryStepper, operator_stands, sole_on_ground, stands_on
+from stylesync.motion.recovery_step import ON_GROUND_GAP_M, RecoveryStepper, operator_stands, stands_on
 from stylesync.motion.reference import LipmMap, ReferencePose
 from stylesync.motion.stance_fsm import (
     CharacterStanceFsm,
@@ -325,14 +326,19 @@ class MotionOptimizer:
         h_h = max(tick.com_h[2] - tick.ankle_h_z + ANKLE_HEIGHT_M / tick.scale, 0.1)
         return tick.com_h + tick.com_vel_h * np.sqrt(h_h / self.g)
 
+    @staticmethod
+    def _operator_stands(tick: _Tick, xi_h: np.ndarray) -> bool:
+        """Whether the operator's capture point ``xi_h`` is within his soles (recovery_step.operator_stands)."""
+        yaw_h = {k: rot.twist_angle(tick.s.quat[f"ANKLE_{v}"], _UP) for k, v in _SIDE_UP.items()}
+        return operator_stands(xi_h, tick.a_h, yaw_h, tick.scale)
+
     def _stopping_landing(self, tick: _Tick, state: CharacterState, side: str, xi_h: np.ndarray,
                           landing: np.ndarray) -> np.ndarray:
         """The swing foot's landing when the operator stops on this step (his capture point within his soles,
         the swinging one where it is): if the character's capture point, when the foot lands, would be outside its
         stance sole and the planned landing, the landing of a recovery step (recovery_step.py) instead, so that
         the character can stop where he does."""
-        yaw_h = {k: rot.twist_angle(tick.s.quat[f"ANKLE_{v}"], _UP) for k, v in _SIDE_UP.items()}
-        if not operator_stands(xi_h, tick.a_h, yaw_h, tick.scale):
+        if not self._operator_stands(tick, xi_h):
             return landing
         other = _OTHER_SIDE[side]
         stance_q = state.link_quat_wxyz[_LINK[f"{other}_ankle"]]
@@ -354,8 +360,7 @@ class MotionOptimizer:
         if (stepper.step is not None or tick.ch_state is not Stance.DS or tick.op_state is not Stance.DS
                 or self.char_fsm.hold_reference):
             return
-        yaw_h = {k: rot.twist_angle(tick.s.quat[f"ANKLE_{v}"], _UP) for k, v in _SIDE_UP.items()}
-        if not operator_stands(self._operator_capture_point(tick), tick.a_h, yaw_h, tick.scale):
+        if not self._operator_stands(tick, self._operator_capture_point(tick)):
             self._operator_stands_since_s = None  # he moves over his feet (a walk's double stance)
             return
         if self._operator_stands_since_s is None:
@@ -363,8 +368,8 @@ class MotionOptimizer:
         if state.time_s - self._operator_stands_since_s < self.cfg.recovery_min_stance_s:
             return  # a double stance shorter than this is a walk's: his next step is the character's
         quats = {s: state.link_quat_wxyz[_LINK[f"{s}_ankle"]] for s in _SIDE_UP}
-        step = stepper.trigger(state.time_s, tick.com_c, tick.com_vel_c, tick.a_c, quats,
-                               [s for s in _SIDE_UP if tick.contact[s] or sole_on_ground(tick.a_c[s], quats[s])])
+        on_ground = [s for s in _SIDE_UP if tick.contact[s] or sole_within_m(tick.a_c[s], quats[s], ON_GROUND_GAP_M)]
+        step = stepper.trigger(state.time_s, tick.com_c, tick.com_vel_c, tick.a_c, quats, on_ground)
         if step is not None:
             timeout_s = self.cfg.recovery_swing_s + self.cfg.late_contact_timeout_s
             tick.ch_state = self.char_fsm.begin_recovery_step(step.side, state.time_s, timeout_s)

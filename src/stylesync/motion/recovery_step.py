@@ -73,11 +73,6 @@ def operator_stands(xi_h_world: np.ndarray, ankles_h_world: dict[str, np.ndarray
     return outside_distance_m(xi_h_world, convex_hull_xy(np.vstack(corners)))[0] <= 0.0
 
 
-def sole_on_ground(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray) -> bool:
-    """Whether the lowest corner of a foot's sole is within ON_GROUND_GAP_M of the (level) ground."""
-    return float(sole_corners_world(ankle_world, foot_quat_wxyz)[:, 2].min()) < ON_GROUND_GAP_M
-
-
 def stands_on(xi_world: np.ndarray, stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray,
               landing_ankle_world: np.ndarray, heading_world: np.ndarray) -> bool:
     """Whether a capture point (horizontal) is within the support polygon of the stance sole and a sole landed
