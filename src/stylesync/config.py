@@ -116,6 +116,9 @@ class MotionConfig:
     stance_hysteresis_m: float = 0.01
     # Late contact (Sec. 5.1): the reference is held until the character's foot touches down, at most this long.
     late_contact_timeout_s: float = 0.4
+    # While a late contact holds the reference (Sec. 5.1), the pelvis and COM targets go on over the ground at the
+    # desired COM velocity the hold began with (off: they stop where the operator was, braking the character)
+    late_contact_keeps_momentum: bool = True
     # Early contact (Sec. 5.1) only counts once the swing has lasted this long (a lifting foot still touches).
     min_swing_s: float = 0.12
     stance_hip_weight_w0: float = 0.5  # Eq. 11 weight w0 (not given in the paper)
@@ -142,6 +145,10 @@ class MotionConfig:
     recovery_swing_s: float = 0.3
     recovery_step_height_m: float = 0.05
     recovery_min_stance_s: float = 0.1
+    # Step timing (motion/recovery_step.py): a swing of the operator's that has lasted this many times his usual
+    # swing time, while the character's capture point is outside its stance sole by more than the margin, is
+    # landed by the balance (a recovery step takes it over) [-]
+    recovery_swing_overrun: float = 1.5
 
     def __post_init__(self) -> None:
         lo, hi = self.step_outside_capture_point_m
@@ -156,6 +163,7 @@ class MotionConfig:
         _positive("MotionConfig.recovery_swing_s", self.recovery_swing_s)
         _non_negative("MotionConfig.recovery_step_height_m", self.recovery_step_height_m)
         _non_negative("MotionConfig.recovery_min_stance_s", self.recovery_min_stance_s)
+        _positive("MotionConfig.recovery_swing_overrun", self.recovery_swing_overrun)
         _non_negative("MotionConfig.stance_hysteresis_m", self.stance_hysteresis_m)
         _positive("MotionConfig.late_contact_timeout_s", self.late_contact_timeout_s)
         _non_negative("MotionConfig.min_swing_s", self.min_swing_s)

@@ -41,7 +41,14 @@ from stylesync.motion.balance_strategy import stance_hip_blend, swing_hip_feedba
 from stylesync.motion.bounds import BoundsMonitor, step_length_bound_m
 from stylesync.motion.leg_ik import solve_leg
 from stylesync.motion.operator_analysis import UPPER_JOINTS, OperatorAnalysis, analyse_operator, upper_local
-from stylesync.motion.recovery_step import ON_GROUND_GAP_M, RecoveryStepper, operator_stands, stands_on
+from stylesync.motion.recovery_step import (
+    ON_GROUND_GAP_M,
+    RecoveryStepper,
+    capture_point,
+    operator_stands,
+    sole_outside_m,
+    stands_on,
+)
 from stylesync.motion.reference import LipmMap, ReferencePose
 from stylesync.motion.stance_fsm import (
     CharacterStanceFsm,
@@ -120,6 +127,11 @@ class _SmoothedRate:
         self._prev: np.ndarray | None = None
         self._rate = np.zeros(3)
 
+    @property
+    def rate(self) -> np.ndarray:
+        """The current estimate (3,)."""
+        return self._rate
+
     def __call__(self, x: np.ndarray) -> np.ndarray:
         if self._prev is not None:
             self._rate += _VELOCITY_SMOOTHING * ((x - self._prev) / self.dt_s - self._rate)
@@ -178,6 +190,8 @@ class MotionOptimizer:
         self._anchor_decay = np.exp(-self.dt_s / ANCHOR_BLEND_S)  # per tick
         self._swing_decay = np.exp(-self.dt_s / SWING_BLEND_S)  # per tick
         self._last_xy: np.ndarray | None = None
+        self._hold_velocity: np.ndarray | None = None  # the desired COM velocity a late-contact hold began with
+        self._hold_shift = np.zeros(2)  # the held targets' travel since the hold began [m]
         self._swing: str | None = None
         self._swing_offset = np.zeros(2)  # lift-off foot position minus the first swing target, decaying [m]
         self._swing_t0_s = 0.0  # when the character's current swing began [s]
@@ -269,6 +283,18 @@ class MotionOptimizer:
         self._anchor_offset *= self._anchor_decay
         pelvis_xy = np.array([*(pelvis_xy[:2] + self._anchor_offset[0]), 0.0])
         com_xy = np.array([*(com_xy[:2] + self._anchor_offset[1]), 0.0])
+        if self.cfg.late_contact_keeps_momentum:
+            # A held reference (late contact) holds the operator's pose, not his progress over the ground: the
+            # targets go on at the desired COM velocity the hold began with, so that the character's momentum is
+            # not braked towards where he was.
+            if self.char_fsm.hold_reference:
+                if self._hold_velocity is None:
+                    self._hold_velocity = self._com_d_rate.rate[:2].copy()
+                self._hold_shift = self._hold_shift + self._hold_velocity * self.dt_s
+                pelvis_xy[:2] += self._hold_shift
+                com_xy[:2] += self._hold_shift
+            else:
+                self._hold_velocity, self._hold_shift = None, np.zeros(2)
         self._last_xy = np.array([pelvis_xy[:2], com_xy[:2]])
         tick.pelvis_d = np.array([pelvis_xy[0], pelvis_xy[1], ANKLE_HEIGHT_M + scale * (p_h[2] - ankle_h_z)])  # Eq. 9
         # The operator's COM height reflects his own mass distribution, not the character's: the vertical is left
@@ -288,6 +314,7 @@ class MotionOptimizer:
         """A planted foot where it is, the swing foot where the operator's is (or where a recovery step lands); the
         pelvis lowered as far as a foot that must land needs."""
         self._recovery_step(tick, state)
+        self._land_overrun_swing(tick, state)
         tick.weights = stance_weights(tick.ch_state, self._ds_left_share(tick.com_c, tick.a_c))
         sw = tick.swing = swing_side(tick.ch_state)
         for side in ("left", "right"):
@@ -374,6 +401,24 @@ class MotionOptimizer:
             timeout_s = self.cfg.recovery_swing_s + self.cfg.late_contact_timeout_s
             tick.ch_state = self.char_fsm.begin_recovery_step(step.side, state.time_s, timeout_s)
             self._swing_t0_s = state.time_s
+
+    def _land_overrun_swing(self, tick: _Tick, state: CharacterState) -> None:
+        """Step timing adapted to the balance: a swing that has lasted ``recovery_swing_overrun`` times the
+        operator's usual swing time (he holds a foot up: a pose on one leg, the held last frame of a clip) while the
+        character's capture point has left its stance sole by more than the margin (it cannot stand on one foot
+        as he does) becomes a recovery step, which lands the foot where the capture point will be."""
+        cfg = self.cfg
+        sw = swing_side(tick.ch_state)
+        if (not cfg.recovery_steps or sw is None or sw != self._swing or self.char_fsm.recovery_step
+                or self.char_fsm.hold_reference or state.time_s - self._swing_t0_s < cfg.recovery_swing_overrun * self._op_swing_s):
+            return
+        other = _OTHER_SIDE[sw]
+        stance_q = state.link_quat_wxyz[_LINK[f"{other}_ankle"]]
+        xi, _ = capture_point(tick.com_c, tick.com_vel_c, self.g)
+        if sole_outside_m(xi, tick.a_c[other], stance_q) <= cfg.recovery_step_margin_m:
+            return
+        self.recovery.take_over(sw, state.time_s, state.link_origin_world[_LINK[f"{sw}_ankle"]])
+        self.char_fsm.take_over_swing(state.time_s, cfg.recovery_swing_s + cfg.late_contact_timeout_s)
 
     def _swing_target(self, tick: _Tick, state: CharacterState, side: str) -> np.ndarray:
         """Where the swing foot goes this tick.

@@ -73,6 +73,11 @@ def operator_stands(xi_h_world: np.ndarray, ankles_h_world: dict[str, np.ndarray
     return outside_distance_m(xi_h_world, convex_hull_xy(np.vstack(corners)))[0] <= 0.0
 
 
+def sole_outside_m(xi_world: np.ndarray, ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray) -> float:
+    """How far a capture point (horizontal) is outside one sole (negative: inside) [m]."""
+    return float(outside_distance_m(xi_world, convex_hull_xy(sole_corners_world(ankle_world, foot_quat_wxyz)[:, :2]))[0])
+
+
 def stands_on(xi_world: np.ndarray, stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray,
               landing_ankle_world: np.ndarray, heading_world: np.ndarray) -> bool:
     """Whether a capture point (horizontal) is within the support polygon of the stance sole and a sole landed
@@ -83,14 +88,29 @@ def stands_on(xi_world: np.ndarray, stance_ankle_world: np.ndarray, stance_foot_
     return outside_distance_m(xi_world, convex_hull_xy(corners))[0] <= 0.0
 
 
+def not_across(landing_world: np.ndarray, stance_ankle_world: np.ndarray, heading_world: np.ndarray,
+               side: str) -> np.ndarray:
+    """(3,) a swing ankle's landing moved sideways, if needed, to at least ``MIN_FOOT_SEPARATION_M`` outwards of
+    the stance ankle in the heading frame (``heading_world``: (3, 3), x forward, y left): a foot landing across
+    the stance foot leaves the body's weight outside the new stance and the legs crossed."""
+    base = np.array([stance_ankle_world[0], stance_ankle_world[1], 0.0])
+    rel = heading_world.T @ (np.array([landing_world[0], landing_world[1], 0.0]) - base)
+    out = _OUT[side]
+    rel[1] = out * max(out * rel[1], MIN_FOOT_SEPARATION_M)
+    landing = base + heading_world @ rel
+    landing[2] = landing_world[2]
+    return landing
+
+
 @dataclass
 class RecoveryStep:
     """A step the character takes on its own (world frame) [m, s]."""
 
     side: str  # the swinging foot
     start_s: float
-    lift_off_world: np.ndarray  # (3,) swing ankle at lift-off
+    lift_off_world: np.ndarray  # (3,) swing ankle at lift-off (or where it was when the step took a swing over)
     landing_world: np.ndarray  # (3,) the planned landing of the swing ankle, re-planned each tick
+    taken_over: bool = False  # the step took over a swing already in the air (it only lands it)
 
 
 class RecoveryStepper:
@@ -123,6 +143,14 @@ class RecoveryStepper:
         side = _OTHER[stance]
         self.step = RecoveryStep(side, time_s, np.array(ankles_world[side], dtype=float),
                                  np.array(ankles_world[side], dtype=float))
+        self.count += 1
+        return self.step
+
+    def take_over(self, side: str, time_s: float, swing_ankle_world: np.ndarray) -> RecoveryStep:
+        """Turn the swing of ``side``, in the air since the operator lifted it, into a recovery step that lands it
+        (step timing adaptation: the balance decides when the step ends)."""
+        ankle = np.array(swing_ankle_world, dtype=float)
+        self.step = RecoveryStep(side, time_s, ankle, ankle.copy(), taken_over=True)
         self.count += 1
         return self.step
 
@@ -160,8 +188,7 @@ class RecoveryStepper:
         length = float(np.linalg.norm(rel[:2]))
         if length > self.max_step_m:
             rel[:2] *= self.max_step_m / length
-        rel[1] = out * max(out * rel[1], MIN_FOOT_SEPARATION_M)
-        landing = base + R @ rel
+        landing = not_across(base + R @ rel, stance_ankle_world, R, side)
         landing[2] = ANKLE_HEIGHT_M
         return landing, xi_land
 
@@ -178,7 +205,11 @@ class RecoveryStepper:
         step.landing_world = landing
         phase = elapsed / cfg.recovery_swing_s
         target = step.lift_off_world + smooth_step(min(phase / HORIZONTAL_SHARE, 1.0)) * (landing - step.lift_off_world)
-        if phase < 1.0:
+        if phase < 1.0 and step.taken_over:
+            # Already in the air: lowered from where it is to the ground by the time it is over the landing.
+            lowered = smooth_step(min(phase / HORIZONTAL_SHARE, 1.0))
+            target[2] = step.lift_off_world[2] + lowered * (ANKLE_HEIGHT_M - step.lift_off_world[2])
+        elif phase < 1.0:
             target[2] = ANKLE_HEIGHT_M + cfg.recovery_step_height_m * np.sin(np.pi * phase)
         else:
             target[2] = ANKLE_HEIGHT_M - LANDING_PRESS_M

@@ -73,6 +73,7 @@ class CharacterStanceFsm:
         self._early_latched_for: Stance | None = None
         self.recovery_step = False  # the current single stance is the character's own recovery step
         self._recovery_timeout_s = 0.0
+        self._recovery_start_s = 0.0
 
     def begin_recovery_step(self, swing: str, time_s: float, timeout_s: float) -> Stance:
         """From double stance, lift ``swing`` on the character's own decision; the step ends at its contact, or
@@ -80,7 +81,17 @@ class CharacterStanceFsm:
         self._early_latched_for = None
         self._enter(Stance.RS if swing == "left" else Stance.LS, time_s)
         self.recovery_step, self._recovery_timeout_s = True, timeout_s
+        self._recovery_start_s = time_s
         return self.state
+
+    def take_over_swing(self, time_s: float, timeout_s: float) -> None:
+        """The current swing (the operator's step) becomes the character's own recovery step from ``time_s``: it
+        ends at its contact, or ``timeout_s`` later, whatever the operator does meanwhile."""
+        assert swing_side(self.state) is not None
+        self._early_latched_for = None
+        self._holding = False
+        self.recovery_step, self._recovery_timeout_s = True, timeout_s
+        self._recovery_start_s = time_s
 
     def update(self, op: Stance, contact: dict[str, bool], time_s: float) -> Stance:
         self.hold_reference = False
@@ -90,7 +101,7 @@ class CharacterStanceFsm:
             sw = swing_side(self.state)
             assert sw is not None
             landed = contact[sw] and time_s - self._swing_start_s >= self.min_swing_s
-            if not landed and time_s - self._swing_start_s < self._recovery_timeout_s:
+            if not landed and time_s - self._recovery_start_s < self._recovery_timeout_s:
                 return self.state
             self.recovery_step = False
             if op is self.state:  # he lifted the same foot meanwhile: his step counts as taken (early contact)
