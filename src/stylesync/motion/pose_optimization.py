@@ -409,8 +409,9 @@ class MotionOptimizer:
         as he does) becomes a recovery step, which lands the foot where the capture point will be."""
         cfg = self.cfg
         sw = swing_side(tick.ch_state)
+        overrun_s = cfg.recovery_swing_overrun * self._op_swing_s
         if (not cfg.recovery_steps or sw is None or sw != self._swing or self.char_fsm.recovery_step
-                or self.char_fsm.hold_reference or state.time_s - self._swing_t0_s < cfg.recovery_swing_overrun * self._op_swing_s):
+                or self.char_fsm.hold_reference or state.time_s - self._swing_t0_s < overrun_s):
             return
         other = _OTHER_SIDE[sw]
         stance_q = state.link_quat_wxyz[_LINK[f"{other}_ankle"]]

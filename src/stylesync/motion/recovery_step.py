@@ -75,7 +75,8 @@ def operator_stands(xi_h_world: np.ndarray, ankles_h_world: dict[str, np.ndarray
 
 def sole_outside_m(xi_world: np.ndarray, ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray) -> float:
     """How far a capture point (horizontal) is outside one sole (negative: inside) [m]."""
-    return float(outside_distance_m(xi_world, convex_hull_xy(sole_corners_world(ankle_world, foot_quat_wxyz)[:, :2]))[0])
+    sole = convex_hull_xy(sole_corners_world(ankle_world, foot_quat_wxyz)[:, :2])
+    return float(outside_distance_m(xi_world, sole)[0])
 
 
 def stands_on(xi_world: np.ndarray, stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray,
@@ -183,7 +184,6 @@ class RecoveryStepper:
         # Within reach, and never across the stance foot (heading frame, relative to the stance ankle).
         base = np.array([stance_ankle_world[0], stance_ankle_world[1], 0.0])
         rel = R.T @ (ankle - base)
-        out = _OUT[side]
         rel[2] = 0.0
         length = float(np.linalg.norm(rel[:2]))
         if length > self.max_step_m:
