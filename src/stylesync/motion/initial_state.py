@@ -53,10 +53,13 @@ class InitialState:
     joint_vel: np.ndarray  # (n_joints, 3): ball joints child-frame angular velocity [rad/s], hinge rate in column 0
 
 
-def retargeted_pose(s: OperatorSample, analysis: OperatorAnalysis) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def retargeted_pose(s: OperatorSample, analysis: OperatorAnalysis, scale: float | None = None
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(root position [m], root quaternion, joint positions) of the character for one operator sample, the pelvis
-    over the ground at the operator's, scaled by h_C / h_H from the world origin (differences give velocities)."""
-    scale = CHAR_LEG_LENGTH_M / analysis.leg_m  # Eq. 9
+    over the ground at the operator's, scaled by ``scale`` (default h_C / h_H of this sample, Eq. 9) from the world
+    origin (differences of poses at one scale give velocities)."""
+    if scale is None:
+        scale = CHAR_LEG_LENGTH_M / analysis.leg_m  # Eq. 9
     q_root = analysis.root_quat_wxyz
     R_root = rot.matrix_from_quat(q_root)
     p_h = s.pos["PELVIS"]
@@ -85,8 +88,12 @@ def initial_state(s0: OperatorSample, a0: OperatorAnalysis, s1: OperatorSample, 
     dt = s1.time_s - s0.time_s
     if not dt > 0:
         raise ValueError("initial_state needs a second sample later than the first")
-    p0, q0, j0 = retargeted_pose(s0, a0)
-    p1, q1, j1 = retargeted_pose(s1, a1)
+    # One scale for both poses: positions are scaled from the world origin, metres away, and the sensor noise on the
+    # operator's leg length (Eq. 1) changes the scale from sample to sample by about 1 %, which alone would add some
+    # 0.3 m/s to a forward difference over a 16 Hz frame.
+    scale = CHAR_LEG_LENGTH_M / a0.leg_m
+    p0, q0, j0 = retargeted_pose(s0, a0, scale)
+    p1, q1, j1 = retargeted_pose(s1, a1, scale)
     q1 = rot.align_sign(q1, q0)
     ang_root = rot.rotvec_from_quat(rot.multiply(q1, rot.conjugate(q0))) / dt
     joint_vel = np.zeros((len(JOINTS), 3))
