@@ -188,3 +188,21 @@ def test_a_late_contact_hold_keeps_the_walk_going():
     assert not on.fell
     off, _ = _run(spec, 7.32, MotionConfig(late_contact_keeps_momentum=False))
     assert off.fell
+
+
+def test_a_sideways_drift_steps_with_the_foot_that_can_catch_it_not_the_one_that_would_cross():
+    """Traced at rest after CMU 06_01 (seed 1): the left foot 0.26 m behind the right, the capture point drifting
+    out beside the right sole. The nearer sole is the right one, but the left foot cannot land beyond it (never
+    across it): its step would leave the capture point outside; the right foot's step out catches it."""
+    ankles = {"left": np.array([-0.298, 0.106, ANKLE_HEIGHT_M]), "right": np.array([-0.036, 0.058, ANKLE_HEIGHT_M])}
+    com, vel = np.array([-0.073, 0.004, 0.8]), np.array([-0.03, -0.09, 0.0])
+    stepper = RecoveryStepper(MotionConfig(), CHAR_LEG_LENGTH_M, G)
+    residual = {stance: stepper.capture_residual_m(com, vel, ankles[stance], IDENTITY, np.eye(3), swing)
+                for stance, swing in (("left", "right"), ("right", "left"))}
+    assert residual["left"] <= 0.0 < residual["right"]
+    step = stepper.trigger(1.0, com, vel, ankles, QUATS, ["left", "right"], np.eye(3))
+    assert step is not None and step.side == "right"
+    # Without the heading frame the nearer sole is the stance, as before.
+    stepper = RecoveryStepper(MotionConfig(), CHAR_LEG_LENGTH_M, G)
+    step = stepper.trigger(1.0, com, vel, ankles, QUATS, ["left", "right"])
+    assert step is not None and step.side == "left"

@@ -396,7 +396,7 @@ class MotionOptimizer:
             return  # a double stance shorter than this is a walk's: his next step is the character's
         quats = {s: state.link_quat_wxyz[_LINK[f"{s}_ankle"]] for s in _SIDE_UP}
         on_ground = [s for s in _SIDE_UP if tick.contact[s] or sole_within_m(tick.a_c[s], quats[s], ON_GROUND_GAP_M)]
-        step = stepper.trigger(state.time_s, tick.com_c, tick.com_vel_c, tick.a_c, quats, on_ground)
+        step = stepper.trigger(state.time_s, tick.com_c, tick.com_vel_c, tick.a_c, quats, on_ground, tick.R_root_d)
         if step is not None:
             timeout_s = self.cfg.recovery_swing_s + self.cfg.late_contact_timeout_s
             tick.ch_state = self.char_fsm.begin_recovery_step(step.side, state.time_s, timeout_s)

@@ -13,7 +13,9 @@ smaller body can; a push moves the character, not him. Then, when the character'
 ``MotionConfig.recovery_step_margin_m`` outside the support polygon of its soles on the ground, it steps on its
 own:
 
-* the stance foot is the one whose sole is nearer ξ (the centre of pressure moves there), the other swings;
+* the stance foot is the one whose step leaves the predicted capture point least outside the new support (the
+  stance sole and the swing sole at its landing, below), the one whose sole is nearer ξ on a tie: when ξ drifts out
+  beside the front foot of a staggered stance, the rear foot cannot land beyond it, and the front foot steps out;
 * the landing is planned each tick where ξ will be when the foot lands: with the centre of pressure held at the
   stance sole's point nearest ξ, ``ξ(t + τ) = p + (ξ(t) - p) e^(ω τ)``, τ the swing time left; the sole is placed
   with its trailing edge there (trailing along ξ's direction of divergence from p), so that every centre of
@@ -24,7 +26,9 @@ own:
   landing, and after ``recovery_swing_s`` is lowered below the ground until it touches (the stance FSM ends the
   step on its contact).
 
-The step's timing is the nominal swing time; its position is what adapts, each tick, to the capture point.
+The step's timing is the nominal swing time; its position is what adapts, each tick, to the capture point. A
+swing of the operator's that he holds up too long while the character cannot stand on one foot is taken over by
+such a step in the air (:meth:`RecoveryStepper.take_over`): the foot is lowered from where it is.
 """
 
 from __future__ import annotations
@@ -127,10 +131,12 @@ class RecoveryStepper:
 
     def trigger(self, time_s: float, com_world: np.ndarray, com_vel_world: np.ndarray,
                 ankles_world: dict[str, np.ndarray], feet_quat_wxyz: dict[str, np.ndarray],
-                on_ground: list[str]) -> RecoveryStep | None:
+                on_ground: list[str], heading_world: np.ndarray | None = None) -> RecoveryStep | None:
         """A new step when the capture point is outside the support polygon of the soles ``on_ground`` by more
         than the margin (and the last recovery step ended at least ``recovery_min_stance_s`` ago). The stance
-        foot is the one on the ground whose sole is nearer the capture point."""
+        foot is the one on the ground whose sole is nearer the capture point; with ``heading_world`` ((3, 3),
+        x forward) and both feet on the ground, the foot whose step leaves the predicted capture point least
+        outside the new support (:meth:`capture_residual_m`), the nearer sole on a tie."""
         cfg = self.cfg
         if not cfg.recovery_steps or not on_ground or time_s - self._last_end_s < cfg.recovery_min_stance_s:
             return None
@@ -141,11 +147,28 @@ class RecoveryStepper:
             return None
         dist = {s: outside_distance_m(xi, convex_hull_xy(c))[0] for s, c in corners.items()}
         stance = min(dist, key=lambda s: dist[s])
+        if heading_world is not None and len(on_ground) == 2:
+            residual = {s: self.capture_residual_m(com_world, com_vel_world, ankles_world[s], feet_quat_wxyz[s],
+                                                   heading_world, _OTHER[s]) for s in on_ground}
+            best = min(residual.values())
+            if residual[stance] > best + 1e-3:
+                stance = min(residual, key=lambda s: residual[s])
         side = _OTHER[stance]
         self.step = RecoveryStep(side, time_s, np.array(ankles_world[side], dtype=float),
                                  np.array(ankles_world[side], dtype=float))
         self.count += 1
         return self.step
+
+    def capture_residual_m(self, com_world: np.ndarray, com_vel_world: np.ndarray, stance_ankle_world: np.ndarray,
+                           stance_foot_quat_wxyz: np.ndarray, heading_world: np.ndarray, side: str) -> float:
+        """How far the capture point, at the end of a nominal recovery swing of ``side`` from now, would be outside
+        the support of the stance sole and the swing sole at its capture landing (<= 0: the step captures it) [m]."""
+        landing, xi_land = self.capture_landing(self.cfg.recovery_swing_s, com_world, com_vel_world,
+                                                stance_ankle_world, stance_foot_quat_wxyz, heading_world, side)
+        yaw = float(np.arctan2(heading_world[1, 0], heading_world[0, 0]))
+        corners = np.vstack([sole_corners_world(stance_ankle_world, stance_foot_quat_wxyz)[:, :2],
+                             sole_corners_world(landing, rot.quat_from_yaw(yaw))[:, :2]])
+        return float(outside_distance_m(xi_land, convex_hull_xy(corners))[0])
 
     def take_over(self, side: str, time_s: float, swing_ankle_world: np.ndarray) -> RecoveryStep:
         """Turn the swing of ``side``, in the air since the operator lifted it, into a recovery step that lands it
