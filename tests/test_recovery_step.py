@@ -206,3 +206,42 @@ def test_a_sideways_drift_steps_with_the_foot_that_can_catch_it_not_the_one_that
     stepper = RecoveryStepper(MotionConfig(), CHAR_LEG_LENGTH_M, G)
     step = stepper.trigger(1.0, com, vel, ankles, QUATS, ["left", "right"])
     assert step is not None and step.side == "left"
+
+
+@pytest.mark.skipif(not (MOCAP / "cmu" / "02_01.bvh").exists(), reason="../shared/mocap/cmu/02_01.bvh is not available")
+def test_a_recovery_step_lets_the_body_move_as_its_landing_assumes():
+    """CMU 02_01, seed 0, in the rest after the clip: the operator's COM is over one of his feet and the COM task
+    pulled the character's there while its recovery step was in the air, so the foot landed where the capture point
+    no longer went (measured: a fall at 4.55 s). With the COM task holding the character's own state during the
+    step, it comes to rest."""
+    spec = f"bvh:{MOCAP / 'cmu' / '02_01.bvh'}"
+    free, _ = _run(spec, 5.85, MotionConfig())
+    assert not free.fell
+    pulled, _ = _run(spec, 5.85, MotionConfig(recovery_step_free_com=False))
+    assert pulled.fell and pulled.fall_time_s is not None and pulled.fall_time_s > 2.85
+
+
+def test_targets_that_follow_the_operator_keep_the_walk_up_with_him():
+    """The built-in walk, 7 s: with the feet-anchored targets the character covers about a third of the operator's
+    (scaled) distance, braked at each stance change; with the targets advancing at his velocity it covers most."""
+    from stylesync.session import Session
+    from stylesync.sources.registry import open_source
+
+    covered = {}
+    for tau in (0.0, 0.5):
+        opened = open_source("builtin:walk", seed=0, duration_s=7.0)
+        cfg = SessionConfig(duration_s=7.0, seed=0, motion=MotionConfig(reference_follows_operator_s=tau))
+        session = Session(cfg, opened.source)
+        start = {}
+
+        def on_tick(state, ref, session=session, start=start):
+            com = session.mass.com(state)
+            start.setdefault("com", com.copy())
+            start["end"] = com.copy()
+
+        session.on_tick = on_tick
+        result = session.run()
+        assert not result.fell
+        covered[tau] = float(np.linalg.norm((start["end"] - start["com"])[:2]))
+    assert covered[0.5] > 2.0 * covered[0.0]
+    assert covered[0.5] > 3.0

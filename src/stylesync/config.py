@@ -119,6 +119,10 @@ class MotionConfig:
     # While a late contact holds the reference (Sec. 5.1), the pelvis and COM targets go on over the ground at the
     # desired COM velocity the hold began with (off: they stop where the operator was, braking the character)
     late_contact_keeps_momentum: bool = True
+    # Opt-in (0: off): the pelvis and COM targets advance at the operator's scaled COM velocity and are pulled towards
+    # the feet-anchored targets of Eq. 10 with this time constant [s]. The character then keeps up with the operator
+    # over the ground (about twice the distance on the walk set) but falls more often (docs/decisions.md).
+    reference_follows_operator_s: float = 0.0
     # Early contact (Sec. 5.1) only counts once the swing has lasted this long (a lifting foot still touches).
     min_swing_s: float = 0.12
     stance_hip_weight_w0: float = 0.5  # Eq. 11 weight w0 (not given in the paper)
@@ -149,6 +153,9 @@ class MotionConfig:
     # swing time, while the character's capture point is outside its stance sole by more than the margin, is
     # landed by the balance (a recovery step takes it over) [-]
     recovery_swing_overrun: float = 1.5
+    # During a recovery step the COM task holds the character's own COM state (no pull towards the operator's
+    # stance): the body moves as the landing's capture-point prediction assumes
+    recovery_step_free_com: bool = True
 
     def __post_init__(self) -> None:
         lo, hi = self.step_outside_capture_point_m
@@ -164,6 +171,7 @@ class MotionConfig:
         _non_negative("MotionConfig.recovery_step_height_m", self.recovery_step_height_m)
         _non_negative("MotionConfig.recovery_min_stance_s", self.recovery_min_stance_s)
         _positive("MotionConfig.recovery_swing_overrun", self.recovery_swing_overrun)
+        _non_negative("MotionConfig.reference_follows_operator_s", self.reference_follows_operator_s)
         _non_negative("MotionConfig.stance_hysteresis_m", self.stance_hysteresis_m)
         _positive("MotionConfig.late_contact_timeout_s", self.late_contact_timeout_s)
         _non_negative("MotionConfig.min_swing_s", self.min_swing_s)

@@ -192,6 +192,7 @@ class MotionOptimizer:
         self._last_xy: np.ndarray | None = None
         self._hold_velocity: np.ndarray | None = None  # the desired COM velocity a late-contact hold began with
         self._hold_shift = np.zeros(2)  # the held targets' travel since the hold began [m]
+        self._ref_xy: np.ndarray | None = None  # (pelvis, COM) x (x, y) targets that follow the operator [m]
         self._swing: str | None = None
         self._swing_offset = np.zeros(2)  # lift-off foot position minus the first swing target, decaying [m]
         self._swing_t0_s = 0.0  # when the character's current swing began [s]
@@ -296,6 +297,22 @@ class MotionOptimizer:
             else:
                 self._hold_velocity, self._hold_shift = None, np.zeros(2)
         self._last_xy = np.array([pelvis_xy[:2], com_xy[:2]])
+        tau = self.cfg.reference_follows_operator_s
+        if tau > 0:
+            # Opt-in: the targets advance at the operator's COM velocity (scaled), pulled towards the anchored ones
+            # with time constant tau, instead of taking up each anchor change as a decaying offset (which moves the
+            # targets back at every stance change of a character whose steps are shorter than his, and brakes it).
+            if self.char_fsm.hold_reference and self._hold_velocity is not None:
+                v_ff = self._hold_velocity
+            else:
+                v_ff = scale * self._com_h_rate.rate[:2]
+            raw = np.array([pelvis_xy[:2], com_xy[:2]])
+            if self._ref_xy is None:
+                self._ref_xy = raw.copy()
+            else:
+                pred = self._ref_xy + v_ff * self.dt_s
+                self._ref_xy = pred + (self.dt_s / tau) * (raw - pred)
+            pelvis_xy[:2], com_xy[:2] = self._ref_xy[0], self._ref_xy[1]
         tick.pelvis_d = np.array([pelvis_xy[0], pelvis_xy[1], ANKLE_HEIGHT_M + scale * (p_h[2] - ankle_h_z)])  # Eq. 9
         # The operator's COM height reflects his own mass distribution, not the character's: the vertical is left
         # to the pelvis height (Eq. 9) through the leg IK, and the COM target keeps the character's own height.
@@ -543,9 +560,16 @@ class MotionOptimizer:
         # the hands go where his are around his body, whatever the lag of the body over the ground).
         hands = {k: state.root_pos_world + tick.scale * (tick.s.pos[f"WRIST_{v}"] - tick.p_h)
                  for k, v in _SIDE_UP.items()}
+        com_d, com_vel_d = tick.com_d, tick.com_vel_d
+        if self.cfg.recovery_step_free_com and self.char_fsm.recovery_step:
+            # The character's own step: its landing is planned on the capture point of a body left to its pendulum
+            # (recovery_step.py); a COM target on the operator's stance would pull the body elsewhere while the foot
+            # is in the air, and the foot would land where the capture point no longer goes.
+            com_d = np.array([tick.com_c[0], tick.com_c[1], tick.com_d[2]])
+            com_vel_d = np.array([tick.com_vel_c[0], tick.com_vel_c[1], 0.0])
         return ReferencePose(
             time_s=state.time_s, joint_pos=joint_pos, root_quat_wxyz=tick.q_root_d, pelvis_world=tick.pelvis_d,
-            com_world=tick.com_d, com_vel_world=tick.com_vel_d, operator_stance=tick.op_state,
+            com_world=com_d, com_vel_world=com_vel_d, operator_stance=tick.op_state,
             character_stance=tick.ch_state, stance_weight=tick.weights, ankle_world=tick.a_c, lipm=lipm,
             operator_features=tick.analysis.features, held=self.char_fsm.hold_reference, scale=tick.scale,
             step_bound_exceeded=tick.step_exceeded, hand_world=hands,
