@@ -123,6 +123,13 @@ class MotionConfig:
     # the feet-anchored targets of Eq. 10 with this time constant [s]. The character then keeps up with the operator
     # over the ground (about twice the distance on the walk set) but falls more often (docs/decisions.md).
     reference_follows_operator_s: float = 0.0
+    # Weight shift before a lift-off from standing (pose_optimization._can_lift): the operator lifts a foot after a
+    # double stance of at least liftoff_after_stand_s [s] with his capture point over his other sole; while the
+    # character's is further than liftoff_margin_m [m] inwards of its own other sole, the foot stays down, at most
+    # liftoff_weight_shift_s [s] (0: off), and the COM target on his stance foot moves the weight over.
+    liftoff_weight_shift_s: float = 0.25
+    liftoff_after_stand_s: float = 0.3
+    liftoff_margin_m: float = 0.02
     # Early contact (Sec. 5.1) only counts once the swing has lasted this long (a lifting foot still touches).
     min_swing_s: float = 0.12
     stance_hip_weight_w0: float = 0.5  # Eq. 11 weight w0 (not given in the paper)
@@ -172,6 +179,8 @@ class MotionConfig:
         _non_negative("MotionConfig.recovery_min_stance_s", self.recovery_min_stance_s)
         _positive("MotionConfig.recovery_swing_overrun", self.recovery_swing_overrun)
         _non_negative("MotionConfig.reference_follows_operator_s", self.reference_follows_operator_s)
+        for n in ("liftoff_weight_shift_s", "liftoff_after_stand_s", "liftoff_margin_m"):
+            _non_negative(f"MotionConfig.{n}", getattr(self, n))
         _non_negative("MotionConfig.stance_hysteresis_m", self.stance_hysteresis_m)
         _positive("MotionConfig.late_contact_timeout_s", self.late_contact_timeout_s)
         _non_negative("MotionConfig.min_swing_s", self.min_swing_s)

@@ -25,6 +25,7 @@ from stylesync import rotations as rot
 from stylesync.config import MotionConfig
 from stylesync.model.character import (
     ANKLE_HEIGHT_M,
+    FOOT_WIDTH_M,
     HIP_HALF_WIDTH_M,
     JOINT_NAMES,
     JOINTS,
@@ -97,6 +98,13 @@ def _heading_frame_fraction(p_h, al_h, ar_h, al_c, ar_c, scale: float, R: np.nda
         if w > 0.0:
             out[ax] += w * (lc[ax] + spread_c * (ph[ax] - lh[ax]) / spread_h - offset)
     return R @ np.array(out)
+
+
+def _inward_m(point_world: np.ndarray, ankle_world: np.ndarray, foot_yaw_rad: float, side: str) -> float:
+    """How far a point is from the ``side`` ankle towards the other foot, across that foot (its frame's y) [m]."""
+    inward = -1.0 if side == "left" else 1.0
+    d = np.asarray(point_world, dtype=float)[:2] - np.asarray(ankle_world, dtype=float)[:2]
+    return inward * float(-np.sin(foot_yaw_rad) * d[0] + np.cos(foot_yaw_rad) * d[1])
 
 
 def map_upper_body(upper_local_wxyz: np.ndarray, local: dict[str, np.ndarray], hinge: dict[str, float]) -> None:
@@ -199,6 +207,7 @@ class MotionOptimizer:
         self._op_swing_s = OPERATOR_SWING_S  # the operator's swing time, averaged over his swings [s]
         self._op_state: Stance | None = None
         self._op_state_t0_s = 0.0
+        self._op_last_ds_s = 0.0
         self.recovery = RecoveryStepper(cfg, CHAR_LEG_LENGTH_M, gravity_mps2)
         self._operator_stands_since_s: float | None = None
 
@@ -208,7 +217,7 @@ class MotionOptimizer:
         :func:`analyse_operator` of ``sample`` if it was computed ahead (prefetch.py); None computes it here."""
         if analysis is None:
             analysis = analyse_operator(sample)
-        tick = self._track_stance(sample, state, analysis)
+        tick = self._track_stance(sample, state, analysis, mass)
         self._retarget_lower_body(tick, state, mass)
         self._plan_feet(tick, state)
         local, hinge = self._solve_legs(tick, state)
@@ -216,14 +225,46 @@ class MotionOptimizer:
         return self._reference(tick, state, local, hinge)
 
     # ---- 1. stance tracking (Sec. 5.1) ---------------------------------------------------------------------
+    def _can_lift(self, sample: OperatorSample, state: CharacterState, mass: MassProperties
+                  ) -> dict[str, bool] | None:
+        """Weight shift before a lift-off: per foot, whether the character may lift it now. A foot may not when the
+        operator lifts it after standing (a double stance of at least ``liftoff_after_stand_s``: a step or a kick
+        from standing, not a walk's double stance) with his capture point over his other sole, sideways (within
+        ``liftoff_margin_m`` of its inner edge, his sole the character's scaled to him), while the character's
+        capture point is further than that inwards of its own other sole. None: no such lift-off now."""
+        cfg = self.cfg
+        if cfg.liftoff_weight_shift_s <= 0.0:
+            return None
+        stood_s = (state.time_s - self._op_state_t0_s) if self._op_state is Stance.DS else self._op_last_ds_s
+        if stood_s < cfg.liftoff_after_stand_s:
+            return None
+        xi, _ = capture_point(mass.com(state), mass.com_velocity(state), self.g)
+        scale = CHAR_LEG_LENGTH_M / self._op_leg_m if self._op_leg_m else 1.0
+        h_h = max(sample.com_world[2] - min(sample.pos["ANKLE_LEFT"][2], sample.pos["ANKLE_RIGHT"][2]), 0.1)
+        xi_h = sample.com_world + self._com_h_rate.rate * np.sqrt(h_h / self.g)
+        edge = FOOT_WIDTH_M / 2 + cfg.liftoff_margin_m
+        can = {}
+        for side in ("left", "right"):
+            stance = _OTHER_SIDE[side]
+            ankle = state.link_origin_world[_LINK[f"{stance}_ankle"]]
+            yaw = rot.twist_angle(state.link_quat_wxyz[_LINK[f"{stance}_ankle"]], _UP)
+            ankle_h = sample.pos[f"ANKLE_{_SIDE_UP[stance]}"]
+            yaw_h = rot.twist_angle(sample.quat[f"ANKLE_{_SIDE_UP[stance]}"], _UP)
+            he_stands_on_it = scale * _inward_m(xi_h, ankle_h, yaw_h, stance) <= edge
+            can[side] = not he_stands_on_it or _inward_m(xi, ankle, yaw, stance) <= edge
+        return can
+
     def _track_stance(self, sample: OperatorSample, state: CharacterState,
-                      analysis: OperatorAnalysis) -> _Tick:
+                      analysis: OperatorAnalysis, mass: MassProperties) -> _Tick:
         """Both stance FSMs, the operator's swing time, and the sample the reference follows (held while the
         character waits for a late contact)."""
         op_state = self.op_fsm.update(sample.pos["ANKLE_LEFT"][2], sample.pos["ANKLE_RIGHT"][2])
         contact = state.feet_pressing()
-        ch_state = self.char_fsm.update(op_state, contact, state.time_s)
+        ch_state = self.char_fsm.update(op_state, contact, state.time_s, self._can_lift(sample, state, mass),
+                                        self.cfg.liftoff_weight_shift_s)
         if op_state is not self._op_state:  # the operator's swing time, for the swing's progress
+            if self._op_state is Stance.DS:
+                self._op_last_ds_s = state.time_s - self._op_state_t0_s
             if self._op_state in (Stance.LS, Stance.RS):
                 swing_s = min(max(state.time_s - self._op_state_t0_s, 0.2), 1.0)
                 self._op_swing_s += 0.5 * (swing_s - self._op_swing_s)

@@ -74,6 +74,8 @@ class CharacterStanceFsm:
         self.recovery_step = False  # the current single stance is the character's own recovery step
         self._recovery_timeout_s = 0.0
         self._recovery_start_s = 0.0
+        self.waiting_to_lift = False  # the operator has lifted a foot; the character shifts its weight first
+        self._lift_wait_from_s: float | None = None
 
     def begin_recovery_step(self, swing: str, time_s: float, timeout_s: float) -> Stance:
         """From double stance, lift ``swing`` on the character's own decision; the step ends at its contact, or
@@ -93,8 +95,13 @@ class CharacterStanceFsm:
         self.recovery_step, self._recovery_timeout_s = True, timeout_s
         self._recovery_start_s = time_s
 
-    def update(self, op: Stance, contact: dict[str, bool], time_s: float) -> Stance:
+    def update(self, op: Stance, contact: dict[str, bool], time_s: float,
+               can_lift: dict[str, bool] | None = None, lift_wait_s: float = 0.0) -> Stance:
+        """The character's stance this tick. ``can_lift``: per foot, whether the character's weight is over the
+        other foot; a lift-off from double stance the operator makes with a foot that cannot lift waits (the
+        weight shifts meanwhile) until it can, at most ``lift_wait_s``."""
         self.hold_reference = False
+        self.waiting_to_lift = False
         if self.recovery_step:
             # The character's own step goes on until its foot lands (or the timeout), whatever the operator does
             # meanwhile: the balance decides where and when it lands.
@@ -116,6 +123,7 @@ class CharacterStanceFsm:
             self._early_latched_for = None
         sw = swing_side(self.state)
         if self.state is op:
+            self._lift_wait_from_s = None
             # Early contact: swing foot down before the operator's transition.
             if sw is not None and contact[sw] and time_s - self._swing_start_s >= self.min_swing_s:
                 self._early_latched_for = op
@@ -133,6 +141,15 @@ class CharacterStanceFsm:
                 else:
                     self.hold_reference = True
             return self.state
+        sw_op = swing_side(op)
+        if self.state is Stance.DS and sw_op is not None and can_lift is not None and not can_lift[sw_op]:
+            # Lift-off from DS is the operator's decision, but the weight has to be over the stance foot first.
+            if self._lift_wait_from_s is None:
+                self._lift_wait_from_s = time_s
+            if time_s - self._lift_wait_from_s < lift_wait_s:
+                self.waiting_to_lift = True
+                return self.state
+        self._lift_wait_from_s = None
         self._enter(op, time_s)  # lift-off from DS is the operator's decision: follow at once
         return self.state
 
