@@ -270,7 +270,8 @@ def test_the_fsm_keeps_a_foot_down_until_the_weight_is_over_the_other_or_the_wai
     assert fsm.update(Stance.LS, both, 0.1) is Stance.LS
 
 
-@pytest.mark.skipif(not (MOCAP / "cmu" / "131_01.bvh").exists(), reason="../shared/mocap/cmu/131_01.bvh is not available")
+@pytest.mark.skipif(not (MOCAP / "cmu" / "131_01.bvh").exists(),
+                    reason="../shared/mocap/cmu/131_01.bvh is not available")
 def test_a_step_from_standing_waits_for_the_weight_to_shift():
     """CMU 131_01 (a styled walk), seed 0: the operator stands, then lifts his right foot with his capture point over
     his left sole; the character's was 7 cm outside its left sole and it fell sideways off it at 1.9 s. Waiting

@@ -43,12 +43,17 @@ def bvh_local_quats(link_quat_wxyz: np.ndarray) -> dict[str, np.ndarray]:
 
 
 def write_bvh(path: str | Path, times_s: np.ndarray, root_pos_world: np.ndarray, link_quat_wxyz: np.ndarray,
-              rest_link_origin_world: np.ndarray, frame_time_s: float | None = None) -> None:
+              rest_link_origin_world: np.ndarray, frame_time_s: float | None = None,
+              end_sites_world: dict[str, np.ndarray] | None = None) -> None:
     """Write the motion sampled at ``times_s`` (uniform) [s]; positions [m] in our world. ``frame_time_s``: the
-    file's Frame Time, the sampling clock's period (default: the median gap of ``times_s``)."""
+    file's Frame Time, the sampling clock's period (default: the median gap of ``times_s``). ``end_sites_world``:
+    where the end segments end in the rest pose [m] (keys: the wrist links, the hands' tips; leaf links, e.g. the
+    ankles and the neck, the toes' tips and the top of the head); without it the wrists' end sites are the wrist
+    joints and the leaves' have zero length."""
     idx = {n: i for i, n in enumerate(LINK_NAMES)}
     children = {n: [c for c in LINK_NAMES if LINK_PARENT[c] == n] for n in LINK_NAMES}
     rest = rest_link_origin_world @ R_BVH_OURS.T * CM_PER_M
+    ends = {k: np.asarray(v, dtype=float) @ R_BVH_OURS.T * CM_PER_M for k, v in (end_sites_world or {}).items()}
     lines = ["HIERARCHY"]
     order: list[str] = []
 
@@ -56,6 +61,8 @@ def write_bvh(path: str | Path, times_s: np.ndarray, root_pos_world: np.ndarray,
         pad = "\t" * depth
         par = LINK_PARENT[name]
         off = np.zeros(3) if par is None else rest[idx[name]] - rest[idx[par]]
+        if name in END_SITES and par is not None and name in ends:
+            off = ends[name] - rest[idx[par]]
         if name in END_SITES:
             lines.extend([f"{pad}End Site", f"{pad}{{", f"{pad}\tOFFSET {off[0]:.6f} {off[1]:.6f} {off[2]:.6f}",
                           f"{pad}}}"])
@@ -70,7 +77,9 @@ def write_bvh(path: str | Path, times_s: np.ndarray, root_pos_world: np.ndarray,
         for c in children[name]:
             block(c, depth + 1)
         if not children[name]:
-            lines.extend([f"{pad}\tEnd Site", f"{pad}\t{{", f"{pad}\t\tOFFSET 0 0 0", f"{pad}\t}}"])
+            tip = ends[name] - rest[idx[name]] if name in ends else np.zeros(3)
+            lines.extend([f"{pad}\tEnd Site", f"{pad}\t{{",
+                          f"{pad}\t\tOFFSET {tip[0]:.6f} {tip[1]:.6f} {tip[2]:.6f}", f"{pad}\t}}"])
         lines.append(f"{pad}}}")
 
     block("root", 0)
