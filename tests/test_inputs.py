@@ -311,3 +311,114 @@ def test_measure_cli_prints_the_link_table(capsys):
     assert cli_main(["measure", "--source", "deepmimic:walk", "--mass", "70"]) == 0
     out = capsys.readouterr().out
     assert "upper_leg" in out and "70.0 kg" in out
+
+
+def _vmc_bundle(messages):
+    from pythonosc.osc_bundle_builder import IMMEDIATELY, OscBundleBuilder
+    from pythonosc.osc_message_builder import OscMessageBuilder
+
+    bundle = OscBundleBuilder(IMMEDIATELY)
+    for addr, args in messages:
+        m = OscMessageBuilder(address=addr)
+        for a in args:
+            m.add_arg(a)
+        bundle.add_content(m.build())
+    return bundle.build()
+
+
+def _wait_frames(source, n, timeout_s=1.0):
+    import time
+
+    t0 = time.perf_counter()
+    while source.frames_received < n and time.perf_counter() - t0 < timeout_s:
+        time.sleep(0.001)
+    return source.frames_received
+
+
+def test_vmc_frames_close_with_their_own_packet_whatever_the_message_order():
+    """A frame is complete when its packet has arrived: with /VMC/Ext/T and /VMC/Ext/OK after the bones, before
+    them (a sender that stamps the frame first), or absent; a sender that spreads a frame over several packets and
+    sends neither closes it with its next root."""
+    pytest.importorskip("pythonosc")
+    from pythonosc.udp_client import SimpleUDPClient
+
+    from stylesync.sources.human_model import HumanModel
+    from stylesync.sources.vmc import VmcSender, VmcSource
+
+    source = VmcSource("127.0.0.1", 0)
+    client = SimpleUDPClient("127.0.0.1", source.port)
+    h = HumanModel()
+    builder = VmcSender("127.0.0.1", 9)  # builds the messages; nothing is sent to port 9
+    try:
+        msgs = builder.messages(h.frame_from_pose(0.0, np.array([0.0, 0.0, h.hip_height_m]), {}))
+        marks = [m for m in msgs if m[0] in ("/VMC/Ext/T", "/VMC/Ext/OK")]
+        body = [m for m in msgs if m not in marks]
+        for k, order in enumerate((body + marks, marks + body, body), start=1):
+            client.send(_vmc_bundle(order))
+            assert _wait_frames(source, k) == k  # no next packet needed
+        # Spread over packets, no T / OK: the next root closes the frame.
+        for addr, args in body:
+            client.send_message(addr, args)
+        assert _wait_frames(source, 4, timeout_s=0.2) == 3
+        client.send_message(*body[0])
+        assert _wait_frames(source, 4) == 4
+        assert source.rejected_frames == 0
+    finally:
+        source.close()
+
+
+def test_vmc_from_vmcp_own_sender_arrives_frame_by_frame():
+    """A third-party VMC sender (vmcp, PyPI, over osc4py3: ``pip install 'vmcp[osc4py3]'``, an optional test
+    dependency) sending bundles in its documented order (root, bones, /VMC/Ext/OK, /VMC/Ext/T): every frame is
+    received before the next is sent."""
+    pytest.importorskip("pythonosc")
+    pytest.importorskip("vmcp")
+    pytest.importorskip("osc4py3")
+    import time
+
+    from vmcp.osc import OSC
+    from vmcp.osc.backend.osc4py3 import as_comthreads as backend
+    from vmcp.osc.typing import Message
+
+    from stylesync.sources.human_model import HumanModel
+    from stylesync.sources.vmc import VmcSender, VmcSource
+
+    def typetags(args):
+        return "," + "".join("s" if isinstance(a, str) else "i" if isinstance(a, int) else "f" for a in args)
+
+    source = VmcSource("127.0.0.1", 0)
+    h = HumanModel()
+    builder = VmcSender("127.0.0.1", 9)
+    osc = OSC(backend)
+    try:
+        with osc.open():
+            sender = osc.create_sender("127.0.0.1", source.port, "stylesync-test").open()
+            for k in range(20):
+                msgs = builder.messages(h.frame_from_pose(k / 60, np.array([0.3, -0.2, h.hip_height_m]), {}))
+                ok = [m for m in msgs if m[0] == "/VMC/Ext/OK"]
+                t = [m for m in msgs if m[0] == "/VMC/Ext/T"]
+                body = [m for m in msgs if m[0] not in ("/VMC/Ext/OK", "/VMC/Ext/T")]
+                sender.send(tuple(Message(a, typetags(v), tuple(v)) for a, v in body + ok + t))
+                t0 = time.perf_counter()
+                while source.frames_received < k + 1 and time.perf_counter() - t0 < 1.0:
+                    osc.run()
+                    time.sleep(0.0005)
+                assert source.frames_received == k + 1
+        assert source.rejected_frames == 0
+        frame = source.poll(1e9)[-1]
+        assert np.linalg.norm(frame.pos("PELVIS")[:2] - np.array([0.3, -0.2])) < 0.01
+    finally:
+        source.close()
+
+
+@needs_cmu
+def test_a_run_names_the_sensor_its_frames_passed_through():
+    opened = open_source(f"bvh:{CMU / '02_01.bvh'}", seed=0, duration_s=1.0)
+    assert opened.sensor == "kinect"
+    assert open_source(f"bvh:{CMU / '02_01.bvh'}", sensor="none", duration_s=1.0).sensor == "none"
+    pytest.importorskip("pythonosc")
+    live = open_source("vmc://127.0.0.1:0")
+    try:
+        assert live.sensor == "live"
+    finally:
+        live.source.close()

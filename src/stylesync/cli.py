@@ -151,7 +151,7 @@ def _run(args: argparse.Namespace) -> int:
                         realtime=args.realtime or live or args.viewer != "none",
                         clocks=dataclasses.replace(clocks, mocap_hz=opened.mocap_hz),
                         control=ControlConfig(lipm_time_sync=not args.no_lipm))
-    return _run_session(cfg, opened.source, Path(args.out), {"source": args.source, "sensor": args.sensor,
+    return _run_session(cfg, opened.source, Path(args.out), {"source": args.source, "sensor": opened.sensor,
                                                               "lipm_time_sync": not args.no_lipm}, args)
 
 

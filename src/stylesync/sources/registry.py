@@ -34,6 +34,9 @@ class OpenedSource:
     duration_s: float | None  # length of a recording (with its lead-in) [s]; None for a live stream
     label: str
     performer: object | None = None  # noise-free recording, ``frame_at(t)``
+    # what the frames passed through: a recorded source's sensor model ("kinect", "none"), or "live" (the device's
+    # or sender's own frames, no sensor model)
+    sensor: str = "live"
 
 
 class _LeadIn:
@@ -88,7 +91,7 @@ def _recorded(performer, label: str, sensor: str, clocks: ClockConfig, op: Opera
         for f in frames:
             f.timestamp_s -= 1.0 / rate
     return OpenedSource(RecordedSource(frames, name=label, starts_in_motion=op.start_in_motion), rate,
-                        lead.duration_s, label, lead)
+                        lead.duration_s, label, lead, sensor)
 
 
 def open_source(spec: str, clocks: ClockConfig | None = None, operator: OperatorConfig | None = None,
@@ -130,7 +133,7 @@ def open_source(spec: str, clocks: ClockConfig | None = None, operator: Operator
         else:
             raise SourceError(f"unknown sensor model '{sensor}'; expected one of {', '.join(SENSORS)}")
         return OpenedSource(RecordedSource(model.sample(performer.frame_at, total), name=spec), clocks.mocap_hz,
-                            total, spec, performer)
+                            total, spec, performer, sensor)
     if spec.startswith("vmc://"):
         from stylesync.sources.vmc import DEFAULT_PORT, VmcSource
 

@@ -3,11 +3,13 @@ tools send it (Virtual Motion Capture, VSeeFace, XR Animator ...).
 
 Messages read: ``/VMC/Ext/Root/Pos`` (name, position xyz, rotation xyzw of the root in the world) and
 ``/VMC/Ext/Bone/Pos`` (Unity humanoid bone name, local position xyz, local rotation xyzw relative to the parent
-bone); ``/VMC/Ext/T`` (sender time [s]) closes a frame, and so does a new root message after bones arrived (for
-senders without ``T``). Unity axes are left-handed, y up, z forward, metres; we convert to ours (x forward, y left,
-z up): ``p_ours = (p_z, -p_x, p_y)``, and a quaternion's vector part ``(-q_z, q_x, -q_y)``. Bone rotations are
-taken relative to a normalised avatar's rest pose (identity local rotations in its T-pose, as VRM avatars are);
-the rest pose's segment directions come from the bones' local positions (sources/skeleton_tracks.py).
+bone); ``/VMC/Ext/OK`` (model state) and ``/VMC/Ext/T`` (sender time [s]) close a frame, as does the end of a UDP
+packet (an OSC bundle) in which a root and bones arrived, whatever the order of the messages in it; for senders
+that spread a frame over several packets and send neither, a new root message after bones does. Unity axes are
+left-handed, y up, z forward, metres; we convert to ours (x forward, y left, z up): ``p_ours = (p_z, -p_x, p_y)``,
+and a quaternion's vector part ``(-q_z, q_x, -q_y)``. Bone rotations are taken relative to a normalised avatar's
+rest pose (identity local rotations in its T-pose, as VRM avatars are); the rest pose's segment directions come
+from the bones' local positions (sources/skeleton_tracks.py).
 
 The socket listens on 127.0.0.1 unless another host is given. Each completed frame is stamped with its arrival
 time (``extras["arrival_wall_s"]``, ``time.perf_counter``) so that the session can measure the latency from
@@ -133,7 +135,7 @@ class VmcSource(QueuedLiveSource):
     def __init__(self, host: str = "127.0.0.1", port: int = DEFAULT_PORT, max_queue: int = 256):
         try:
             from pythonosc.dispatcher import Dispatcher
-            from pythonosc.osc_server import ThreadingOSCUDPServer
+            from pythonosc.osc_server import BlockingOSCUDPServer
         except ImportError:
             raise SourceError("the VMC source needs python-osc: pip install 'stylesync[live]'") from None
         super().__init__(max_queue)
@@ -143,19 +145,42 @@ class VmcSource(QueuedLiveSource):
         self._q_rest: dict[str, np.ndarray] | None = None
         self._t0 = time.perf_counter()
         self.frames_received = 0
-        d = Dispatcher()
+        self._root_in_packet = False
+        source = self
+
+        class _PacketDispatcher(Dispatcher):
+            """Dispatches a packet's messages, then tells the source the packet has ended."""
+
+            def call_handlers_for_packet(self, data: bytes, client_address: tuple[str, int]) -> Any:
+                source._root_in_packet = False
+                result = super().call_handlers_for_packet(data, client_address)
+                source._end_of_packet()
+                return result
+
+        d = _PacketDispatcher()
         d.map("/VMC/Ext/Root/Pos", self._on_root)
         d.map("/VMC/Ext/Bone/Pos", self._on_bone)
         d.map("/VMC/Ext/T", self._on_time)
+        d.map("/VMC/Ext/OK", self._on_ok)
         try:
-            self._server = ThreadingOSCUDPServer((host, port), d)
+            # One packet at a time, in arrival order: a frame is assembled from its packet's messages.
+            self._server = BlockingOSCUDPServer((host, port), d)
         except OSError as exc:
             raise SourceError(f"cannot listen for VMC on {host}:{port}: {exc.strerror or exc}") from None
         self.port = int(self._server.server_address[1])
         self._thread = threading.Thread(target=self._server.serve_forever, name="vmc-listener", daemon=True)
         self._thread.start()
 
+    def _end_of_packet(self) -> None:
+        """A packet that carried a root and bones holds a whole frame (one bundle per frame)."""
+        if self._root_in_packet and self._bones:
+            self._complete(None)
+
+    def _on_ok(self, _addr: str, *args: Any) -> None:
+        self._complete(None)
+
     def _on_root(self, _addr: str, *args: Any) -> None:
+        self._root_in_packet = True
         if self._bones:
             self._complete(None)
         try:
@@ -260,10 +285,9 @@ class VmcSender:
             rest_abs[b] = local[b] + (rest_abs[par] if par else 0.0)
         self._q_rest = rest_corrections({c: rest_abs[b] for c, b in CANONICAL_BONE.items()})
 
-    def send(self, frame: OperatorFrame, sender_time_s: float | None = None) -> None:
-        from pythonosc.osc_bundle_builder import IMMEDIATELY, OscBundleBuilder
-        from pythonosc.osc_message_builder import OscMessageBuilder
-
+    def messages(self, frame: OperatorFrame, sender_time_s: float | None = None) -> list[tuple[str, list]]:
+        """One frame's VMC messages (OSC address, arguments), in the order sent: the root, the bones, then
+        ``/VMC/Ext/T`` (sender time) and ``/VMC/Ext/OK`` (model loaded), which close the frame."""
         if self._rest_local is None:
             self._rest_from(frame)
         assert self._rest_local is not None and self._q_rest is not None
@@ -275,20 +299,27 @@ class VmcSender:
             world_q[f"{side}Shoulder"] = world_q["Chest"]
             world_q[f"{side}Toes"] = world_q[f"{side}Foot"]
             world_q[f"{side}Hand"] = world_q[f"{side}LowerArm"]
-        bundle = OscBundleBuilder(IMMEDIATELY)
+        root_p = frame.pos("PELVIS")
+        out: list[tuple[str, list]] = [("/VMC/Ext/Root/Pos", ["root", *unity_from_ours_pos(root_p).tolist(),
+                                                               *unity_from_ours_quat(rot.IDENTITY_WXYZ).tolist()])]
+        for b, lp in self._rest_local.items():
+            par = _parent(b, set(self._rest_local))
+            lq = world_q[b] if par is None else rot.multiply(rot.conjugate(world_q[par]), world_q[b])
+            out.append(("/VMC/Ext/Bone/Pos", [b, *unity_from_ours_pos(lp).tolist(),
+                                              *unity_from_ours_quat(lq).tolist()]))
+        out.append(("/VMC/Ext/T", [float(frame.timestamp_s if sender_time_s is None else sender_time_s)]))
+        out.append(("/VMC/Ext/OK", [1]))  # model loaded
+        return out
 
-        def msg(addr: str, args: list) -> None:
+    def send(self, frame: OperatorFrame, sender_time_s: float | None = None) -> None:
+        """Send one frame as one OSC bundle."""
+        from pythonosc.osc_bundle_builder import IMMEDIATELY, OscBundleBuilder
+        from pythonosc.osc_message_builder import OscMessageBuilder
+
+        bundle = OscBundleBuilder(IMMEDIATELY)
+        for addr, args in self.messages(frame, sender_time_s):
             m = OscMessageBuilder(address=addr)
             for a in args:
                 m.add_arg(a)
             bundle.add_content(m.build())  # type: ignore[arg-type]
-
-        root_p = frame.pos("PELVIS")
-        msg("/VMC/Ext/Root/Pos", ["root", *unity_from_ours_pos(root_p).tolist(),
-                                  *unity_from_ours_quat(rot.IDENTITY_WXYZ).tolist()])
-        for b, lp in self._rest_local.items():
-            par = _parent(b, set(self._rest_local))
-            lq = world_q[b] if par is None else rot.multiply(rot.conjugate(world_q[par]), world_q[b])
-            msg("/VMC/Ext/Bone/Pos", [b, *unity_from_ours_pos(lp).tolist(), *unity_from_ours_quat(lq).tolist()])
-        msg("/VMC/Ext/T", [float(frame.timestamp_s if sender_time_s is None else sender_time_s)])
         self._client.send(bundle.build())
