@@ -422,3 +422,57 @@ def test_a_run_names_the_sensor_its_frames_passed_through():
         assert live.sensor == "live"
     finally:
         live.source.close()
+
+
+def _walk_frames(seconds):
+    from stylesync.config import SessionConfig
+    from stylesync.sources.builtin_operator import builtin_operator
+
+    cfg = SessionConfig(duration_s=seconds)
+    source, _ = builtin_operator(cfg.operator, cfg.clocks, seconds + 1.0, 0)
+    return cfg, source.poll(1e9)
+
+
+def test_a_recording_whose_first_frames_lost_joints_starts_at_its_first_whole_frame():
+    """A lost knee (no confidence) in the first five frames, or NaN there (those frames rejected): the character
+    starts from the first frame with every joint tracked, not from garbage, and the run goes on."""
+    from stylesync.session import Session
+    from stylesync.sources.base import RecordedSource
+    from stylesync.sources.frame import JOINT_INDEX
+
+    for lost in (0.0, np.nan):
+        cfg, frames = _walk_frames(1.0)
+        for f in frames[:5]:
+            f.confidence[JOINT_INDEX["KNEE_LEFT"]] = 0.0
+            f.joint_pos_world[JOINT_INDEX["KNEE_LEFT"]] = lost
+        result = Session(cfg, RecordedSource(frames)).run()
+        assert not result.fell and result.sim_duration_s == pytest.approx(1.0, abs=0.01)
+
+
+def test_a_recording_with_no_whole_frame_ends_with_one_clear_line(tmp_path, capsys):
+    from stylesync.session import Session
+    from stylesync.sources.base import RecordedSource
+    from stylesync.sources.frame import JOINT_INDEX
+
+    cfg, frames = _walk_frames(1.0)
+    for f in frames:
+        f.confidence[JOINT_INDEX["ANKLE_RIGHT"]] = 0.0
+    with pytest.raises(SourceError, match="no frame with every joint tracked"):
+        Session(cfg, RecordedSource(frames)).run()
+
+
+def test_a_live_source_whose_frames_all_lost_joints_ends_with_one_clear_line(monkeypatch):
+    from stylesync import session as session_module
+    from stylesync.session import Session
+    from stylesync.sources.base import QueuedLiveSource
+    from stylesync.sources.frame import JOINT_INDEX
+
+    cfg, frames = _walk_frames(1.0)
+    for f in frames:
+        f.confidence[JOINT_INDEX["HIP_LEFT"]] = 0.0
+    live = QueuedLiveSource(256)
+    for f in frames:
+        live.push(f)
+    monkeypatch.setattr(session_module, "FIRST_FRAME_TIMEOUT_S", 0.3)
+    with pytest.raises(SourceError, match="no operator frame with every joint tracked arrived within"):
+        Session(cfg, live).run()

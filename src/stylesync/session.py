@@ -39,6 +39,7 @@ from stylesync.motion.stance_fsm import Stance
 from stylesync.motion.style_features import ROW_NAMES as _FEATURES
 from stylesync.motion.style_features import style_rows
 from stylesync.prefetch import OperatorInline, OperatorPrefetch
+from stylesync.processing.joint_map import tracked_arrays
 from stylesync.processing.operator_processing import OperatorProcessing, OperatorSample
 from stylesync.sim.backend import PhysicsBackend
 from stylesync.sim.factory import make_backend
@@ -53,6 +54,12 @@ DIVERGED_LINK_SPEED_MPS = 25.0
 DIVERGED_ROOT_HEIGHT_M = 2.5
 SILENT_STREAM_TIMEOUT_S = 2.0
 FIRST_FRAME_TIMEOUT_S = 10.0
+
+
+def _all_tracked(frame: OperatorFrame) -> bool:
+    """Whether every joint the processing stage reads is tracked in ``frame``."""
+    _, _, cq, cp = tracked_arrays(frame)
+    return bool(np.all(cq > 0) and np.all(cp > 0))
 _LINK = {n: i for i, n in enumerate(LINK_NAMES)}
 # Hip, knee and ankle links of the left and the right leg, (2, 3).
 _LEG_LINKS = np.array([[_LINK[f"{s}_{j}"] for j in ("hip", "knee", "ankle")] for s in ("left", "right")])
@@ -177,20 +184,48 @@ class Session:
             command(self)
 
     def _place_character(self) -> None:
-        """Stand the character where the operator stands (scaled), facing the operator's heading."""
+        """Stand the character where the operator stands (scaled), facing the operator's heading, once a frame with
+        every tracked joint has arrived (the processing stage cannot start from one with lost joints)."""
         wait = getattr(self.source, "wait_first_frame", None)
         if wait is not None and not wait(FIRST_FRAME_TIMEOUT_S):
             raise SourceError(f"no operator frame arrived within {FIRST_FRAME_TIMEOUT_S:.0f} s")
-        frames = self.source.poll(0.0)
-        if not frames:
-            raise SourceError("the operator source delivered no frame at start (t = 0 s)")
-        for f in frames:
-            self.processing.push(f)
-        if getattr(self.source, "starts_in_motion", False) and len(frames) > 1:
+        frames = self._first_complete_frames(live=wait is not None)
+        complete = [f for f in frames if _all_tracked(f)]
+        if (getattr(self.source, "starts_in_motion", False) and len(frames) > 1 and frames[-1] is complete[-1]
+                and len(complete) > 1 and frames[-2] is complete[-2]):
             if self._start_in_motion(frames[-2], frames[-1]):
                 return
-        f0 = frames[-1]
+        f0 = complete[-1]
         self._stand_at(f0.pos("PELVIS"), f0.quat("PELVIS"))
+
+    def _first_complete_frames(self, live: bool) -> list[OperatorFrame]:
+        """The frames up to the first with every tracked joint, pushed into the processing stage: a live source's as
+        they arrive (at most FIRST_FRAME_TIMEOUT_S), a recording's from its start onwards (its first
+        FIRST_FRAME_TIMEOUT_S); one clear error when there is none."""
+        frames = self.source.poll(0.0)
+        for f in frames:
+            self.processing.push(f)
+        t_s, deadline = 0.0, time.perf_counter() + FIRST_FRAME_TIMEOUT_S
+        while not self.processing.ready:
+            if live:
+                if time.perf_counter() > deadline:
+                    raise SourceError(f"no operator frame with every joint tracked arrived within "
+                                      f"{FIRST_FRAME_TIMEOUT_S:.0f} s ({len(frames)} frames had lost joints)")
+                time.sleep(0.005)
+                new = self.source.poll(0.0)
+            else:
+                t_s += 1.0 / self.cfg.clocks.mocap_hz
+                if t_s > FIRST_FRAME_TIMEOUT_S:
+                    raise SourceError(f"the operator source delivered no frame with every joint tracked in its first "
+                                      f"{FIRST_FRAME_TIMEOUT_S:.0f} s ({len(frames)} frames, with lost joints)")
+                new = self.source.poll(t_s)
+            for f in new:
+                self.processing.push(f)
+            frames += new
+        if t_s > 0.0:
+            log.info("the operator's first frame with every joint tracked came at %.2f s (%d frames before it)",
+                     t_s, len(frames) - 1)
+        return frames
 
     def _start_in_motion(self, f0: OperatorFrame, f1: OperatorFrame) -> bool:
         """The character in the operator's pose of frame ``f0`` (the reference-state initialisation of
