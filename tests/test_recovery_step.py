@@ -208,17 +208,18 @@ def test_a_sideways_drift_steps_with_the_foot_that_can_catch_it_not_the_one_that
     assert step is not None and step.side == "left"
 
 
-@pytest.mark.skipif(not (MOCAP / "cmu" / "02_01.bvh").exists(), reason="../shared/mocap/cmu/02_01.bvh is not available")
+@pytest.mark.skipif(not (MOCAP / "cmu-dev" / "07_01.bvh").exists(),
+                    reason="../shared/mocap/cmu-dev/07_01.bvh is not available")
 def test_a_recovery_step_lets_the_body_move_as_its_landing_assumes():
-    """CMU 02_01, seed 0, in the rest after the clip: the operator's COM is over one of his feet and the COM task
-    pulled the character's there while its recovery step was in the air, so the foot landed where the capture point
-    no longer went (measured: a fall at 4.55 s). With the COM task holding the character's own state during the
-    step, it comes to rest."""
-    spec = f"bvh:{MOCAP / 'cmu' / '02_01.bvh'}"
-    free, _ = _run(spec, 5.85, MotionConfig())
+    """CMU 07_01, seed 0, in the rest after the clip (2.6 s): the frozen operator's COM is over one of his feet, and
+    a COM task pulling the character's there while its recovery step is in the air lands the foot where the capture
+    point no longer goes (measured: a fall at 5.2 s). With the COM task holding the character's own state during
+    the step, it comes to rest."""
+    spec = f"bvh:{MOCAP / 'cmu-dev' / '07_01.bvh'}"
+    free, _ = _run(spec, 5.6, MotionConfig())
     assert not free.fell
-    pulled, _ = _run(spec, 5.85, MotionConfig(recovery_step_free_com=False))
-    assert pulled.fell and pulled.fall_time_s is not None and pulled.fall_time_s > 2.85
+    pulled, _ = _run(spec, 5.6, MotionConfig(recovery_step_free_com=False))
+    assert pulled.fell and pulled.fall_time_s is not None and pulled.fall_time_s > 2.6
 
 
 def test_targets_that_follow_the_operator_keep_the_walk_up_with_him():

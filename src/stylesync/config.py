@@ -153,7 +153,7 @@ class MotionConfig:
     # swing time [s] and height [m]; the double stance kept after one before another [s].
     recovery_steps: bool = True
     recovery_step_margin_m: float = 0.02
-    recovery_swing_s: float = 0.3
+    recovery_swing_s: float = 0.2
     recovery_step_height_m: float = 0.05
     recovery_min_stance_s: float = 0.1
     # Step timing (motion/recovery_step.py): a swing of the operator's that has lasted this many times his usual
