@@ -22,25 +22,12 @@ import sys
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-import numpy as np
 from versions import REPO, checkouts, probe
 
-SHARED = REPO.parent / "shared" / "mocap"
-# Category of each clip, from the clips' READMEs (../shared/mocap/*/README.md) and the humanoid3d clip names.
-CATEGORIES = {
-    "walk": "walk", "stealthy_walk": "styled walk", "long_humanoid3d_stealthy_walk0": "styled walk",
-    "zombie_walk": "styled walk", "jog": "run", "run": "run", "jump": "jump", "kick": "kick", "spinkick": "kick",
-    "punch": "arms", "dance_a": "arms", "dance_b": "arms", "spin": "arms", "backflip": "acrobatics",
-    "cartwheel": "acrobatics", "crawl": "acrobatics", "getup_facedown": "acrobatics",
-    "getup_faceup": "acrobatics", "roll": "acrobatics",
-    "02_01": "walk", "131_01": "styled walk", "131_02": "styled walk", "131_03": "jump",
-    "02_02": "walk", "05_01": "walk", "06_01": "walk", "07_01": "walk", "07_05": "walk", "07_11": "walk",
-    "08_01": "walk", "08_04": "walk", "08_08": "walk", "10_04": "walk", "12_01": "walk", "08_07": "styled walk",
-    "03_01": "uneven", "03_02": "uneven", "02_03": "run", "09_01": "run", "09_06": "run", "09_11": "run",
-    "02_04": "jump", "13_11": "jump", "13_32": "jump", "13_39": "jump", "13_41": "jump", "jumping_jacks": "jump",
-}
-ORDER = ("walk", "styled walk", "uneven", "run", "jump", "kick", "arms", "acrobatics")
+from stylesync.metrics.dev_suite import clip_specs as suite_clips
+from stylesync.metrics.dev_suite import table
 
+SHARED = REPO.parent / "shared" / "mocap"
 _PROBE = r'''
 import dataclasses, json, logging, sys
 logging.disable(logging.CRITICAL)
@@ -73,57 +60,8 @@ print(json.dumps({"clip_end_s": clip_end, **{k: m.get(k) for k in keys}}))
 
 
 def clip_specs() -> list[tuple[str, str, str]]:
-    """(spec, name, category) of every clip of the suite."""
-    import pybullet_data
-
-    motions = Path(pybullet_data.getDataPath()) / "data" / "motions"
-    out = [(f"builtin:{p.stem.removeprefix('humanoid3d_')}", p.stem.removeprefix("humanoid3d_"))
-           for p in sorted(motions.glob("humanoid3d_*.txt"))]
-    for folder in ("cmu", "cmu-dev"):
-        out += [(f"bvh:{p}", p.stem) for p in sorted((SHARED / folder).glob("*.bvh"))]
-    for p in sorted((SHARED / "deepmimic").glob("*.txt")):
-        name = p.stem.removeprefix("humanoid3d_")
-        out.append((f"deepmimic:{p}", name if not p.stem.startswith("long_") else p.stem))
-    return [(spec, name, CATEGORIES.get(name, "other")) for spec, name in out]
-
-
-def _share(k: int, n: int) -> str:
-    return f"{100 * k / n:.0f} % ({k}/{n})" if n else "-"
-
-
-def _mean(values: list[float], fmt: str) -> str:
-    return format(float(np.mean(values)), fmt) if values else "-"
-
-
-def category_row(cat: str, version: str, rs: list[dict]) -> str:
-    """One row of the per-category table (runs that could not be opened are counted, not averaged)."""
-    ok = [r for r in rs if "error" not in r]
-    n = len(ok)
-    complete = sum(not r["fell"] for r in ok)
-    through_clip = sum(not r["fell"] or r["fall_time_s"] >= r.get("clip_end_s", np.inf) for r in ok)
-    no_uhc = sum(not r["fell"] and r["uhc_fall_time_s"] is None for r in ok)
-    falls = [r["fall_time_s"] for r in ok if r["fell"]]
-    delays = [r["state_transition_delay_s"]["max"] for r in ok if r["state_transition_delay_s"]["count"]]
-    cells = [cat, version, str(len(rs)), str(n), _share(complete, n), _share(through_clip, n), _share(no_uhc, n),
-             _mean(falls, ".2f"),
-             _mean([r["mpjpe_global_mm"] for r in ok if r.get("mpjpe_global_mm") is not None], ".0f"),
-             _mean([r["mpjpe_root_mm"] for r in ok if r.get("mpjpe_root_mm") is not None], ".0f"),
-             f"{sum(r['character_steps'] for r in ok)}/{sum(r['operator_steps'] for r in ok)}",
-             f"{np.median(delays):.3f}" if delays else "-"]
-    return "| " + " | ".join(cells) + " |"
-
-
-def table(rows: list[dict], versions: list[str]) -> str:
-    lines = ["| category | version | runs | opened | complete (no fall) | through the clip (no fall before its end) | "
-             "no UHC termination | mean fall time [s] | MPJPE global [mm] | MPJPE root-rel. [mm] | steps char/op | "
-             "max delay median [s] |",
-             "|" + "---|" * 12]
-    for cat in ORDER:
-        for v in versions:
-            rs = [r for r in rows if r["category"] == cat and r["version"] == v]
-            if rs:
-                lines.append(category_row(cat, v, rs))
-    return "\n".join(lines)
+    """(spec, name, category) of every clip of the suite (stylesync.metrics.dev_suite)."""
+    return suite_clips(SHARED)
 
 
 def main() -> None:

@@ -187,7 +187,18 @@ def _bench(args: argparse.Namespace) -> int:
     from stylesync.metrics.bench import run_bench
 
     shared = Path(args.shared) if args.shared else SHARED_DIR
-    report = run_bench(Path(args.out), args.duration, args.seed, shared if shared.is_dir() else None)
+    if args.suite == "dev":
+        from stylesync.metrics.dev_suite import ORDER, run_dev_suite
+
+        only = tuple(c.strip() for c in args.only.split(",") if c.strip()) if args.only else ()
+        unknown = [c for c in only if c not in ORDER]
+        if unknown:
+            raise StylesyncError(f"unknown categories {', '.join(unknown)}; expected some of {', '.join(ORDER)}")
+        mocap = shared / "mocap"
+        report = run_dev_suite(Path(args.out), args.seeds, args.duration, mocap if mocap.is_dir() else None, only,
+                               workers=args.workers)
+    else:
+        report = run_bench(Path(args.out), args.duration, args.seed, shared if shared.is_dir() else None)
     print(report["table"])
     from stylesync.metrics.report import write_report
 
@@ -329,6 +340,12 @@ def main(argv: list[str] | None = None) -> int:
     bench.add_argument("--seed", type=int, default=0)
     bench.add_argument("--out", default="out/bench", help="output folder (bench.md, bench.json)")
     bench.add_argument("--shared", help="folder holding mocap/cmu (default: ../shared beside the checkout)")
+    bench.add_argument("--suite", choices=("bench", "dev"), default="bench",
+                       help="bench: the humanoid3d clips and CMU BVH against two baselines; dev: every shared clip "
+                            "per category, several seeds, stylesync and the plain PD tracker (dev_suite.md/json)")
+    bench.add_argument("--seeds", type=int, default=2, help="dev suite: sensor seeds 0 .. N-1")
+    bench.add_argument("--only", help="dev suite: comma-separated categories (default: all)")
+    bench.add_argument("--workers", type=int, default=2, help="dev suite: runs in parallel (processes)")
     bench.set_defaults(func=_bench)
     inspect = sub.add_parser("inspect", help="show how a BVH file is understood: joint map, units, axes, frames")
     inspect.add_argument("file", help="BVH file")

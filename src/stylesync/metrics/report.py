@@ -58,9 +58,10 @@ def write_report(folder: str | Path) -> Path:
             rows = "".join(f"<tr><td>{html.escape(k)}</td><td>{html.escape(v)}</td></tr>"
                            for k, v in _flatten(data))
             parts.append(f"<h2>{name}</h2><table>{rows}</table>")
-    md = folder / "bench.md"
-    if md.is_file():
-        parts.append(f"<h2>bench.md</h2><pre>{html.escape(md.read_text())}</pre>")
+    for name in ("bench.md", "dev_suite.md"):
+        md = folder / name
+        if md.is_file():
+            parts.append(f"<h2>{name}</h2><pre>{html.escape(md.read_text())}</pre>")
     for png in sorted(folder.glob("*.png")):
         b64 = base64.b64encode(png.read_bytes()).decode()
         parts.append(f"<h2>{html.escape(png.name)}</h2><img src='data:image/png;base64,{b64}'>")

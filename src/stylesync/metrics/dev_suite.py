@@ -1,0 +1,153 @@
+"""``stylesync bench --suite dev``: every shared clip, a category per clip, several sensor seeds, per category.
+
+Clips: the humanoid3d clips of pybullet_data (played by the built-in operator) and every clip of
+``../shared/mocap`` (``cmu``, ``cmu-dev`` BVH, ``deepmimic``), each with a category (walk, styled walk, uneven,
+run, jump, kick, arms, acrobatics; from the clips' READMEs and names). Each clip runs through the Kinect sensor
+model with seeds 0 .. N-1, with this version (``stylesync``) and the plain PD tracker (``plain-pd``, bench.py) in
+the same run, the same settings for every clip. A run lasts the clip (at most ``duration_s``; the 1 s standing
+lead-in of a clip, or the 3 s rest after a recorded file, included). Per category and controller: runs, clips that
+could be opened, completion (no fall through the clip and the rest), runs through the clip (no fall before its
+end), runs without a UHC/PHC termination, mean fall time, MPJPE (global, root-relative), steps (character /
+operator) and the median of the runs' largest transition delays. Written as dev_suite.md, dev_suite.json and
+report.html. The previous version of the code in the same run: ``benchmarks/dev_suite.py --baseline REF`` (git
+worktrees).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import logging
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+from stylesync.config import OperatorConfig, SessionConfig
+from stylesync.errors import StylesyncError
+from stylesync.metrics.bench import CONTROLLERS
+from stylesync.metrics.summary import summarize
+
+# Category of each clip, from the clips' READMEs (../shared/mocap/*/README.md) and the humanoid3d clip names.
+CATEGORIES = {
+    "walk": "walk", "stealthy_walk": "styled walk", "long_humanoid3d_stealthy_walk0": "styled walk",
+    "zombie_walk": "styled walk", "jog": "run", "run": "run", "jump": "jump", "kick": "kick", "spinkick": "kick",
+    "punch": "arms", "dance_a": "arms", "dance_b": "arms", "spin": "arms", "backflip": "acrobatics",
+    "cartwheel": "acrobatics", "crawl": "acrobatics", "getup_facedown": "acrobatics",
+    "getup_faceup": "acrobatics", "roll": "acrobatics",
+    "02_01": "walk", "131_01": "styled walk", "131_02": "styled walk", "131_03": "jump",
+    "02_02": "walk", "05_01": "walk", "06_01": "walk", "07_01": "walk", "07_05": "walk", "07_11": "walk",
+    "08_01": "walk", "08_04": "walk", "08_08": "walk", "10_04": "walk", "12_01": "walk", "08_07": "styled walk",
+    "03_01": "uneven", "03_02": "uneven", "02_03": "run", "09_01": "run", "09_06": "run", "09_11": "run",
+    "02_04": "jump", "13_11": "jump", "13_32": "jump", "13_39": "jump", "13_41": "jump", "jumping_jacks": "jump",
+}
+ORDER = ("walk", "styled walk", "uneven", "run", "jump", "kick", "arms", "acrobatics", "other")
+SUITE_CONTROLLERS = ("stylesync", "plain-pd")
+
+
+def clip_specs(mocap: Path | None) -> list[tuple[str, str, str]]:
+    """(spec, name, category) of every clip of the suite; ``mocap``: the shared mocap folder (or None)."""
+    import pybullet_data
+
+    motions = Path(pybullet_data.getDataPath()) / "data" / "motions"
+    out = [(f"builtin:{p.stem.removeprefix('humanoid3d_')}", p.stem.removeprefix("humanoid3d_"))
+           for p in sorted(motions.glob("humanoid3d_*.txt"))]
+    if mocap is not None:
+        for folder in ("cmu", "cmu-dev"):
+            out += [(f"bvh:{p}", p.stem) for p in sorted((mocap / folder).glob("*.bvh"))]
+        for p in sorted((mocap / "deepmimic").glob("*.txt")):
+            name = p.stem.removeprefix("humanoid3d_")
+            out.append((f"deepmimic:{p}", name if not p.stem.startswith("long_") else p.stem))
+    return [(spec, name, CATEGORIES.get(name, "other")) for spec, name in out]
+
+
+def run_clip(spec: str, seed: int, duration_s: float, controller: str) -> dict:
+    """One run of the suite: the clip through the Kinect sensor model with ``seed``; a clip that cannot be opened
+    gives ``{"error": ...}``."""
+    from stylesync.session import Session
+    from stylesync.sources.registry import open_source
+
+    logging.disable(logging.WARNING)
+    control, motion = CONTROLLERS[controller]
+    try:
+        opened = open_source(spec, seed=seed, duration_s=duration_s)
+    except StylesyncError as exc:
+        return {"error": str(exc)[:200]}
+    op = OperatorConfig()
+    length = min(duration_s, float(opened.duration_s or duration_s))
+    in_motion = spec.startswith(("bvh:", "k4a-json:")) and op.start_in_motion
+    clip_end = length - (min(op.rest_after_clip_s, length) if in_motion else 0.0)
+    cfg = SessionConfig(duration_s=length, seed=seed, operator=op, control=control, motion=motion,
+                        clocks=dataclasses.replace(SessionConfig().clocks, mocap_hz=opened.mocap_hz))
+    try:
+        result = Session(cfg, opened.source).run()
+    finally:
+        opened.source.close()
+    m = summarize(result)
+    keys = ("fell", "fall_time_s", "sim_duration_s", "operator_steps", "character_steps",
+            "state_transition_delay_s", "mpjpe_global_mm", "mpjpe_root_mm", "uhc_fall_time_s", "realtime_factor")
+    return {"clip_end_s": clip_end, **{k: m.get(k) for k in keys}}
+
+
+def _job(job: tuple) -> dict:
+    spec, name, cat, seed, controller, duration_s = job
+    return {"clip": name, "spec": spec, "category": cat, "seed": seed, "version": controller,
+            **run_clip(spec, seed, duration_s, controller)}
+
+
+def _share(k: int, n: int) -> str:
+    return f"{100 * k / n:.0f} % ({k}/{n})" if n else "-"
+
+
+def _mean(values: list[float], fmt: str) -> str:
+    return format(float(np.mean(values)), fmt) if values else "-"
+
+
+def category_row(cat: str, version: str, rs: list[dict]) -> str:
+    """One row of the per-category table (runs that could not be opened are counted, not averaged)."""
+    ok = [r for r in rs if "error" not in r]
+    n = len(ok)
+    complete = sum(not r["fell"] for r in ok)
+    through_clip = sum(not r["fell"] or r["fall_time_s"] >= r.get("clip_end_s", np.inf) for r in ok)
+    no_uhc = sum(not r["fell"] and r["uhc_fall_time_s"] is None for r in ok)
+    falls = [r["fall_time_s"] for r in ok if r["fell"]]
+    delays = [r["state_transition_delay_s"]["max"] for r in ok if r["state_transition_delay_s"]["count"]]
+    cells = [cat, version, str(len(rs)), str(n), _share(complete, n), _share(through_clip, n), _share(no_uhc, n),
+             _mean(falls, ".2f"),
+             _mean([r["mpjpe_global_mm"] for r in ok if r.get("mpjpe_global_mm") is not None], ".0f"),
+             _mean([r["mpjpe_root_mm"] for r in ok if r.get("mpjpe_root_mm") is not None], ".0f"),
+             f"{sum(r['character_steps'] for r in ok)}/{sum(r['operator_steps'] for r in ok)}",
+             f"{np.median(delays):.3f}" if delays else "-"]
+    return "| " + " | ".join(cells) + " |"
+
+
+def table(rows: list[dict], versions: list[str]) -> str:
+    """The per-category Markdown table, one row per category and version (controller or code version)."""
+    lines = ["| category | version | runs | opened | complete (no fall) | through the clip (no fall before its end) | "
+             "no UHC termination | mean fall time [s] | MPJPE global [mm] | MPJPE root-rel. [mm] | steps char/op | "
+             "max delay median [s] |",
+             "|" + "---|" * 12]
+    for cat in ORDER:
+        for v in versions:
+            rs = [r for r in rows if r["category"] == cat and r["version"] == v]
+            if rs:
+                lines.append(category_row(cat, v, rs))
+    return "\n".join(lines)
+
+
+def run_dev_suite(out: Path, seeds: int, duration_s: float, mocap: Path | None, only: tuple[str, ...] = (),
+                  controllers: tuple[str, ...] = SUITE_CONTROLLERS, workers: int = 2) -> dict:
+    """Run the suite; writes dev_suite.md and dev_suite.json under ``out`` and returns {"rows", "table"}."""
+    out.mkdir(parents=True, exist_ok=True)
+    clips = [c for c in clip_specs(mocap) if not only or c[2] in only]
+    jobs = [(spec, name, cat, seed, ctrl, duration_s) for spec, name, cat in clips for seed in range(seeds)
+            for ctrl in controllers]
+    if workers > 1:
+        with ProcessPoolExecutor(max_workers=workers) as pool:
+            rows = list(pool.map(_job, jobs))
+    else:
+        rows = [_job(j) for j in jobs]
+    md = table(rows, list(controllers))
+    (out / "dev_suite.json").write_text(json.dumps(rows, indent=1))
+    (out / "dev_suite.md").write_text(md + "\n")
+    return {"rows": rows, "table": md}

@@ -1,0 +1,38 @@
+"""``stylesync bench --suite dev``: the development suite per category, stylesync and the plain PD tracker."""
+
+import json
+
+from stylesync.cli import main as cli_main
+from stylesync.metrics.dev_suite import CATEGORIES, clip_specs, table
+
+
+def test_every_shared_clip_has_a_category(tmp_path):
+    from pathlib import Path
+
+    mocap = Path(__file__).resolve().parents[2] / "shared" / "mocap"
+    specs = clip_specs(mocap if mocap.is_dir() else None)
+    assert {"walk", "jump", "kick", "acrobatics"} <= {cat for _, _, cat in specs}
+    assert all(cat != "other" for _, _, cat in specs), [n for _, n, c in specs if c == "other"]
+    assert set(CATEGORIES.values()) <= {"walk", "styled walk", "uneven", "run", "jump", "kick", "arms", "acrobatics"}
+
+
+def test_the_dev_suite_writes_one_row_per_category_and_controller(tmp_path, capsys):
+    out = tmp_path / "dev"
+    assert cli_main(["bench", "--suite", "dev", "--only", "kick", "--seeds", "1", "--duration", "1.5",
+                     "--workers", "1", "--out", str(out)]) == 0
+    rows = json.loads((out / "dev_suite.json").read_text())
+    clips = {r["clip"] for r in rows}
+    assert {"kick", "spinkick"} <= clips
+    for clip in clips:
+        assert {r["version"] for r in rows if r["clip"] == clip} == {"stylesync", "plain-pd"}
+    assert all(r["category"] == "kick" and "error" not in r for r in rows)
+    md = (out / "dev_suite.md").read_text()
+    assert "| kick | stylesync |" in md and "| kick | plain-pd |" in md
+    assert "dev_suite.md" in (out / "report.html").read_text()
+    assert table(rows, ["stylesync"]).count("| kick |") == 1
+
+
+def test_an_unknown_category_is_one_line(tmp_path, capsys):
+    assert cli_main(["bench", "--suite", "dev", "--only", "swimming", "--out", str(tmp_path / "d")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("stylesync: error:") and "swimming" in err and "\n" not in err
