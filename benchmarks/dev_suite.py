@@ -28,6 +28,8 @@ from stylesync.metrics.dev_suite import clip_specs as suite_clips
 from stylesync.metrics.dev_suite import table
 
 SHARED = REPO.parent / "shared" / "mocap"
+# Run inside each checked-out version, old ones included, which have no stylesync.metrics.dev_suite to call: the
+# same steps as its run_clip, written against the API every version has.
 _PROBE = r'''
 import dataclasses, json, logging, sys
 logging.disable(logging.CRITICAL)

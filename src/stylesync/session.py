@@ -190,12 +190,10 @@ class Session:
         if wait is not None and not wait(FIRST_FRAME_TIMEOUT_S):
             raise SourceError(f"no operator frame arrived within {FIRST_FRAME_TIMEOUT_S:.0f} s")
         frames = self._first_complete_frames(live=wait is not None)
-        complete = [f for f in frames if _all_tracked(f)]
-        if (getattr(self.source, "starts_in_motion", False) and len(frames) > 1 and frames[-1] is complete[-1]
-                and len(complete) > 1 and frames[-2] is complete[-2]):
-            if self._start_in_motion(frames[-2], frames[-1]):
+        if getattr(self.source, "starts_in_motion", False) and len(frames) > 1:
+            if self._start_in_motion(frames[-2], frames[-1]):  # False when either frame lost joints
                 return
-        f0 = complete[-1]
+        f0 = next(f for f in reversed(frames) if _all_tracked(f))
         self._stand_at(f0.pos("PELVIS"), f0.quat("PELVIS"))
 
     def _first_complete_frames(self, live: bool) -> list[OperatorFrame]:

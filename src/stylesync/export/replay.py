@@ -13,35 +13,35 @@ from stylesync.export.bvh_export import write_bvh
 from stylesync.export.session_file import SessionFile
 from stylesync.export.video import write_mp4
 from stylesync.model.character import LINK_NAMES, STANDING_ROOT_HEIGHT_M
+from stylesync.model.state import CharacterState, LinkShape
 from stylesync.sim.factory import make_backend
+
+
+def _rest_pose() -> tuple[CharacterState, list[LinkShape]]:
+    """The character standing in its rest pose (all joints zero, facing +x), and its collision shapes."""
+    backend = make_backend(WorldConfig(), 600.0)
+    try:
+        backend.reset(np.array([0.0, 0.0, STANDING_ROOT_HEIGHT_M]), np.array([1.0, 0.0, 0.0, 0.0]))
+        return backend.read_state(0.0), backend.collision_shapes()
+    finally:
+        backend.close()
 
 
 def rest_link_origins() -> np.ndarray:
     """Link origins (n_links, 3) [m] of the character standing in its rest pose (all joints zero)."""
-    backend = make_backend(WorldConfig(), 600.0)
-    try:
-        backend.reset(np.array([0.0, 0.0, STANDING_ROOT_HEIGHT_M]), np.array([1.0, 0.0, 0.0, 0.0]))
-        return backend.read_state(0.0).link_origin_world.copy()
-    finally:
-        backend.close()
+    return _rest_pose()[0].link_origin_world.copy()
 
 
 def segment_ends_rest() -> dict[str, np.ndarray]:
     """Where the character's end segments end in its rest pose (all joints zero, standing, facing +x) [m], from
     the engine's collision shapes: the hands' tips (the wrist links' shapes, furthest along the forearm), the toes'
     tips (the foot shapes' front edge, at the sole) and the top of the head (the neck link's shape, highest)."""
-    backend = make_backend(WorldConfig(), 600.0)
-    try:
-        backend.reset(np.array([0.0, 0.0, STANDING_ROOT_HEIGHT_M]), np.array([1.0, 0.0, 0.0, 0.0]))
-        state = backend.read_state(0.0)
-        points: dict[int, list[np.ndarray]] = {}
-        for shape in backend.collision_shapes():
-            # The rest pose's canonical link orientations are the identity: link axes are world axes.
-            centre = state.link_com_world[shape.link] + shape.pos_link
-            points.setdefault(shape.link, []).extend(_shape_points(shape.kind, shape.size, centre,
-                                                                   shape.quat_link_wxyz))
-    finally:
-        backend.close()
+    state, shapes = _rest_pose()
+    points: dict[int, list[np.ndarray]] = {}
+    for shape in shapes:
+        # The rest pose's canonical link orientations are the identity: link axes are world axes.
+        centre = state.link_com_world[shape.link] + shape.pos_link
+        points.setdefault(shape.link, []).extend(_shape_points(shape.kind, shape.size, centre, shape.quat_link_wxyz))
     idx = {n: i for i, n in enumerate(LINK_NAMES)}
     ends = {}
     for side in ("left", "right"):
@@ -83,8 +83,8 @@ def interpolated_motion(session: SessionFile, fps: float) -> tuple[np.ndarray, n
     grid = np.arange(t[0], t[-1] + 1e-9, 1.0 / fps)
     pos = session.array("root_pos_world")
     quat = session.array("link_quat_wxyz")
-    hi = np.clip(np.searchsorted(t, grid), 1, max(len(t) - 1, 1))
-    lo = hi - 1 if len(t) > 1 else hi
+    hi = np.clip(np.searchsorted(t, grid), 0, len(t) - 1)
+    lo = np.maximum(hi - 1, 0)
     span = np.where(t[hi] > t[lo], t[hi] - t[lo], 1.0)
     w = np.clip((grid - t[lo]) / span, 0.0, 1.0)
     root = pos[lo] + w[:, None] * (pos[hi] - pos[lo])

@@ -78,3 +78,8 @@ def outside_distance_m(point_xy: np.ndarray, hull_xy: np.ndarray) -> tuple[float
     if inside:
         return -float(inside_margin), p.copy()
     return best, nearest
+
+
+def sole_outside_m(point_xy: np.ndarray, ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray) -> float:
+    """Signed distance of a horizontal point from one foot's sole: > 0 outside, < 0 inside [m]."""
+    return outside_distance_m(point_xy, convex_hull_xy(sole_corners_world(ankle_world, foot_quat_wxyz)[:, :2]))[0]

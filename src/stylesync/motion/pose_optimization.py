@@ -36,7 +36,7 @@ from stylesync.model.character import (
     batch_model_quat_from_canonical,
     canonical_quat_from_model,
 )
-from stylesync.model.sole import sole_within_m
+from stylesync.model.sole import sole_outside_m, sole_within_m
 from stylesync.model.state import CharacterState, MassProperties
 from stylesync.motion.balance_strategy import stance_hip_blend, swing_hip_feedback
 from stylesync.motion.bounds import BoundsMonitor, step_length_bound_m
@@ -47,7 +47,6 @@ from stylesync.motion.recovery_step import (
     RecoveryStepper,
     capture_point,
     operator_stands,
-    sole_outside_m,
     stands_on,
 )
 from stylesync.motion.reference import LipmMap, ReferencePose
@@ -260,8 +259,10 @@ class MotionOptimizer:
         character waits for a late contact)."""
         op_state = self.op_fsm.update(sample.pos["ANKLE_LEFT"][2], sample.pos["ANKLE_RIGHT"][2])
         contact = state.feet_pressing()
-        ch_state = self.char_fsm.update(op_state, contact, state.time_s, self._can_lift(sample, state, mass),
-                                        self.cfg.liftoff_weight_shift_s)
+        # Only a lift-off from double stance can wait for the weight to shift.
+        lifting = op_state is not Stance.DS and self.char_fsm.state is Stance.DS
+        can_lift = self._can_lift(sample, state, mass) if lifting else None
+        ch_state = self.char_fsm.update(op_state, contact, state.time_s, can_lift, self.cfg.liftoff_weight_shift_s)
         if op_state is not self._op_state:  # the operator's swing time, for the swing's progress
             if self._op_state is Stance.DS:
                 self._op_last_ds_s = state.time_s - self._op_state_t0_s

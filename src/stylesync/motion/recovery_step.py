@@ -46,7 +46,13 @@ from stylesync.model.character import (
     FOOT_WIDTH_M,
     HIP_HALF_WIDTH_M,
 )
-from stylesync.model.sole import convex_hull_xy, outside_distance_m, sole_corners_in_foot, sole_corners_world
+from stylesync.model.sole import (
+    convex_hull_xy,
+    outside_distance_m,
+    sole_corners_in_foot,
+    sole_corners_world,
+    sole_outside_m,
+)
 from stylesync.processing.interpolation import smooth_step
 
 MAX_STEP_SHARE = 0.6  # the landing ankle is at most this share of the leg's length from the stance ankle
@@ -77,20 +83,21 @@ def operator_stands(xi_h_world: np.ndarray, ankles_h_world: dict[str, np.ndarray
     return outside_distance_m(xi_h_world, convex_hull_xy(np.vstack(corners)))[0] <= 0.0
 
 
-def sole_outside_m(xi_world: np.ndarray, ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray) -> float:
-    """How far a capture point (horizontal) is outside one sole (negative: inside) [m]."""
-    sole = convex_hull_xy(sole_corners_world(ankle_world, foot_quat_wxyz)[:, :2])
-    return float(outside_distance_m(xi_world, sole)[0])
+def outside_step_m(xi_world: np.ndarray, stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray,
+                   landing_ankle_world: np.ndarray, heading_world: np.ndarray) -> float:
+    """Signed distance of a capture point (horizontal) from the support polygon of the stance sole and a sole landed
+    flat at ``landing_ankle_world`` along the heading (``heading_world``: (3, 3), x forward): > 0 outside [m]."""
+    yaw = float(np.arctan2(heading_world[1, 0], heading_world[0, 0]))
+    corners = np.vstack([sole_corners_world(stance_ankle_world, stance_foot_quat_wxyz)[:, :2],
+                         sole_corners_world(landing_ankle_world, rot.quat_from_yaw(yaw))[:, :2]])
+    return outside_distance_m(xi_world, convex_hull_xy(corners))[0]
 
 
 def stands_on(xi_world: np.ndarray, stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray,
               landing_ankle_world: np.ndarray, heading_world: np.ndarray) -> bool:
-    """Whether a capture point (horizontal) is within the support polygon of the stance sole and a sole landed
-    flat at ``landing_ankle_world`` along the heading (``heading_world``: (3, 3), x forward)."""
-    yaw = float(np.arctan2(heading_world[1, 0], heading_world[0, 0]))
-    corners = np.vstack([sole_corners_world(stance_ankle_world, stance_foot_quat_wxyz)[:, :2],
-                         sole_corners_world(landing_ankle_world, rot.quat_from_yaw(yaw))[:, :2]])
-    return outside_distance_m(xi_world, convex_hull_xy(corners))[0] <= 0.0
+    """Whether a capture point is within the support of the stance sole and a landed sole (:func:`outside_step_m`)."""
+    return outside_step_m(xi_world, stance_ankle_world, stance_foot_quat_wxyz, landing_ankle_world,
+                          heading_world) <= 0.0
 
 
 def not_across(landing_world: np.ndarray, stance_ankle_world: np.ndarray, heading_world: np.ndarray,
@@ -145,7 +152,7 @@ class RecoveryStepper:
         outside, _ = outside_distance_m(xi, convex_hull_xy(np.vstack(list(corners.values()))))
         if outside <= cfg.recovery_step_margin_m:
             return None
-        dist = {s: outside_distance_m(xi, convex_hull_xy(c))[0] for s, c in corners.items()}
+        dist = {s: sole_outside_m(xi, ankles_world[s], feet_quat_wxyz[s]) for s in on_ground}
         stance = min(dist, key=lambda s: dist[s])
         if heading_world is not None and len(on_ground) == 2:
             residual = {s: self.capture_residual_m(com_world, com_vel_world, ankles_world[s], feet_quat_wxyz[s],
@@ -165,10 +172,7 @@ class RecoveryStepper:
         the support of the stance sole and the swing sole at its capture landing (<= 0: the step captures it) [m]."""
         landing, xi_land = self.capture_landing(self.cfg.recovery_swing_s, com_world, com_vel_world,
                                                 stance_ankle_world, stance_foot_quat_wxyz, heading_world, side)
-        yaw = float(np.arctan2(heading_world[1, 0], heading_world[0, 0]))
-        corners = np.vstack([sole_corners_world(stance_ankle_world, stance_foot_quat_wxyz)[:, :2],
-                             sole_corners_world(landing, rot.quat_from_yaw(yaw))[:, :2]])
-        return float(outside_distance_m(xi_land, convex_hull_xy(corners))[0])
+        return float(outside_step_m(xi_land, stance_ankle_world, stance_foot_quat_wxyz, landing, heading_world))
 
     def take_over(self, side: str, time_s: float, swing_ankle_world: np.ndarray) -> RecoveryStep:
         """Turn the swing of ``side``, in the air since the operator lifted it, into a recovery step that lands it
@@ -227,11 +231,11 @@ class RecoveryStepper:
                                           stance_ankle_world, stance_foot_quat_wxyz, heading_world, step.side)
         step.landing_world = landing
         phase = elapsed / cfg.recovery_swing_s
-        target = step.lift_off_world + smooth_step(min(phase / HORIZONTAL_SHARE, 1.0)) * (landing - step.lift_off_world)
+        moved = smooth_step(min(phase / HORIZONTAL_SHARE, 1.0))
+        target = step.lift_off_world + moved * (landing - step.lift_off_world)
         if phase < 1.0 and step.taken_over:
             # Already in the air: lowered from where it is to the ground by the time it is over the landing.
-            lowered = smooth_step(min(phase / HORIZONTAL_SHARE, 1.0))
-            target[2] = step.lift_off_world[2] + lowered * (ANKLE_HEIGHT_M - step.lift_off_world[2])
+            target[2] = step.lift_off_world[2] + moved * (ANKLE_HEIGHT_M - step.lift_off_world[2])
         elif phase < 1.0:
             target[2] = ANKLE_HEIGHT_M + cfg.recovery_step_height_m * np.sin(np.pi * phase)
         else:
