@@ -229,3 +229,45 @@ def test_same_input_and_seed_give_the_same_simulation_offline_and_paced():
     for key, values in first.items():
         assert np.array_equal(values, second[key]), key
         assert np.array_equal(values, paced[key]), key
+
+
+def test_eq26_is_checked_on_the_operators_motion_and_the_clamp_counted_apart():
+    """Eq. 26 reported against what the operator's motion asks of an exactly tracking character; the clamp of the
+    applied force (which carries the character's own lag) is counted apart and is not an operator's bound."""
+    from stylesync.control.model_compensation import bounded_lipm_sync_force, synchronised_tracking_force_n
+    from stylesync.motion.bounds import BoundsMonitor, lipm_force_bound_n
+    from stylesync.motion.reference import LipmMap
+
+    m, g, h_h, h_c = 45.0, 9.8, 0.95, 0.75
+    limit = lipm_force_bound_n(m, g, h_c)
+    # A walk: his COM 0.2 m ahead of his stance ankle, the character 0.1 m behind its own (lagging).
+    walk = LipmMap(np.array([0.2, 0.0, 0.0]), h_h, np.array([-0.1, 0.0, 0.0]), h_c)
+    assert synchronised_tracking_force_n(walk, m, g) < limit
+    b = BoundsMonitor()
+    f = bounded_lipm_sync_force(walk, m, g, 1e9, True, b, 0.0)
+    assert np.linalg.norm(f) == pytest.approx(limit)  # the applied force is clamped ...
+    assert b.counts["lipm_clamped"] == 1 and b.counts["lipm_force"] == 0  # ... but he asked for nothing beyond
+    assert b.summary(600.0) is None
+    # A lunge far beyond his stance foot asks more than the character's foot can pass.
+    lunge = LipmMap(np.array([0.8, 0.0, 0.0]), h_h, np.array([0.8 * h_c / h_h, 0.0, 0.0]), h_c)
+    assert synchronised_tracking_force_n(lunge, m, g) > limit
+    bounded_lipm_sync_force(lunge, m, g, 1e9, True, b, 1.5)
+    assert b.counts["lipm_force"] == 1
+    line = b.summary(600.0)
+    assert line is not None and "lipm_force" in line and "t=1.50 s" in line
+
+
+def test_the_built_in_walk_exceeds_no_movement_bound_and_logs_no_warning(caplog):
+    import logging
+
+    from stylesync.config import SessionConfig
+    from stylesync.session import Session
+    from stylesync.sources.registry import open_source
+
+    opened = open_source("builtin:walk", seed=0, duration_s=6.0)
+    with caplog.at_level(logging.WARNING):
+        result = Session(SessionConfig(duration_s=6.0, seed=0), opened.source).run()
+    assert not result.fell
+    assert result.bound_counts["lipm_force"] == 0 and result.bound_counts["step_length"] == 0
+    assert result.bound_counts["lipm_clamped"] > 0  # the controller does work at its limit meanwhile
+    assert not [r for r in caplog.records if r.levelno >= logging.WARNING]

@@ -12,6 +12,7 @@ import threading
 from pathlib import Path
 
 from stylesync.config import SHARED_DIR, VIEWER_DRAW_HZ, ClockConfig, ControlConfig, OperatorConfig, SessionConfig
+from stylesync import cli_args as typed
 from stylesync.errors import StylesyncError
 
 _HEADLINE = ("fell", "fall_time_s", "sim_duration_s", "operator_steps", "character_steps", "realtime_factor")
@@ -160,6 +161,9 @@ def _export(record: Path, bvh: str | None, mp4: str | None) -> None:
     from stylesync.export.session_file import read_session
 
     session = read_session(record)
+    for path in (bvh, mp4):
+        if path:
+            Path(path).expanduser().absolute().parent.mkdir(parents=True, exist_ok=True)
     if bvh:
         n = export_bvh(session, bvh)
         print(f"BVH: {bvh} ({n} frames)")
@@ -229,23 +233,23 @@ def _report(args: argparse.Namespace) -> int:
 
 
 def _add_export_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--export-bvh", help="write the character's motion as BVH")
-    p.add_argument("--export-mp4", help="write an MP4 of the character (software renderer)")
+    p.add_argument("--export-bvh", type=typed.out_file, help="write the character's motion as BVH")
+    p.add_argument("--export-mp4", type=typed.out_file, help="write an MP4 of the character (software renderer)")
     p.add_argument("--viewer", default="none", choices=("none", "web", "gui"),
                    help="web: browser viewer (prints its address); gui: PyBullet window mirroring the character. "
                         "A viewer paces the run to the wall clock")
     p.add_argument("--viewer-host", default="127.0.0.1", help="address the web viewer listens on")
-    p.add_argument("--viewer-port", type=int, help="web viewer port (default: a free one)")
-    p.add_argument("--viewer-hz", type=float, default=VIEWER_DRAW_HZ, help="viewer drawing rate [Hz]")
+    p.add_argument("--viewer-port", type=typed.port, help="web viewer port (default: a free one)")
+    p.add_argument("--viewer-hz", type=typed.rate_hz, default=VIEWER_DRAW_HZ, help="viewer drawing rate [Hz]")
 
 
 def _add_session_args(p: argparse.ArgumentParser, out_default: str, realtime_help: str) -> None:
     """Options shared by the commands that run a session (demo, run)."""
-    p.add_argument("--out", default=out_default, help="output folder")
+    p.add_argument("--out", type=typed.out_dir, default=out_default, help="output folder")
     p.add_argument("--gui", action="store_true", help="open the PyBullet window")
     p.add_argument("--realtime", action="store_true", help=realtime_help)
     p.add_argument("--no-lipm", action="store_true", help="switch the LIPM time-sync compensation off (Eq. 21-23)")
-    p.add_argument("--record", help="session file to write (default: OUT/session.jsonl)")
+    p.add_argument("--record", type=typed.out_file, help="session file to write (default: OUT/session.jsonl)")
     p.add_argument("--progress", action="store_true", help="show a progress line (default: when on a terminal)")
     _add_export_args(p)
 
@@ -278,9 +282,9 @@ def _add_source_args(p: argparse.ArgumentParser) -> None:
                         "video:PATH, k4a:DEVICE")
     p.add_argument("--sensor", default="kinect", choices=("kinect", "none"),
                    help="recorded sources: 16 Hz Kinect-like sensor model, or the frames as recorded")
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--joint-map", help="BVH: JSON object canonical joint -> BVH joint name")
-    p.add_argument("--bvh-scale", type=float, help="BVH: file units to metres (default: detected)")
+    p.add_argument("--seed", type=typed.seed, default=0)
+    p.add_argument("--joint-map", type=typed.in_file, help="BVH: JSON object canonical joint -> BVH joint name")
+    p.add_argument("--bvh-scale", type=typed.scale, help="BVH: file units to metres (default: detected)")
     p.add_argument("--bvh-up", help="BVH: up axis x|y|z, optionally signed (default: detected)")
 
 
@@ -308,54 +312,54 @@ def _inspect(args: argparse.Namespace) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="stylesync", description="Style-preserving humanoid teleoperation")
+    parser = typed.OneLineParser(prog="stylesync", description="Style-preserving humanoid teleoperation")
     sub = parser.add_subparsers(dest="command", required=True)
     demo = sub.add_parser("demo", help="run the built-in operator through the whole pipeline, headless")
     demo.add_argument("--clip", default="walk", help="pybullet_data humanoid3d clip, or 'stand'")
-    demo.add_argument("--duration", type=float, default=12.0, help="simulated seconds")
-    demo.add_argument("--seed", type=int, default=0)
+    demo.add_argument("--duration", type=typed.duration_s, default=12.0, help="simulated seconds")
+    demo.add_argument("--seed", type=typed.seed, default=0)
     _add_session_args(demo, "out/demo", "pace to the wall clock")
     demo.set_defaults(func=_demo)
     run = sub.add_parser("run", help="drive the character from an operator source")
     _add_source_args(run)
-    run.add_argument("--duration", type=float, help="simulated seconds (default: the recording's length)")
+    run.add_argument("--duration", type=typed.duration_s, help="simulated seconds (default: the recording's length)")
     _add_session_args(run, "out/run", "pace to the wall clock (always for live sources)")
     run.set_defaults(func=_run)
     measure = sub.add_parser("measure", help="print the operator's link table (Sec. 4.2, Table 2)")
     _add_source_args(measure)
-    measure.add_argument("--mass", type=float, default=75.8, help="operator's total mass [kg]")
-    measure.add_argument("--point-cloud", help="body point cloud (.ply or .npy, metres, world frame)")
+    measure.add_argument("--mass", type=typed.mass_kg, default=75.8, help="operator's total mass [kg]")
+    measure.add_argument("--point-cloud", type=typed.in_file, help="body point cloud (.ply or .npy, metres, world frame)")
     measure.set_defaults(func=_measure)
     experiment = sub.add_parser("experiment", help="re-run one of the paper's experiments (Sec. 7.4)")
     experiment.add_argument("name", choices=("sync", "push", "styles", "kick", "squat-jump", "tune"))
-    experiment.add_argument("--duration", type=float, default=12.0)
-    experiment.add_argument("--seed", type=int, default=0)
-    experiment.add_argument("--out", default="out/experiments")
+    experiment.add_argument("--duration", type=typed.duration_s, default=12.0)
+    experiment.add_argument("--seed", type=typed.seed, default=0)
+    experiment.add_argument("--out", type=typed.out_dir, default="out/experiments")
     experiment.set_defaults(func=_experiment)
     report = sub.add_parser("report", help="write report.html for a run, bench or experiment folder")
-    report.add_argument("folder")
+    report.add_argument("folder", type=typed.in_dir)
     report.set_defaults(func=_report)
     bench = sub.add_parser("bench", help="stylesync vs plain PD vs no model-based compensation over the clip suite")
-    bench.add_argument("--duration", type=float, default=10.0, help="simulated seconds per clip")
-    bench.add_argument("--seed", type=int, default=0)
-    bench.add_argument("--out", default="out/bench", help="output folder (bench.md, bench.json)")
-    bench.add_argument("--shared", help="folder holding mocap/cmu (default: ../shared beside the checkout)")
+    bench.add_argument("--duration", type=typed.duration_s, default=10.0, help="simulated seconds per clip")
+    bench.add_argument("--seed", type=typed.seed, default=0)
+    bench.add_argument("--out", type=typed.out_dir, default="out/bench", help="output folder (bench.md, bench.json)")
+    bench.add_argument("--shared", type=typed.in_dir, help="folder holding mocap/cmu (default: ../shared beside the checkout)")
     bench.add_argument("--suite", choices=("bench", "dev"), default="bench",
                        help="bench: the humanoid3d clips and CMU BVH against two baselines; dev: every shared clip "
                             "per category, several seeds, stylesync and the plain PD tracker (dev_suite.md/json)")
-    bench.add_argument("--seeds", type=int, default=2, help="dev suite: sensor seeds 0 .. N-1")
+    bench.add_argument("--seeds", type=typed.integer(1, 1000), default=2, help="dev suite: sensor seeds 0 .. N-1")
     bench.add_argument("--only", help="dev suite: comma-separated categories (default: all)")
-    bench.add_argument("--workers", type=int, default=2, help="dev suite: runs in parallel (processes)")
+    bench.add_argument("--workers", type=typed.integer(1, 256), default=2, help="dev suite: runs in parallel (processes)")
     bench.set_defaults(func=_bench)
     inspect = sub.add_parser("inspect", help="show how a BVH file is understood: joint map, units, axes, frames")
-    inspect.add_argument("file", help="BVH file")
-    inspect.add_argument("--joint-map", help="JSON object canonical joint -> BVH joint name, overriding the matching")
-    inspect.add_argument("--bvh-scale", type=float, help="file units to metres (default: found from the stature)")
+    inspect.add_argument("file", type=typed.in_file, help="BVH file")
+    inspect.add_argument("--joint-map", type=typed.in_file, help="JSON object canonical joint -> BVH joint name, overriding the matching")
+    inspect.add_argument("--bvh-scale", type=typed.scale, help="file units to metres (default: found from the stature)")
     inspect.add_argument("--up-axis", help="the file's up axis, e.g. y or -z (default: found from the rest pose)")
     inspect.set_defaults(func=_inspect)
     replay = sub.add_parser("replay", help="replay a session file (no re-simulation) into BVH and/or MP4")
     replay.add_argument("file", help="session file (.jsonl) written by run or demo")
-    replay.add_argument("--speed", type=float, default=1.0, help="viewer playback speed (1 = real time)")
+    replay.add_argument("--speed", type=typed.speed, default=1.0, help="viewer playback speed (1 = real time)")
     _add_export_args(replay)
     replay.set_defaults(func=_replay)
     args = parser.parse_args(argv)
@@ -372,6 +376,10 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("stylesync: interrupted", file=sys.stderr)
         return 130
+    except OSError as exc:  # a folder or file the system refuses (permissions, a full disk, a read-only system)
+        where = f": {exc.filename}" if exc.filename else ""
+        print(f"stylesync: error: {exc.strerror or exc}{where}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":

@@ -281,6 +281,9 @@ class Session:
         finally:
             operator.close()
         _add_after_run_columns(run.log)
+        bounds_line = self.bounds.summary(cfg.clocks.control_hz)
+        if bounds_line is not None:
+            log.warning(bounds_line)
         wall = time.perf_counter() - run.wall0
         sim_t = (step + 1) * dt if not (self.fell and self.stop_on_fall) else float(run.fall_time or 0.0)
         return SessionResult(run.log, self.fell, run.fall_time, run.fall_reason, sim_t, wall, step + 1,

@@ -7,7 +7,11 @@
 * Eq. 28: the step length is bounded by ``d_f / |h_C / h_H - 1|``. As printed the denominator is negative for a
   character smaller than its operator (h_C < h_H); we use its magnitude. The swing-foot target is clamped to
   the bound.
-Violations are counted and logged (rate-limited) so the operator can be told.
+Eq. 26 is checked on the operator's motion (model_compensation.synchronised_tracking_force_n): the force his
+motion asks of a character that tracks him exactly. The clamp of the force actually applied, which also carries
+the character's own lag, is counted apart (``lipm_clamped``) and is not an operator's bound.
+Violations are counted (metrics.json, ``bound_violations``), logged at debug level and summarised once at the
+end of a run (:meth:`BoundsMonitor.summary`), so that the operator is told without a line per second.
 """
 
 from __future__ import annotations
@@ -22,6 +26,8 @@ from stylesync.model.character import FOOT_LENGTH_M, FOOT_WIDTH_M
 log = logging.getLogger("stylesync.bounds")
 FOOT_MIN_DIMENSION_M = min(FOOT_LENGTH_M, FOOT_WIDTH_M)  # d_f of Eq. 27 [m]
 _LOG_INTERVAL_S = 1.0
+BOUND_KINDS = ("ds_com", "lipm_force", "step_length")  # the operator's movement bounds (Eq. 24, 26, 28)
+CONTROLLER_KINDS = ("lipm_clamped",)  # the controller's own clamps, counted only
 
 
 def ds_com_bound_m() -> float:
@@ -42,9 +48,11 @@ def step_length_bound_m(h_char_m: float, h_human_m: float) -> float:
 
 @dataclass
 class BoundsMonitor:
-    counts: dict[str, int] = field(default_factory=lambda: {"ds_com": 0, "lipm_force": 0, "step_length": 0})
-    active: dict[str, bool] = field(default_factory=lambda: {"ds_com": False, "lipm_force": False,
-                                                             "step_length": False})
+    """Per bound: ticks exceeded, whether it is exceeded now, and the first excess (time and detail)."""
+
+    counts: dict[str, int] = field(default_factory=lambda: dict.fromkeys(BOUND_KINDS + CONTROLLER_KINDS, 0))
+    active: dict[str, bool] = field(default_factory=lambda: dict.fromkeys(BOUND_KINDS + CONTROLLER_KINDS, False))
+    first: dict[str, tuple[float, str]] = field(default_factory=dict)
     _last_log_s: dict[str, float] = field(default_factory=dict)
 
     def report(self, kind: str, exceeded: bool, time_s: float, detail: str) -> None:
@@ -52,6 +60,13 @@ class BoundsMonitor:
         if not exceeded:
             return
         self.counts[kind] += 1
+        self.first.setdefault(kind, (time_s, detail))
         if time_s - self._last_log_s.get(kind, -np.inf) >= _LOG_INTERVAL_S:
             self._last_log_s[kind] = time_s
-            log.warning("t=%.2f s: operator exceeds movement bound (%s): %s", time_s, kind, detail)
+            log.debug("t=%.2f s: %s: %s", time_s, kind, detail)
+
+    def summary(self, control_hz: float) -> str | None:
+        """One line on the operator's bounds exceeded over a run (None if none was)."""
+        parts = [f"{kind} {self.counts[kind] / control_hz:.2f} s from t={self.first[kind][0]:.2f} s "
+                 f"({self.first[kind][1]})" for kind in BOUND_KINDS if self.counts[kind]]
+        return "operator exceeded movement bounds: " + "; ".join(parts) if parts else None

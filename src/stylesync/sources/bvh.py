@@ -25,6 +25,7 @@ from stylesync.errors import SourceError
 from stylesync.sources.base import read_json_file
 from stylesync.sources.frame import JOINT_INDEX, N_JOINTS
 from stylesync.sources.skeleton_names import match_by_name
+from stylesync.sources.skeleton_structure import match_by_structure
 from stylesync.sources.skeleton_tracks import (
     REQUIRED_JOINTS,
     SEGMENT_DIRECTIONS,
@@ -58,18 +59,32 @@ def load_joint_map(path: str | Path) -> dict[str, str]:
     return data
 
 
-def match_joints(names: list[str], joint_map: dict[str, str] | None = None) -> dict[str, tuple[str, str]]:
+def match_joints(names: list[str], joint_map: dict[str, str] | None = None, parent_index: list[int] | None = None,
+                 rest: np.ndarray | None = None, end_sites: frozenset[int] = frozenset()
+                 ) -> dict[str, tuple[str, str]]:
     """Canonical joint -> (BVH joint name, how it was matched), for the canonical joints found; raises, naming the
-    missing segments, when a required one is missing."""
+    missing segments, when a required one is missing.
+
+    Names first (skeleton_names.py); when they leave a required joint unmatched and the tree is given
+    (``parent_index``, ``rest`` positions), the joints are matched by structure (skeleton_structure.py). A joint
+    map given by the user overrides either.
+    """
     out = match_by_name(names)
+    missing = [j for j in REQUIRED_JOINTS if j not in out]
+    why_not_structure = ""
+    if missing and parent_index is not None and rest is not None:
+        try:
+            out = match_by_structure(names, parent_index, rest, end_sites)
+        except SourceError as exc:
+            why_not_structure = f"; by structure: {exc}"
     for canon, bvh_name in (joint_map or {}).items():
         if bvh_name not in names:
             raise SourceError(f"joint map names '{bvh_name}' for {canon}, but the BVH has no such joint")
         out[canon] = (bvh_name, "joint map")
     missing = [j for j in REQUIRED_JOINTS if j not in out]
     if missing:
-        raise SourceError(f"unknown skeleton: no BVH joint found for {', '.join(missing)} (joints in file: "
-                          f"{', '.join(names[:40])}); give a joint map (JSON canonical -> BVH name)")
+        raise SourceError(f"unknown skeleton: no BVH joint found for {', '.join(missing)}{why_not_structure} "
+                          f"(joints in file: {', '.join(names[:40])}); give a joint map (JSON canonical -> BVH name)")
     return out
 
 
@@ -185,15 +200,16 @@ class BvhRecording:
             offsets = np.vstack([offsets, end_offsets])
             local_pos = np.concatenate([local_pos, np.repeat(end_offsets[:, None, :], n_frames, axis=1)])
             local_q = np.concatenate([local_q, np.tile(rot.IDENTITY_WXYZ, (len(ends), n_frames, 1))])
-        self.path = p
-        self.joint_names = names
-        self.matches = match_joints(names, joint_map)
-        idx = {canon: names.index(n) for canon, (n, _) in self.matches.items()}
-
         # Rest pose (all rotations identity): cumulative offsets, file units and axes.
         rest = np.zeros((len(names), 3))
         for j, par in enumerate(parent_index):
             rest[j] = offsets[j] + (rest[par] if par >= 0 else 0.0)
+        self.path = p
+        self.joint_names = names
+        n_joints = len(joints)
+        self.matches = match_joints(names, joint_map, parent_index, rest,
+                                    frozenset(range(n_joints, len(names))))
+        idx = {canon: names.index(n) for canon, (n, _) in self.matches.items()}
         # A segment joint that coincides with the next one (CMU's Spine1 sits on its Neck) gives way to its parent.
         for seg, (distal, _) in SEGMENT_DIRECTIONS.items():
             while np.linalg.norm(rest[idx[distal]] - rest[idx[seg]]) < 1e-9 and parent_index[idx[seg]] >= 0:

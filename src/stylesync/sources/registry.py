@@ -142,6 +142,8 @@ def open_source(spec: str, clocks: ClockConfig | None = None, operator: Operator
             port_n = int(port) if port else DEFAULT_PORT
         except ValueError:
             raise SourceError(f"VMC port must be a number: '{spec}'") from None
+        if not 0 <= port_n <= 65535:
+            raise SourceError(f"VMC port must be 0-65535: '{spec}'")
         return OpenedSource(VmcSource(host or "127.0.0.1", port_n), 60.0, None, spec)
     if kind in ("webcam", "video"):
         from stylesync.sources.webcam import MediaPipeSource
