@@ -1,6 +1,7 @@
 """Bad command lines end with exit 2 and one line naming the option, before anything runs."""
 
 import pytest
+
 from stylesync.cli import main as cli_main
 
 

@@ -11,8 +11,8 @@ import sys
 import threading
 from pathlib import Path
 
-from stylesync.config import SHARED_DIR, VIEWER_DRAW_HZ, ClockConfig, ControlConfig, OperatorConfig, SessionConfig
 from stylesync import cli_args as typed
+from stylesync.config import SHARED_DIR, VIEWER_DRAW_HZ, ClockConfig, ControlConfig, OperatorConfig, SessionConfig
 from stylesync.errors import StylesyncError
 
 _HEADLINE = ("fell", "fall_time_s", "sim_duration_s", "operator_steps", "character_steps", "realtime_factor")
