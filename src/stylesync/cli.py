@@ -328,7 +328,8 @@ def main(argv: list[str] | None = None) -> int:
     measure = sub.add_parser("measure", help="print the operator's link table (Sec. 4.2, Table 2)")
     _add_source_args(measure)
     measure.add_argument("--mass", type=typed.mass_kg, default=75.8, help="operator's total mass [kg]")
-    measure.add_argument("--point-cloud", type=typed.in_file, help="body point cloud (.ply or .npy, metres, world frame)")
+    measure.add_argument("--point-cloud", type=typed.in_file,
+                         help="body point cloud (.ply or .npy, metres, world frame)")
     measure.set_defaults(func=_measure)
     experiment = sub.add_parser("experiment", help="re-run one of the paper's experiments (Sec. 7.4)")
     experiment.add_argument("name", choices=("sync", "push", "styles", "kick", "squat-jump", "tune"))
@@ -343,17 +344,20 @@ def main(argv: list[str] | None = None) -> int:
     bench.add_argument("--duration", type=typed.duration_s, default=10.0, help="simulated seconds per clip")
     bench.add_argument("--seed", type=typed.seed, default=0)
     bench.add_argument("--out", type=typed.out_dir, default="out/bench", help="output folder (bench.md, bench.json)")
-    bench.add_argument("--shared", type=typed.in_dir, help="folder holding mocap/cmu (default: ../shared beside the checkout)")
+    bench.add_argument("--shared", type=typed.in_dir,
+                       help="folder holding mocap/cmu (default: ../shared beside the checkout)")
     bench.add_argument("--suite", choices=("bench", "dev"), default="bench",
                        help="bench: the humanoid3d clips and CMU BVH against two baselines; dev: every shared clip "
                             "per category, several seeds, stylesync and the plain PD tracker (dev_suite.md/json)")
     bench.add_argument("--seeds", type=typed.integer(1, 1000), default=2, help="dev suite: sensor seeds 0 .. N-1")
     bench.add_argument("--only", help="dev suite: comma-separated categories (default: all)")
-    bench.add_argument("--workers", type=typed.integer(1, 256), default=2, help="dev suite: runs in parallel (processes)")
+    bench.add_argument("--workers", type=typed.integer(1, 256), default=2,
+                       help="dev suite: runs in parallel (processes)")
     bench.set_defaults(func=_bench)
     inspect = sub.add_parser("inspect", help="show how a BVH file is understood: joint map, units, axes, frames")
     inspect.add_argument("file", type=typed.in_file, help="BVH file")
-    inspect.add_argument("--joint-map", type=typed.in_file, help="JSON object canonical joint -> BVH joint name, overriding the matching")
+    inspect.add_argument("--joint-map", type=typed.in_file,
+                         help="JSON object canonical joint -> BVH joint name, overriding the matching")
     inspect.add_argument("--bvh-scale", type=typed.scale, help="file units to metres (default: found from the stature)")
     inspect.add_argument("--up-axis", help="the file's up axis, e.g. y or -z (default: found from the rest pose)")
     inspect.set_defaults(func=_inspect)
