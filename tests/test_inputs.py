@@ -478,3 +478,45 @@ def test_a_live_source_whose_frames_all_lost_joints_ends_with_one_clear_line(mon
     monkeypatch.setattr(session_module, "FIRST_FRAME_TIMEOUT_S", 0.3)
     with pytest.raises(SourceError, match="no operator frame with every joint tracked arrived within"):
         Session(cfg, live).run()
+
+
+@pytest.mark.parametrize("frame_time", ["1e-9", "1e300", "5"])
+def test_bvh_frame_time_outside_a_capture_rate_is_one_clear_error(tmp_path, frame_time):
+    p = _write_tiny(tmp_path)
+    p.write_text(p.read_text().replace("Frame Time: 0.0333333", f"Frame Time: {frame_time}"))
+    with pytest.raises(SourceError, match=r"Frame Time: frame interval .* outside \[0.0001, 1\] s"):
+        BvhRecording(p)
+
+
+def test_bvh_positions_beyond_a_kilometre_are_refused(tmp_path):
+    motion = [[0, 95, 0] + [0.0] * (_N_CHANNELS - 3) for _ in range(3)]
+    motion[2][0] = 1e9  # root 10 000 km away (cm)
+    with pytest.raises(SourceError, match="m from where the recording starts"):
+        BvhRecording(_write_tiny(tmp_path, motion))
+
+
+def test_deepmimic_frame_durations_outside_a_capture_rate_are_refused(tmp_path):
+    import pybullet_data
+
+    from stylesync.sources.deepmimic_clip import DeepMimicClip
+
+    src = json.loads((Path(pybullet_data.getDataPath()) / "data/motions/humanoid3d_walk.txt").read_text())
+    src["Frames"][2][0] = 1e-300
+    p = tmp_path / "clip.txt"
+    p.write_text(json.dumps(src))
+    with pytest.raises(SourceError, match="frame 2: frame interval"):
+        DeepMimicClip.load(p)
+
+
+def test_k4a_json_frames_far_in_time_or_space_are_rejected_and_counted(tmp_path):
+    human = HumanModel()
+    frames = [human.frame_from_pose(k / 30, np.array([0.01 * k, 0, 0.93]), {}) for k in range(10)]
+    p = tmp_path / "rec.json"
+    write_k4abt_json(frames, p)
+    doc = json.loads(p.read_text())
+    doc["frames"][4]["timestamp_usec"] = 10**30  # 3e16 years later
+    doc["frames"][6]["bodies"][0]["joint_positions"][0][0] = 1e12  # a million km away (mm)
+    p.write_text(json.dumps(doc))
+    rec = K4abtRecording(p)
+    assert rec.rejected_frames == 2
+    assert rec.performer.times_s[-1] < 1.0

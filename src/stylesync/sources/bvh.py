@@ -24,6 +24,7 @@ from stylesync import rotations as rot
 from stylesync.errors import SourceError
 from stylesync.sources.base import read_json_file
 from stylesync.sources.frame import JOINT_INDEX, N_JOINTS
+from stylesync.sources.limits import MAX_RECORDING_S, distance_problem, frame_interval_problem
 from stylesync.sources.skeleton_names import match_by_name
 from stylesync.sources.skeleton_structure import match_by_structure
 from stylesync.sources.skeleton_tracks import (
@@ -173,6 +174,11 @@ class BvhRecording:
                               ) from None
         if n_frames < 1 or not np.isfinite(frame_time) or frame_time <= 0:
             raise SourceError(f"BVH file {p}: needs at least one frame and a frame time > 0 s")
+        if why := frame_interval_problem(frame_time):
+            raise SourceError(f"BVH file {p}: Frame Time: {why}")
+        if n_frames * frame_time > MAX_RECORDING_S:
+            raise SourceError(f"BVH file {p}: {n_frames} frames of {frame_time:g} s last longer than "
+                              f"{MAX_RECORDING_S:g} s")
         names = [j.Name for j, _ in joints]
         parent_index = [par for _, par in joints]
         if len(set(names)) != len(names):
@@ -275,5 +281,7 @@ class BvhRecording:
         if n_bind:
             log.info("BVH file %s: %d leading frame(s) blend from a bind pose; left out", p, n_bind)
             pos, quat, conf, T = pos[n_bind:], quat[n_bind:], conf[n_bind:], T - n_bind
+        if why := distance_problem(pos, pos[0, JOINT_INDEX["PELVIS"]]):
+            raise SourceError(f"BVH file {p}: {why}")
         place_on_floor(pos)
         self.performer = TrackPerformer(np.arange(T) * frame_time, pos, quat, conf, name=f"bvh:{p.name}")

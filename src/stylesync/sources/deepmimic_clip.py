@@ -18,6 +18,7 @@ from stylesync import rotations as rot
 from stylesync.errors import SourceError
 from stylesync.model.character import Q_WORLD_MODEL, canonical_quat_from_model
 from stylesync.sources.base import read_json_file
+from stylesync.sources.limits import distance_problem, frame_interval_problem
 
 FRAME_WIDTH = 44
 # (canonical joint, kind, width) in clip order after dt, root position and root rotation.
@@ -95,6 +96,11 @@ class DeepMimicClip:
             raise SourceError(f"DeepMimic clip {p} contains NaN or infinite values")
         if len(frames) > 1 and np.any(frames[:-1, 0] <= 0):
             raise SourceError(f"DeepMimic clip {p}: frame durations must be > 0 s")
+        for k, dt in enumerate(frames[:-1, 0]):
+            if why := frame_interval_problem(float(dt)):
+                raise SourceError(f"DeepMimic clip {p}: frame {k}: {why}")
+        if why := distance_problem(frames[:, 1:4], frames[0, 1:4]):
+            raise SourceError(f"DeepMimic clip {p}: root: {why}")
         return cls(frames, loop=data.get("Loop", "none") == "wrap", name=p.stem.removeprefix("humanoid3d_"))
 
     @classmethod

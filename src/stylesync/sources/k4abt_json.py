@@ -29,6 +29,7 @@ from stylesync import rotations as rot
 from stylesync.errors import SourceError
 from stylesync.sources.base import read_json_file
 from stylesync.sources.frame import K4ABT_JOINTS, N_JOINTS, OperatorFrame
+from stylesync.sources.limits import MAX_RECORDING_S, distance_problem, frame_interval_problem
 from stylesync.sources.segment_frames import canonical_quats_from_positions
 from stylesync.sources.skeleton_tracks import TrackPerformer, place_on_floor
 
@@ -75,6 +76,13 @@ class K4abtRecording:
                 continue
             if times and t <= times[-1]:
                 self._reject(p, k, f"timestamp {t:.6f} s not after {times[-1]:.6f} s")
+                continue
+            # Frames may be seconds apart where the tracker lost the person; a recording is at most a day long.
+            if times and (problem := frame_interval_problem(t - times[-1], MAX_RECORDING_S - (times[-1] - times[0]))):
+                self._reject(p, k, problem)
+                continue
+            if positions and (problem := distance_problem(pos @ R_WORLD_CAMERA.T * 1e-3, positions[0][0])):
+                self._reject(p, k, problem)
                 continue
             body_id = body.get("body_id", body_id)
             times.append(t)
