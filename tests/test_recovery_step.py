@@ -282,3 +282,34 @@ def test_a_step_from_standing_waits_for_the_weight_to_shift():
     at_once, _ = _run(spec, 3.5, MotionConfig(liftoff_weight_shift_s=0.0))
     assert at_once.fell and at_once.fall_time_s is not None and at_once.fall_time_s < 2.1
     assert not shifted.fell or (shifted.fall_time_s is not None and shifted.fall_time_s > 2.5)
+
+
+@pytest.mark.skipif(not (MOCAP / "deepmimic" / "humanoid3d_stealthy_walk.txt").exists(),
+                    reason="../shared/mocap/deepmimic/humanoid3d_stealthy_walk.txt is not available")
+def test_a_rear_foot_on_its_toes_is_read_as_still_standing():
+    """The stealthy walk's long, low stride (2.6-3.2 s): the rear ankle rises 6-10 cm above the front one while
+    its toes stay down and the operator's capture point stays 0.1-0.2 m behind his front heel. Read by ankle heights
+    alone he stands on his front foot, and the character lifts its rear foot with its COM behind the front one;
+    read with the rear foot bearing weight, both stay down, and the fall comes later."""
+    from stylesync.session import Session
+    from stylesync.sources.registry import open_source
+
+    spec = f"deepmimic:{MOCAP / 'deepmimic' / 'humanoid3d_stealthy_walk.txt'}"
+    out = {}
+    for margin in (None, 0.02):
+        opened = open_source(spec, seed=0, duration_s=5.0)
+        cfg = SessionConfig(duration_s=5.0, seed=0, motion=MotionConfig(rear_foot_support_margin_m=margin),
+                            clocks=dataclasses.replace(SessionConfig().clocks, mocap_hz=opened.mocap_hz))
+        session = Session(cfg, opened.source)
+        stances: list[Stance] = []
+
+        def on_tick(state, ref, stances=stances):
+            if 2.7 <= state.time_s <= 3.0:
+                stances.append(ref.operator_stance)
+
+        session.on_tick = on_tick
+        result = session.run()
+        out[margin] = (stances, result.fall_time_s or 5.0)
+    assert Stance.LS in out[None][0]  # ankle heights alone: he stands on his left (front) foot
+    assert set(out[0.02][0]) == {Stance.DS}
+    assert out[0.02][1] > out[None][1] + 0.2

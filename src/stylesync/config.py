@@ -130,6 +130,11 @@ class MotionConfig:
     liftoff_weight_shift_s: float = 0.25
     liftoff_after_stand_s: float = 0.3
     liftoff_margin_m: float = 0.02
+    # A raised rear foot that still bears weight (on its toes, pose_optimization._rear_foot_bears_weight): while the
+    # operator's capture point is more than this behind his stance sole's heel (the character's sole scaled to him,
+    # in the heading frame) and his raised foot is behind it, his single stance is read as a double stance.
+    # None: off.
+    rear_foot_support_margin_m: float | None = 0.02
     # Early contact (Sec. 5.1) only counts once the swing has lasted this long (a lifting foot still touches).
     min_swing_s: float = 0.12
     stance_hip_weight_w0: float = 0.5  # Eq. 11 weight w0 (not given in the paper)

@@ -25,6 +25,8 @@ from stylesync import rotations as rot
 from stylesync.config import MotionConfig
 from stylesync.model.character import (
     ANKLE_HEIGHT_M,
+    FOOT_CENTER_AHEAD_OF_ANKLE_M,
+    FOOT_LENGTH_M,
     FOOT_WIDTH_M,
     HIP_HALF_WIDTH_M,
     JOINT_NAMES,
@@ -77,6 +79,8 @@ _SIDE_UP = {"left": "LEFT", "right": "RIGHT"}
 _OTHER_SIDE = {"left": "right", "right": "left"}
 _LINK = {n: i for i, n in enumerate(LINK_NAMES)}
 CHAR_LEG_LENGTH_M = THIGH_LENGTH_M + SHANK_LENGTH_M
+OPERATOR_VELOCITY_SETTLE_S = 0.2  # the operator's filtered COM velocity is taken as settled from then on [s]
+HEEL_AHEAD_OF_ANKLE_M = FOOT_CENTER_AHEAD_OF_ANKLE_M - FOOT_LENGTH_M / 2  # < 0: the heel is behind the ankle [m]
 
 
 def _heading_frame_fraction(p_h, al_h, ar_h, al_c, ar_c, scale: float, R: np.ndarray) -> np.ndarray:
@@ -253,11 +257,35 @@ class MotionOptimizer:
             can[side] = not he_stands_on_it or _inward_m(xi, ankle, yaw, stance) <= edge
         return can
 
+    def _rear_foot_bears_weight(self, sample: OperatorSample, analysis: OperatorAnalysis, op_state: Stance) -> bool:
+        """Whether the operator's raised foot still carries weight: it is behind his stance foot, and his capture
+        point is more than ``rear_foot_support_margin_m`` behind his stance sole's heel (the character's sole scaled
+        to him), in the heading frame. Nobody stands on one foot with his capture point behind its heel: his rear
+        foot, its heel raised above the stance threshold, still stands on its toes (a long, low stealthy stride).
+        In a walk the rear foot lifts with the capture point ahead of the front ankle. Not before the operator's
+        COM velocity has settled (OPERATOR_VELOCITY_SETTLE_S): a recording that starts mid-stride starts with his
+        filtered velocity at rest, his capture point on his COM, between his feet."""
+        margin = self.cfg.rear_foot_support_margin_m
+        if margin is None or self._op_leg_m is None or sample.time_s < OPERATOR_VELOCITY_SETTLE_S:
+            return False
+        scale = CHAR_LEG_LENGTH_M / self._op_leg_m
+        stance, raised = ("LEFT", "RIGHT") if op_state is Stance.LS else ("RIGHT", "LEFT")
+        forward = rot.matrix_from_quat(analysis.root_quat_wxyz)[:, 0]
+        a = sample.pos[f"ANKLE_{stance}"]
+        if float((sample.pos[f"ANKLE_{raised}"] - a)[:2] @ forward[:2]) >= 0.0:
+            return False
+        h_h = max(sample.com_world[2] - a[2], 0.1)
+        xi_h = sample.com_world + self._com_h_rate.rate * np.sqrt(h_h / self.g)
+        behind_heel_m = -(scale * float((xi_h - a)[:2] @ forward[:2]) - HEEL_AHEAD_OF_ANKLE_M)
+        return behind_heel_m > margin
+
     def _track_stance(self, sample: OperatorSample, state: CharacterState,
                       analysis: OperatorAnalysis, mass: MassProperties) -> _Tick:
         """Both stance FSMs, the operator's swing time, and the sample the reference follows (held while the
         character waits for a late contact)."""
         op_state = self.op_fsm.update(sample.pos["ANKLE_LEFT"][2], sample.pos["ANKLE_RIGHT"][2])
+        if op_state is not Stance.DS and self._rear_foot_bears_weight(sample, analysis, op_state):
+            op_state = Stance.DS
         contact = state.feet_pressing()
         # Only a lift-off from double stance can wait for the weight to shift.
         lifting = op_state is not Stance.DS and self.char_fsm.state is Stance.DS
