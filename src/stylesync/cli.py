@@ -153,7 +153,8 @@ def _run(args: argparse.Namespace) -> int:
                         clocks=dataclasses.replace(clocks, mocap_hz=opened.mocap_hz),
                         control=ControlConfig(lipm_time_sync=not args.no_lipm))
     return _run_session(cfg, opened.source, Path(args.out), {"source": args.source, "sensor": opened.sensor,
-                                                              "lipm_time_sync": not args.no_lipm}, args)
+                                                              "lipm_time_sync": not args.no_lipm,
+                                                              **opened.extras}, args)
 
 
 def _export(record: Path, bvh: str | None, mp4: str | None) -> None:

@@ -11,7 +11,7 @@ with the operator holding the last frame for ``rest_after_clip_s``; with ``start
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -37,6 +37,7 @@ class OpenedSource:
     # what the frames passed through: a recorded source's sensor model ("kinect", "none"), or "live" (the device's
     # or sender's own frames, no sensor model)
     sensor: str = "live"
+    extras: dict[str, object] = field(default_factory=dict)  # what the source reports (metrics.json "source_info")
 
 
 class _LeadIn:
@@ -145,10 +146,21 @@ def open_source(spec: str, clocks: ClockConfig | None = None, operator: Operator
         if not 0 <= port_n <= 65535:
             raise SourceError(f"VMC port must be 0-65535: '{spec}'")
         return OpenedSource(VmcSource(host or "127.0.0.1", port_n), 60.0, None, spec)
-    if kind in ("webcam", "video"):
+    if kind == "video":
+        from stylesync.sources.webcam import VideoRecording
+
+        video = VideoRecording(arg)
+        # The pose model's landmarks are the sensor: no sensor model on top.
+        opened = _recorded(video.performer, spec, "none", clocks, op, seed, duration_s)
+        opened.extras["camera_tilt_deg"] = round(video.camera_tilt_deg, 2)
+        opened.extras["video_frames"] = video.frames
+        opened.extras["video_frames_without_person"] = video.frames_without_person
+        opened.extras["video_frame_rate_hz"] = video.frame_rate_hz
+        return opened
+    if kind == "webcam":
         from stylesync.sources.webcam import MediaPipeSource
 
-        return OpenedSource(MediaPipeSource(arg, is_file=kind == "video"), 30.0, None, spec)
+        return OpenedSource(MediaPipeSource(arg, is_file=False), 30.0, None, spec)
     if kind == "k4a":
         from stylesync.sources.azure_kinect import AzureKinectSource
 
