@@ -171,3 +171,87 @@ def test_inspect_shows_the_map_and_names_what_is_missing(tmp_path, capsys):
     assert cli_main(["inspect", str(bad)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "KNEE_LEFT" in err and "HIP_RIGHT" in err
+
+
+def _rewritten(text: str, factor: float = 1.0, axes: np.ndarray | None = None, order: str | None = None,
+               six_channels: bool = False) -> str:
+    """The same motion written otherwise: lengths times ``factor`` (units), every vector in axes ``axes`` (each
+    joint's rotation R -> A R A^T), the rotation channels in Euler ``order`` (e.g. "XYZ"), position channels on
+    every joint (Unity), all re-derived from the file's own channels (BVH: intrinsic rotations in channel order)."""
+    from scipy.spatial.transform import Rotation
+
+    A = np.eye(3) if axes is None else axes
+    head, motion = text.split("MOTION", 1)
+    joints: list[list[str]] = []  # per joint: its channel names, in file order
+    out_head = []
+    for line in head.splitlines():
+        words = line.split()
+        pad = line[: len(line) - len(line.lstrip())]
+        if words and words[0] == "OFFSET":
+            v = A @ (np.array([float(w) for w in words[1:4]]) * factor)
+            out_head.append(f"{pad}OFFSET {v[0]:.6f} {v[1]:.6f} {v[2]:.6f}")
+            if joints and joints[-1] == ["offset-pending"]:
+                joints[-1] = ["offset", *map(str, v)]
+        elif words and words[0] == "CHANNELS":
+            chans = words[2:]
+            offset = joints.pop() if joints and joints[-1][0] == "offset" else None
+            rot_order = "".join(c[0] for c in chans if c.endswith("rotation"))
+            new = [c for c in chans if c.endswith("position")]
+            if six_channels and not new:
+                new = ["Xposition", "Yposition", "Zposition"]
+            new += [f"{c}rotation" for c in (order or rot_order)]
+            joints.append([" ".join(chans), " ".join(new), offset[1:] if offset else []])
+            out_head.append(f"{pad}CHANNELS {len(new)} {' '.join(new)}")
+        else:
+            if words and words[0] in ("ROOT", "JOINT"):
+                joints.append(["offset-pending"])
+            elif words and words[0] == "End":
+                joints.append(["end"])
+            elif words == ["}"] and joints and joints[-1] == ["end"]:
+                joints.pop()
+            out_head.append(line)
+    lines = motion.strip().splitlines()
+    rows = np.array([[float(w) for w in ln.split()] for ln in lines[2:]])
+    cols, k = [], 0
+    for old, new, offset in joints:
+        old_c, new_c = old.split(), new.split()
+        block = rows[:, k:k + len(old_c)]
+        k += len(old_c)
+        pos = np.array([block[:, old_c.index(f"{a}position")] for a in "XYZ"]).T if "Xposition" in old_c else None
+        rord = "".join(c[0] for c in old_c if c.endswith("rotation"))
+        ang = block[:, [old_c.index(f"{a}rotation") for a in rord]]
+        R = A @ Rotation.from_euler(rord.upper(), ang, degrees=True).as_matrix() @ A.T
+        nord = "".join(c[0] for c in new_c if c.endswith("rotation"))
+        ang_new = Rotation.from_matrix(R).as_euler(nord.upper(), degrees=True)
+        for c in new_c:
+            if c.endswith("position"):
+                p = (pos * factor) @ A.T if pos is not None else np.tile([float(x) for x in offset], (len(rows), 1))
+                cols.append(p[:, "XYZ".index(c[0])])
+            else:
+                cols.append(ang_new[:, nord.index(c[0])])
+    body = np.array(cols).T
+    return ("\n".join(out_head) + "\nMOTION\n" + "\n".join(lines[:2]) + "\n"
+            + "\n".join(" ".join(f"{v:.6f}" for v in r) for r in body) + "\n")
+
+
+@needs_cmu
+@pytest.mark.parametrize("variant", ["mm", "inch", "z_up", "euler_xyz", "unity_six_channels_cm"])
+def test_units_axes_euler_order_and_channels_give_the_same_operator(tmp_path, variant):
+    from stylesync.sources.bvh import _axes_matrix
+
+    original = (MOCAP / "cmu" / "02_01.bvh").read_text()
+    cmu_to_m = 0.056444
+    kwargs = {
+        "mm": {"factor": cmu_to_m * 1000}, "inch": {"factor": cmu_to_m / 0.0254},
+        "z_up": {"axes": _axes_matrix(2, 1.0).T @ _axes_matrix(1, 1.0)}, "euler_xyz": {"order": "XYZ"},
+        "unity_six_channels_cm": {"factor": cmu_to_m * 100, "six_channels": True},
+    }[variant]
+    path = tmp_path / f"02_01_{variant}.bvh"
+    text = _rewritten(original, **kwargs)
+    if variant == "unity_six_channels_cm":
+        text = _renamed(text, "unity")
+    path.write_text(text)
+    ref, rec = BvhRecording(MOCAP / "cmu" / "02_01.bvh"), BvhRecording(path)
+    assert np.abs(rec.performer.pos_world - ref.performer.pos_world).max() < 1e-3  # [m], whole clip
+    q_err = np.abs(np.abs(np.sum(rec.performer.quat_wxyz * ref.performer.quat_wxyz, axis=-1)) - 1.0).max()
+    assert q_err < 1e-6
