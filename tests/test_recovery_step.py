@@ -276,10 +276,14 @@ def test_the_fsm_keeps_a_foot_down_until_the_weight_is_over_the_other_or_the_wai
 def test_a_step_from_standing_waits_for_the_weight_to_shift():
     """CMU 131_01 (a styled walk), seed 0: the operator stands, then lifts his right foot with his capture point over
     his left sole; the character's was 7 cm outside its left sole and it fell sideways off it at 1.9 s. Waiting
-    (at most 0.25 s) for the weight to come over, it takes that step and falls later (it still falls)."""
+    (at most 0.25 s) for the weight to come over, it takes that step and falls later (at 3.05 s). Both runs read
+    the operator's stance by his ankles alone (no rear-foot support), so that only the wait differs; with it as well,
+    the default, the character does not fall in these 3.5 s."""
     spec = f"bvh:{MOCAP / 'cmu' / '131_01.bvh'}"
-    shifted, _ = _run(spec, 3.5, MotionConfig())
-    at_once, _ = _run(spec, 3.5, MotionConfig(liftoff_weight_shift_s=0.0))
+    shifted, _ = _run(spec, 3.5, MotionConfig(rear_foot_support_margin_m=None))
+    at_once, _ = _run(spec, 3.5, MotionConfig(liftoff_weight_shift_s=0.0, rear_foot_support_margin_m=None))
+    default, _ = _run(spec, 3.5, MotionConfig())
+    assert not default.fell
     assert at_once.fell and at_once.fall_time_s is not None and at_once.fall_time_s < 2.1
     assert not shifted.fell or (shifted.fall_time_s is not None and shifted.fall_time_s > 2.5)
 
