@@ -148,7 +148,7 @@ def _run(args: argparse.Namespace) -> int:
     if live and args.duration is None:
         raise StylesyncError("a live source needs --duration (seconds to run)")
     duration = args.duration if args.duration is not None else float(opened.duration_s or 0.0)
-    cfg = SessionConfig(duration_s=duration, seed=args.seed, gui=args.gui,
+    cfg = SessionConfig(duration_s=duration, seed=args.seed, gui=args.gui, stream_timeout_s=args.stream_timeout,
                         realtime=args.realtime or live or args.viewer != "none",
                         clocks=dataclasses.replace(clocks, mocap_hz=opened.mocap_hz),
                         control=ControlConfig(lipm_time_sync=not args.no_lipm))
@@ -324,6 +324,8 @@ def main(argv: list[str] | None = None) -> int:
     run = sub.add_parser("run", help="drive the character from an operator source")
     _add_source_args(run)
     run.add_argument("--duration", type=typed.duration_s, help="simulated seconds (default: the recording's length)")
+    run.add_argument("--stream-timeout", type=typed.duration_s, default=SessionConfig().stream_timeout_s,
+                     help="live sources: seconds of silence that end the run (shorter ones are held)")
     _add_session_args(run, "out/run", "pace to the wall clock (always for live sources)")
     run.set_defaults(func=_run)
     measure = sub.add_parser("measure", help="print the operator's link table (Sec. 4.2, Table 2)")

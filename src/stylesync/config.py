@@ -329,9 +329,12 @@ class SessionConfig:
     seed: int = 0
     realtime: bool = False  # paced to the wall clock (interactive) or as fast as possible (offline)
     gui: bool = False
+    # A live stream silent for longer than this ends the run (its outputs written); shorter silences are held [s]
+    stream_timeout_s: float = 5.0
 
     def __post_init__(self) -> None:
         _positive("SessionConfig.duration_s", self.duration_s)
+        _positive("SessionConfig.stream_timeout_s", self.stream_timeout_s)
 
     def replace(self, **changes) -> SessionConfig:
         return dataclasses.replace(self, **changes)

@@ -52,7 +52,6 @@ FALL_ROOT_HEIGHT_M = 0.5  # a fall: pelvis below this height, or a non-foot link
 # about 15-20 m/s), or the pelvis higher than a jump can lift it (0.88 m standing).
 DIVERGED_LINK_SPEED_MPS = 25.0
 DIVERGED_ROOT_HEIGHT_M = 2.5
-SILENT_STREAM_TIMEOUT_S = 2.0
 FIRST_FRAME_TIMEOUT_S = 10.0
 
 
@@ -95,6 +94,8 @@ class SessionResult:
     stage_ms: dict[str, list[float]]
     input_latency_ms: list[float] = field(default_factory=list)  # live frames: arrival -> first control tick using it
     operator_prefetched: bool = False  # the operator side ran ahead in a second process (prefetch.py)
+    end_reason: str = ""  # why the run ended before its duration without a fall ("" : it did not)
+    rejections: dict[str, int] = field(default_factory=dict)  # a live source's rejected packets/frames by reason
 
 
 @dataclass
@@ -110,6 +111,7 @@ class _RunState:
     fall_reason: str = ""
     wall0: float = 0.0
     last_frame_sim_s: float = 0.0
+    end_reason: str = ""
     next_render_s: float = 0.0
 
 
@@ -270,7 +272,7 @@ class Session:
                 if is_tick[step]:
                     self._wait_while_paused(run)
                     state = self._control_tick(t, operator, run)
-                    if self._detect_fall(state, t, run) or self.closed:
+                    if self._detect_fall(state, t, run) or self.closed or run.end_reason:
                         break
                     self._render_if_due(state, t, run)
                     if progress is not None:
@@ -289,7 +291,8 @@ class Session:
         return SessionResult(run.log, self.fell, run.fall_time, run.fall_reason, sim_t, wall, step + 1,
                              operator.rejected_frames, operator.dropped_joint_values,
                              dict(self.bounds.counts), run.stage_ms, run.latency_ms,
-                             isinstance(operator, OperatorPrefetch))
+                             isinstance(operator, OperatorPrefetch), run.end_reason,
+                             dict(getattr(self.source, "rejections", {})))
 
     # ---- the parts of a run ----------------------------------------------------------------------------------
     def _wait_while_paused(self, run: _RunState) -> None:
@@ -327,11 +330,15 @@ class Session:
         return state
 
     def _watch_stream(self, got_frames: bool, t: float, run: _RunState) -> None:
-        """Watchdog: a live stream silent for longer than SILENT_STREAM_TIMEOUT_S ends the run."""
+        """Watchdog of a live stream. While it is silent the operator side holds his last sample (the character
+        keeps balancing in his last pose) and the run goes on when frames come back; silent for longer than
+        ``SessionConfig.stream_timeout_s``, the run ends there, as a run that has reached its duration (its
+        outputs are written), with the reason in ``end_reason``."""
         if got_frames:
             run.last_frame_sim_s = t
-        elif t - run.last_frame_sim_s > SILENT_STREAM_TIMEOUT_S and self._source_is_live():
-            raise SourceError(f"operator stream silent for more than {SILENT_STREAM_TIMEOUT_S:.0f} s")
+        elif t - run.last_frame_sim_s > self.cfg.stream_timeout_s and self._source_is_live():
+            run.end_reason = f"operator stream silent for more than {self.cfg.stream_timeout_s:g} s"
+            log.warning("%s: run ended at t=%.2f s", run.end_reason, t)
 
     def _detect_fall(self, state: CharacterState, t: float, run: _RunState) -> bool:
         """Record the first fall; whether the run ends here."""

@@ -64,6 +64,8 @@ def summarize(result: SessionResult) -> dict:
         "com_error_m": {"mean": float(com_err.mean()), "max": float(com_err.max())},
         "joint_error_deg": {"mean": float(lg.array("joint_err_deg").mean()) if len(t) else 0.0},
         "rejected_frames": result.rejected_frames,
+        "rejections": dict(result.rejections),  # a live source's rejected packets or frames by reason
+        "ended_by": "fall" if result.fell else (result.end_reason or "duration"),
         "dropped_joint_values": result.dropped_joint_values,
         "bound_violations": result.bound_counts,
         "input_latency_ms": _latency(result.input_latency_ms),

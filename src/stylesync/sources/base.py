@@ -92,12 +92,25 @@ class QueuedLiveSource(OperatorSource):
 
     def __init__(self, max_queue: int):
         self.rejected_frames = 0
+        self.rejections: dict[str, int] = {}  # rejected packets or frames by reason
         self._queue: deque[OperatorFrame] = deque(maxlen=max_queue)
         self._lock = threading.Lock()
 
-    def push(self, frame: OperatorFrame) -> None:
+    def count_rejection(self, reason: str) -> int:
+        """Count one rejection of ``reason``; returns how many of that reason so far."""
         with self._lock:
+            n = self.rejections[reason] = self.rejections.get(reason, 0) + 1
+        return n
+
+    def push(self, frame: OperatorFrame) -> None:
+        """Queue a frame; when the queue is full the oldest frame is dropped and counted ("queue overflow")."""
+        with self._lock:
+            overflow = len(self._queue) == self._queue.maxlen
             self._queue.append(frame)
+        if overflow:
+            self.rejected_frames += 1
+            if self.count_rejection("queue overflow") == 1:
+                log.warning("operator stream: frames arrive faster than they are used; the oldest are dropped")
 
     def poll(self, now_s: float) -> list[OperatorFrame]:
         with self._lock:

@@ -134,6 +134,7 @@ class VmcSource(QueuedLiveSource):
 
     def __init__(self, host: str = "127.0.0.1", port: int = DEFAULT_PORT, max_queue: int = 256):
         try:
+            from pythonosc import osc_packet
             from pythonosc.dispatcher import Dispatcher
             from pythonosc.osc_server import BlockingOSCUDPServer
         except ImportError:
@@ -146,83 +147,121 @@ class VmcSource(QueuedLiveSource):
         self._t0 = time.perf_counter()
         self.frames_received = 0
         self._root_in_packet = False
+        self._frame_spoiled = False
+        self._parse = osc_packet.OscPacket
+        # address -> (handler, smallest argument count)
+        self._handlers = {"/VMC/Ext/Root/Pos": (self._on_root, 8), "/VMC/Ext/Bone/Pos": (self._on_bone, 8),
+                          "/VMC/Ext/T": (self._on_time, 1), "/VMC/Ext/OK": (self._on_ok, 1)}
         source = self
 
         class _PacketDispatcher(Dispatcher):
-            """Dispatches a packet's messages, then tells the source the packet has ended."""
+            """Hands each UDP packet to the source whole (python-osc's own dispatch would sleep until a bundle's
+            time tag and print tracebacks for garbage)."""
 
             def call_handlers_for_packet(self, data: bytes, client_address: tuple[str, int]) -> Any:
-                source._root_in_packet = False
-                result = super().call_handlers_for_packet(data, client_address)
-                source._end_of_packet()
-                return result
+                source._on_packet(data)
+                return []
 
-        d = _PacketDispatcher()
-        d.map("/VMC/Ext/Root/Pos", self._on_root)
-        d.map("/VMC/Ext/Bone/Pos", self._on_bone)
-        d.map("/VMC/Ext/T", self._on_time)
-        d.map("/VMC/Ext/OK", self._on_ok)
+        class _Server(BlockingOSCUDPServer):
+            def verify_request(self, request: Any, client_address: Any) -> bool:
+                return True  # every datagram reaches _on_packet, where what is not OSC is counted
+
+            def handle_error(self, request: Any, client_address: Any) -> None:
+                source._reject("handler error", "")  # counted, never a traceback on the terminal
+
         try:
             # One packet at a time, in arrival order: a frame is assembled from its packet's messages.
-            self._server = BlockingOSCUDPServer((host, port), d)
-        except OSError as exc:
-            raise SourceError(f"cannot listen for VMC on {host}:{port}: {exc.strerror or exc}") from None
+            self._server = _Server((host, port), _PacketDispatcher())
+        except (OSError, OverflowError) as exc:
+            raise SourceError(f"cannot listen for VMC on {host}:{port}: {getattr(exc, 'strerror', None) or exc}"
+                              ) from None
         self.port = int(self._server.server_address[1])
-        self._thread = threading.Thread(target=self._server.serve_forever, name="vmc-listener", daemon=True)
+        self._thread = threading.Thread(target=self._server.serve_forever, args=(0.1,), name="vmc-listener",
+                                        daemon=True)
         self._thread.start()
+
+    def _on_packet(self, data: bytes) -> None:
+        """One UDP packet: its messages in order, then the end of the packet. Time tags are not waited on: a frame
+        is timed on its arrival."""
+        self._root_in_packet = False
+        try:
+            messages = [m.message for m in self._parse(data).messages]
+        except Exception as exc:  # noqa: BLE001 - python-osc raises ParseError, struct, Unicode and index errors
+            self._reject("malformed packet", f"{type(exc).__name__}: {exc}")
+            return
+        for msg in messages:
+            entry = self._handlers.get(msg.address)
+            if entry is None:
+                if not msg.address.startswith("/VMC/"):  # other VMC messages (blend shapes, camera ...) are unused
+                    self._reject("unknown address", msg.address[:80])
+                continue
+            handler, arity = entry
+            args = list(msg.params)
+            if len(args) < arity:
+                self._reject("bad arity", f"{msg.address} with {len(args)} arguments")
+                continue
+            handler(*args)
+        self._end_of_packet()
 
     def _end_of_packet(self) -> None:
         """A packet that carried a root and bones holds a whole frame (one bundle per frame)."""
         if self._root_in_packet and self._bones:
             self._complete(None)
 
-    def _on_ok(self, _addr: str, *args: Any) -> None:
+    def _on_ok(self, *args: Any) -> None:
         self._complete(None)
 
-    def _on_root(self, _addr: str, *args: Any) -> None:
+    @staticmethod
+    def _pose(args: list[Any]) -> tuple[np.ndarray, np.ndarray] | str:
+        """Position and rotation of a Root/Bone message's arguments 1-7, or why they are not usable."""
+        try:
+            values = np.array([float(a) for a in args[1:8]])
+        except (ValueError, TypeError, OverflowError):
+            return "malformed message"
+        if not np.all(np.isfinite(values)):
+            return "non-finite values"
+        if float(np.linalg.norm(values[3:7])) < 1e-6:
+            return "zero quaternion"
+        return ours_from_unity_pos(values[0:3]), ours_from_unity_quat(values[3:7])
+
+    def _on_root(self, *args: Any) -> None:
         self._root_in_packet = True
         if self._bones:
             self._complete(None)
-        try:
-            p = ours_from_unity_pos(args[1:4])
-            q = ours_from_unity_quat(args[4:8])
-        except (ValueError, TypeError, IndexError):
-            self._reject("malformed /VMC/Ext/Root/Pos")
+        pose = self._pose(list(args))
+        if isinstance(pose, str):
+            self._reject(pose, "/VMC/Ext/Root/Pos")
+            self._root = None  # no frame until a usable root arrives
             return
-        self._root = (p, q)
+        self._root = pose
 
-    def _on_bone(self, _addr: str, *args: Any) -> None:
-        try:
-            name = str(args[0])
-            p = ours_from_unity_pos(args[1:4])
-            q = ours_from_unity_quat(args[4:8])
-        except (ValueError, TypeError, IndexError):
-            self._reject("malformed /VMC/Ext/Bone/Pos")
+    def _on_bone(self, *args: Any) -> None:
+        pose = self._pose(list(args))
+        if isinstance(pose, str):
+            self._reject(pose, "/VMC/Ext/Bone/Pos")
+            self._frame_spoiled = True  # the frame this bone belongs to is not passed on
             return
+        name = str(args[0])
         if name in UNITY_PARENT:
-            self._bones[name] = (p, q)
+            self._bones[name] = pose
 
-    def _on_time(self, _addr: str, *args: Any) -> None:
+    def _on_time(self, *args: Any) -> None:
         try:
-            t = float(args[0])
-        except (ValueError, TypeError, IndexError):
+            t: float | None = float(args[0])
+        except (ValueError, TypeError, OverflowError):
             t = None
-        self._complete(t)
+        self._complete(t if t is not None and np.isfinite(t) else None)
 
     def _complete(self, sender_time_s: float | None) -> None:
         arrival = time.perf_counter()
-        bones, root = self._bones, self._root
-        self._bones = {}
-        if root is None or not bones:
-            return
-        if not (np.all(np.isfinite(root[0])) and all(np.all(np.isfinite(p)) and np.all(np.isfinite(q))
-                                                     for p, q in bones.values())):
-            self._reject("NaN or infinite values")
+        bones, root, spoiled = self._bones, self._root, self._frame_spoiled
+        self._bones, self._frame_spoiled = {}, False
+        if root is None or not bones or spoiled:
             return
         try:
             frame, q_rest = frame_from_bones(arrival - self._t0, root[0], root[1], bones, self._q_rest)
         except SourceError as exc:
-            self._reject(str(exc))
+            self._reject("incomplete frame", str(exc))
             return
         self._q_rest = q_rest
         frame.extras["arrival_wall_s"] = arrival
@@ -231,10 +270,13 @@ class VmcSource(QueuedLiveSource):
         self.push(frame)
         self.frames_received += 1
 
-    def _reject(self, why: str) -> None:
+    def _reject(self, why: str, detail: str) -> None:
+        """Count a rejected packet, message or frame by reason; log the first of each reason with what it was."""
         self.rejected_frames += 1
-        if self.rejected_frames <= 10 or self.rejected_frames % 100 == 0:
-            log.warning("vmc: rejected frame (%s), %d so far", why, self.rejected_frames)
+        n = self.count_rejection(why)
+        if n == 1:
+            log.warning("vmc: rejected (%s)%s; later ones of this kind are counted in metrics.json", why,
+                        f": {detail}" if detail else "")
 
     def close(self) -> None:
         self._server.shutdown()

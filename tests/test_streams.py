@@ -1,0 +1,129 @@
+"""Live streams that survive their senders: silence, garbage packets, time tags in the future, bursts."""
+
+from __future__ import annotations
+
+import json
+import logging
+import socket
+import time
+
+import numpy as np
+import pytest
+
+from stylesync.config import SessionConfig
+from stylesync.sources.base import QueuedLiveSource
+from stylesync.sources.human_model import HumanModel
+
+
+class _ScriptedStream(QueuedLiveSource):
+    """A live source whose operator stands still and sends at 60 Hz of simulated time, except in ``gaps``
+    ((start, end) [s]): a stream that falls silent, deterministically (the run is not paced)."""
+
+    live = True
+
+    def __init__(self, gaps: list[tuple[float, float]]):
+        super().__init__(256)
+        self.gaps = gaps
+        self.human = HumanModel()
+        self.sent_until_s = -1.0
+
+    def wait_first_frame(self, timeout_s: float) -> bool:
+        return True
+
+    def poll(self, now_s: float) -> list:
+        frames = []
+        k = int(np.floor(self.sent_until_s * 60)) + 1
+        while k / 60 <= now_s + 1e-9:
+            t = k / 60
+            if not any(a <= t < b for a, b in self.gaps):
+                frames.append(self.human.frame_from_pose(t, np.array([0.0, 0.0, self.human.hip_height_m]), {}))
+            k += 1
+        self.sent_until_s = max(self.sent_until_s, now_s)
+        return frames
+
+
+def test_a_silent_stream_is_held_then_ends_the_run_cleanly(caplog):
+    from stylesync.metrics.summary import summarize
+    from stylesync.session import Session
+
+    # 2 s of silence while the operator stands: held, no fall, the run goes on when frames come back.
+    source = _ScriptedStream(gaps=[(1.0, 3.0), (4.0, 99.0)])
+    with caplog.at_level(logging.WARNING, logger="stylesync.session"):
+        result = Session(SessionConfig(duration_s=10.0, stream_timeout_s=2.5), source).run()
+    assert not result.fell
+    # frames came back at 3 s; the last one at 4 s, and 2.5 s of silence after it ends the run
+    assert result.sim_duration_s == pytest.approx(4.0 + 2.5, abs=0.05)
+    assert result.end_reason == "operator stream silent for more than 2.5 s"
+    m = summarize(result)
+    assert m["ended_by"] == result.end_reason and json.dumps(m)
+    assert any("silent for more than 2.5 s" in r.message for r in caplog.records)
+    # The same silence with a shorter timeout ends the run in the first gap.
+    short = Session(SessionConfig(duration_s=10.0, stream_timeout_s=1.5), _ScriptedStream([(1.0, 3.0)])).run()
+    assert short.sim_duration_s == pytest.approx(2.5, abs=0.05) and not short.fell
+
+
+def _bone_bundle(msgs, timetag):
+    from pythonosc import osc_bundle_builder, osc_message_builder
+
+    bundle = osc_bundle_builder.OscBundleBuilder(timetag)
+    for address, args in msgs:
+        m = osc_message_builder.OscMessageBuilder(address=address)
+        for a in args:
+            m.add_arg(a)
+        bundle.add_content(m.build())
+    return bundle.build().dgram
+
+
+def test_vmc_hostile_packets_are_counted_by_reason_and_never_block_shutdown(capfd):
+    pytest.importorskip("pythonosc")
+    from stylesync.sources.vmc import VmcSender, VmcSource
+
+    source = VmcSource("127.0.0.1", 0, max_queue=256)
+    sender = VmcSender("127.0.0.1", source.port)
+    human = HumanModel()
+    frame = human.frame_from_pose(0.0, np.array([0.0, 0.0, human.hip_height_m]), {})
+    good = sender.messages(frame)
+    sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    addr = ("127.0.0.1", source.port)
+    rng = np.random.default_rng(0)
+    try:
+        # A bundle time-tagged an hour ahead: taken on arrival, not waited for.
+        sock.sendto(_bone_bundle(good, time.time() + 3600.0), addr)
+        # Garbage: random bytes, a bundle header with nothing sound after it, an unknown address, bad arity,
+        # non-finite values, a zero quaternion.
+        for _ in range(300):
+            sock.sendto(rng.bytes(int(rng.integers(1, 200))), addr)
+        sock.sendto(b"#bundle\x00" + rng.bytes(40), addr)
+        sock.sendto(_bone_bundle([("/not/vmc", [1.0])], 1), addr)
+        sock.sendto(_bone_bundle([("/VMC/Ext/Bone/Pos", ["Hips", 1.0])], 1), addr)
+        bad = [(a, [x if not isinstance(x, float) else float("nan") for x in args]) if a == "/VMC/Ext/Bone/Pos"
+               else (a, args) for a, args in good]
+        sock.sendto(_bone_bundle(bad, 1), addr)
+        zero = [(a, [*args[:4], 0.0, 0.0, 0.0, 0.0]) if a == "/VMC/Ext/Root/Pos" else (a, args) for a, args in good]
+        sock.sendto(_bone_bundle(zero, 1), addr)
+        # A burst beyond the queue, nobody polling (in chunks the socket's receive buffer holds: what the kernel
+        # drops never reaches the source).
+        packet = _bone_bundle(good, 1)
+        for k in range(600):
+            sock.sendto(packet, addr)
+            if k % 20 == 19:
+                time.sleep(0.02)
+        seen, deadline = -1, time.perf_counter() + 10.0
+        while source.frames_received != seen and time.perf_counter() < deadline:
+            seen = source.frames_received
+            time.sleep(0.2)
+    finally:
+        t0 = time.perf_counter()
+        source.close()
+        closed_in_s = time.perf_counter() - t0
+        sock.close()
+    assert closed_in_s < 2.0
+    # the future-tagged frame and the burst (less what the kernel dropped on a busy machine)
+    assert source.frames_received > 400
+    r = source.rejections
+    assert r["malformed packet"] >= 250  # random bytes that happen to parse are counted under another reason
+    assert r["unknown address"] >= 1 and r["bad arity"] >= 1
+    assert r["non-finite values"] >= 1 and r["zero quaternion"] >= 1
+    assert r["queue overflow"] == source.frames_received - 256
+    assert len(source.poll(0.0)) == 256
+    assert "Traceback" not in capfd.readouterr().err
