@@ -91,8 +91,11 @@ def test_vmc_hostile_packets_are_counted_by_reason_and_never_block_shutdown(capf
         sock.sendto(_bone_bundle(good, time.time() + 3600.0), addr)
         # Garbage: random bytes, a bundle header with nothing sound after it, an unknown address, bad arity,
         # non-finite values, a zero quaternion.
-        for _ in range(300):
+        for k in range(300):
             sock.sendto(rng.bytes(int(rng.integers(1, 200))), addr)
+            if k % 20 == 19:
+                time.sleep(0.02)  # what the socket's receive buffer cannot hold never reaches the source
+        time.sleep(0.1)
         sock.sendto(b"#bundle\x00" + rng.bytes(40), addr)
         sock.sendto(_bone_bundle([("/not/vmc", [1.0])], 1), addr)
         sock.sendto(_bone_bundle([("/VMC/Ext/Bone/Pos", ["Hips", 1.0])], 1), addr)
@@ -127,3 +130,59 @@ def test_vmc_hostile_packets_are_counted_by_reason_and_never_block_shutdown(capf
     assert r["queue overflow"] == source.frames_received - 256
     assert len(source.poll(0.0)) == 256
     assert "Traceback" not in capfd.readouterr().err
+
+
+def _demo_session(tmp_path):
+    from stylesync.cli import main as cli_main
+
+    out = tmp_path / "demo"
+    assert cli_main(["demo", "--duration", "0.3", "--out", str(out)]) == 0
+    return out, (out / "session.jsonl").read_text().splitlines()
+
+
+def test_damaged_session_files_replay_what_is_before_the_damage(tmp_path, capsys):
+    from stylesync.cli import main as cli_main
+    from stylesync.export.session_file import read_session
+
+    _, lines = _demo_session(tmp_path)
+    n_ticks = len(lines) - 2  # header, ticks, metrics
+    cases = {}
+    for name, change in (("far", ("t", 1e6)), ("nan", ("root_pos_world", [float("nan"), 0.0, 0.9])),
+                         ("back", ("t", 0.0)), ("short", ("joint_pos", [[1.0, 0.0, 0.0, 0.0]]))):
+        tick = json.loads(lines[6])
+        tick[change[0]] = change[1]
+        path = tmp_path / f"{name}.jsonl"
+        path.write_text("\n".join(lines[:6] + [json.dumps(tick)] + lines[7:]) + "\n")
+        cases[name] = read_session(path)
+    for name, session in cases.items():
+        assert len(session.ticks) == 5 and session.bad_line is not None and "line 7" in session.bad_line, name
+    assert "jumps" in cases["far"].bad_line and "not finite" in cases["nan"].bad_line
+    assert "not after" in cases["back"].bad_line and "values, not" in cases["short"].bad_line
+    intact = tmp_path / "intact.jsonl"
+    intact.write_text("\n".join(lines) + "\n")
+    whole = read_session(intact)
+    assert whole.bad_line is None and len(whole.ticks) == n_ticks
+    # the export of the damaged file holds only finite values, over the time of the ticks before the damage
+    assert cli_main(["replay", str(tmp_path / "nan.jsonl"), "--export-bvh", str(tmp_path / "nan.bvh")]) == 0
+    motion = (tmp_path / "nan.bvh").read_text().split("MOTION")[1]
+    assert "nan" not in motion.lower() and "inf" not in motion.lower()
+    assert cli_main(["replay", str(tmp_path / "far.jsonl"), "--export-bvh", str(tmp_path / "far.bvh")]) == 0
+    assert "Frames: 2" in (tmp_path / "far.bvh").read_text()  # ticks over 0-0.032 s, at 60 fps: not 1e6 s
+    # a header alone (a run killed before its first tick): one line, no traceback
+    header_only = tmp_path / "header.jsonl"
+    header_only.write_text(lines[0] + "\n")
+    capsys.readouterr()
+    assert cli_main(["replay", str(header_only), "--export-bvh", str(tmp_path / "h.bvh")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == f"stylesync: error: {header_only}: no ticks to replay (the run was cut short before its first one)"
+
+
+def test_a_run_in_a_used_folder_leaves_no_output_of_the_earlier_run(tmp_path):
+    out, _ = _demo_session(tmp_path)
+    (out / "report.html").write_text("an earlier run's report")
+    (out / "stale.txt").write_text("not ours")
+    from stylesync.cli import _clear_outputs
+
+    _clear_outputs(out, out / "session.jsonl")
+    assert not (out / "metrics.json").exists() and not (out / "report.html").exists()
+    assert not (out / "session.jsonl").exists() and (out / "stale.txt").exists()  # only our outputs are removed

@@ -10,10 +10,14 @@ import signal
 import sys
 import threading
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from stylesync import cli_args as typed
 from stylesync.config import SHARED_DIR, VIEWER_DRAW_HZ, ClockConfig, ControlConfig, OperatorConfig, SessionConfig
 from stylesync.errors import StylesyncError
+
+if TYPE_CHECKING:
+    from stylesync.export.session_file import SessionFile
 
 _HEADLINE = ("fell", "fall_time_s", "sim_duration_s", "operator_steps", "character_steps", "realtime_factor")
 
@@ -44,8 +48,9 @@ def _run_session(cfg: SessionConfig, source, out: Path, extra: dict, args: argpa
     from stylesync.session import Session
 
     out.mkdir(parents=True, exist_ok=True)
-    session = Session(cfg, source)
     record = Path(args.record) if args.record else out / "session.jsonl"
+    _clear_outputs(out, record)
+    session = Session(cfg, source)
     # A run as fast as possible writes its session file when it ends (session_file.py): not in the control loop.
     recorder = SessionRecorder(record, cfg, session, deferred=not cfg.realtime)
     session.on_tick = recorder.tick
@@ -74,7 +79,7 @@ def _run_session(cfg: SessionConfig, source, out: Path, extra: dict, args: argpa
     if progress is not None:
         progress.done(result.fell, result.fall_time_s)
     metrics["session_file"] = str(record)
-    (out / "metrics.json").write_text(json.dumps(metrics, indent=2))
+    _write_atomically(out / "metrics.json", json.dumps(metrics, indent=2))
     if args.export_bvh or args.export_mp4:
         _export(record, args.export_bvh, args.export_mp4)
     write_plots(result, out)
@@ -85,6 +90,25 @@ def _run_session(cfg: SessionConfig, source, out: Path, extra: dict, args: argpa
     write_report(out)
     print(f"outputs in {out} (report.html)")
     return 0
+
+
+RUN_OUTPUTS = ("metrics.json", "report.html", "com_footsteps.png", "stance_states.png", "style_features.png",
+               "render_strip.png", "session.jsonl")
+
+
+def _clear_outputs(out: Path, record: Path) -> None:
+    """Remove an earlier run's outputs from ``out`` (and the session file about to be written), so that a run cut
+    short never leaves another run's metrics or report beside its own session file."""
+    for path in [out / name for name in RUN_OUTPUTS] + [record]:
+        if path.is_file():
+            path.unlink()
+
+
+def _write_atomically(path: Path, text: str) -> None:
+    """Write under a temporary name, then rename: a reader sees the old file or the whole new one."""
+    tmp = path.with_name(f".{path.name}.tmp")
+    tmp.write_text(text)
+    tmp.replace(path)
 
 
 def _hold_viewer(viewer) -> None:
@@ -157,11 +181,13 @@ def _run(args: argparse.Namespace) -> int:
                                                               **opened.extras}, args)
 
 
-def _export(record: Path, bvh: str | None, mp4: str | None) -> None:
+def _export(record: Path | SessionFile, bvh: str | None, mp4: str | None) -> None:
     from stylesync.export.replay import export_bvh, export_mp4
     from stylesync.export.session_file import read_session
 
-    session = read_session(record)
+    session = read_session(record) if isinstance(record, Path) else record
+    if not session.ticks:
+        raise StylesyncError("the session has no ticks to export (the run was cut short before its first one)")
     for path in (bvh, mp4):
         if path:
             Path(path).expanduser().absolute().parent.mkdir(parents=True, exist_ok=True)
@@ -181,8 +207,10 @@ def _replay(args: argparse.Namespace) -> int:
                       "fell": (session.metrics or {}).get("fell")}))
     if not (args.export_bvh or args.export_mp4 or args.viewer != "none"):
         raise StylesyncError("replay: give --viewer web|gui, --export-bvh FILE and/or --export-mp4 FILE")
+    if not session.ticks:
+        raise StylesyncError(f"{args.file}: no ticks to replay (the run was cut short before its first one)")
     if args.export_bvh or args.export_mp4:
-        _export(Path(args.file), args.export_bvh, args.export_mp4)
+        _export(session, args.export_bvh, args.export_mp4)
     if args.viewer != "none":
         _replay_viewer(args, session)
     return 0

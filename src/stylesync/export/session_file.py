@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import logging
 from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any, NamedTuple
@@ -30,6 +31,8 @@ import numpy as np
 from stylesync.errors import SourceError
 from stylesync.model.character import JOINTS, LINK_NAMES
 from stylesync.processing.joint_map import TRACKED_POSITIONS
+
+log = logging.getLogger("stylesync.export")
 
 FORMAT = "stylesync-session"
 VERSION = 1
@@ -140,6 +143,7 @@ class SessionFile:
     header: dict
     ticks: list[dict]
     metrics: dict | None
+    bad_line: str | None = None  # where and why the reading stopped before the end of the file
 
     def array(self, key: str) -> np.ndarray:
         return np.asarray([t[key] for t in self.ticks], dtype=float)
@@ -159,14 +163,51 @@ def iter_lines(path: Path) -> Iterator[tuple[int, dict]]:
             yield k, obj
 
 
+# A tick's state: these keys must hold finite numbers (nested lists) of these shapes' sizes.
+_TICK_ARRAYS = {"root_pos_world": 3, "root_quat_wxyz": 4, "joint_pos": 4 * len(JOINTS),
+                "link_quat_wxyz": 4 * len(LINK_NAMES)}
+MAX_TICK_GAP_S = 1.0  # consecutive ticks further apart than this are damage (control ticks are ~7.5 ms apart) [s]
+
+
+def _tick_problem(obj: dict, last_t: float) -> str | None:
+    """Why a tick line cannot be replayed (None: it can): time not finite, not after the previous tick or jumping
+    by more than MAX_TICK_GAP_S, a state array missing, of the wrong size or not finite."""
+    try:
+        t = float(obj["t"])
+    except (TypeError, ValueError, OverflowError):
+        return "time is not a number"
+    if not np.isfinite(t):
+        return "time is not finite"
+    if t <= last_t:
+        return f"time {t:g} s not after {last_t:g} s"
+    if np.isfinite(last_t) and t - last_t > MAX_TICK_GAP_S:
+        return f"time jumps from {last_t:g} s to {t:g} s"
+    for key, size in _TICK_ARRAYS.items():
+        if key not in obj:
+            continue  # older files may lack link rotations; the replay then says what is missing
+        try:
+            values = np.asarray(obj[key], dtype=float)
+        except (TypeError, ValueError, OverflowError):
+            return f"{key} is not numeric"
+        if values.size != size:
+            return f"{key} has {values.size} values, not {size}"
+        if not np.all(np.isfinite(values)):
+            return f"{key} is not finite"
+    return None
+
+
 def read_session(path: str | Path) -> SessionFile:
-    """Read a session file; a run cut short (no metrics line, a truncated last line) keeps its complete ticks."""
+    """Read a session file. A run cut short (no metrics line, a truncated last line) keeps its complete ticks; a
+    damaged line (not JSON, not a tick, a state that is not finite, time not increasing or jumping) ends the
+    reading there: the ticks before it are kept and ``bad_line`` says which line and why (logged once)."""
     p = Path(path)
     if not p.is_file():
         raise SourceError(f"session file not found: {p}")
     header: dict | None = None
     ticks: list[dict] = []
     metrics = None
+    bad: str | None = None
+    last_t = -np.inf
     try:
         for k, obj in iter_lines(p):
             if header is None:
@@ -176,14 +217,23 @@ def read_session(path: str | Path) -> SessionFile:
             elif "metrics" in obj:
                 metrics = obj["metrics"]
             elif "t" in obj and "root_pos_world" in obj:
+                problem = _tick_problem(obj, last_t)
+                if problem is not None:
+                    bad = f"line {k}: {problem}"
+                    break
                 ticks.append(obj)
+                last_t = float(obj["t"])
             else:
-                raise SourceError(f"session file {p}, line {k}: neither a tick nor the metrics")
+                bad = f"line {k}: neither a tick nor the metrics"
+                break
     except SourceError as exc:
         if header is None or "not JSON" not in str(exc):
             raise
+        bad = str(exc).split(", ", 1)[-1]
     except UnicodeDecodeError:
         raise SourceError(f"session file {p} is not UTF-8 text") from None
     if header is None:
         raise SourceError(f"session file {p} is empty")
-    return SessionFile(header, ticks, metrics)
+    if bad is not None:
+        log.warning("session file %s, %s: replaying the %d ticks before it", p, bad, len(ticks))
+    return SessionFile(header, ticks, metrics, bad)
