@@ -84,6 +84,7 @@ def _run_session(cfg: SessionConfig, source, out: Path, extra: dict, args: argpa
         _export(record, args.export_bvh, args.export_mp4)
     write_plots(result, out)
     write_strip(session.renders, out / "render_strip.png")
+    session.release_engine()
     print(json.dumps({k: metrics[k] for k in _HEADLINE}))
     from stylesync.metrics.report import write_report
 
@@ -321,6 +322,30 @@ def _interrupt(signum: int, frame: object) -> None:
     raise KeyboardInterrupt
 
 
+def _batch(args: argparse.Namespace) -> int:
+    import importlib.util
+
+    from stylesync.batch.clips import BatchSettings, find_clips, jobs_for
+    from stylesync.batch.runner import print_progress, run_batch
+
+    executor = args.executor or ("ray" if importlib.util.find_spec("ray") else "processes")
+    if args.ray_address and executor != "ray":
+        raise StylesyncError("--ray-address needs the ray executor")
+    settings = BatchSettings(seeds=tuple(range(args.seeds)), sensor=args.sensor, duration_s=args.duration,
+                             export_bvh=not args.no_bvh, export_mp4=args.mp4, lipm_time_sync=not args.no_lipm)
+    jobs = jobs_for(find_clips(args.input), settings)
+    out = Path(args.out)
+    print(f"batch: {len(jobs)} runs ({len(jobs) // len(settings.seeds)} clips x {len(settings.seeds)} seeds), "
+          f"executor {executor}, outputs in {out}", file=sys.stderr, flush=True)
+    counts = run_batch(jobs, settings, out, executor, args.workers, args.ray_address, args.max_retries,
+                       progress=print_progress)
+    if sys.stderr.isatty():
+        print(file=sys.stderr)
+    print(json.dumps({"runs": counts.total, "done": counts.done, "failed": counts.failed, "retried": counts.retried,
+                      "from_before": counts.skipped, "summary": str(out / "batch.md")}))
+    return 0
+
+
 def _inspect(args: argparse.Namespace) -> int:
     """Print what the BVH reader understood of a file; a skeleton that cannot be mapped is an error (exit 2)."""
     from stylesync.sources.bvh import BvhRecording, load_joint_map
@@ -385,6 +410,23 @@ def main(argv: list[str] | None = None) -> int:
     bench.add_argument("--workers", type=typed.integer(1, 256), default=2,
                        help="dev suite: runs in parallel (processes)")
     bench.set_defaults(func=_bench)
+    batch = sub.add_parser("batch", help="run every clip of a folder, glob or list through the pipeline (Ray)")
+    batch.add_argument("input", help="folder (recursive), glob pattern, list file (.list/.lst) or clip file")
+    batch.add_argument("--out", type=typed.out_dir, default="out/batch", help="output folder")
+    batch.add_argument("--seeds", type=typed.integer(1, 1000), default=1, help="sensor seeds 0 .. N-1 per clip")
+    batch.add_argument("--sensor", default="kinect", choices=("kinect", "none"),
+                       help="16 Hz Kinect-like sensor model, or the frames as recorded")
+    batch.add_argument("--duration", type=typed.duration_s, help="cap on each run's simulated seconds")
+    batch.add_argument("--no-lipm", action="store_true", help="switch the LIPM time-sync compensation off")
+    batch.add_argument("--no-bvh", action="store_true", help="do not export each run's motion as BVH")
+    batch.add_argument("--mp4", action="store_true", help="also render each run to MP4 (slow)")
+    batch.add_argument("--executor", choices=("ray", "processes", "inline"),
+                       help="ray (default when installed), processes (a local pool) or inline")
+    batch.add_argument("--workers", type=typed.integer(1, 4096), help="parallel runs (default: one per core)")
+    batch.add_argument("--ray-address", help="join a Ray cluster (HOST:PORT or 'auto') instead of a local Ray")
+    batch.add_argument("--max-retries", type=typed.integer(0, 100), default=2,
+                       help="times a job whose worker or node died is submitted again")
+    batch.set_defaults(func=_batch)
     inspect = sub.add_parser("inspect", help="show how a BVH file is understood: joint map, units, axes, frames")
     inspect.add_argument("file", type=typed.in_file, help="BVH file")
     inspect.add_argument("--joint-map", type=typed.in_file,

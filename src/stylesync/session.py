@@ -130,6 +130,7 @@ class Session:
                  on_tick: Callable[[CharacterState, object], None] | None = None):
         self.cfg = config
         self.source = source
+        self._owns_backend = backend is None
         self.backend = backend or make_backend(config.world, config.clocks.physics_hz, gui=config.gui)
         self.mass = self.backend.mass_properties()
         self.processing = OperatorProcessing(config.clocks, config.filters)
@@ -161,6 +162,13 @@ class Session:
         self.prefetch_operator = True
         self.closed = False
         self.fell = False  # the run has recorded a fall (viewers show it)
+
+    def release_engine(self) -> None:
+        """Disconnect the physics engine this session made (each holds tens of MB in the engine): after a run
+        and whatever is read from its state. A process that runs many sessions (bench, batch) calls it."""
+        if self._owns_backend:
+            self.backend.close()
+            self._owns_backend = False
 
     def reset_character(self) -> None:
         """Stand the character up again where the operator now stands (an interactive reset; it is not a force

@@ -80,9 +80,15 @@ def _run(spec: str, name: str, duration_s: float, seed: int) -> dict:
                         clocks=dataclasses.replace(SessionConfig().clocks, mocap_hz=opened.mocap_hz),
                         operator=OperatorConfig())
     try:
-        result = Session(cfg, opened.source).run()
+        session = Session(cfg, opened.source)
+    except BaseException:
+        opened.source.close()
+        raise
+    try:
+        result = session.run()
     finally:
         opened.source.close()
+        session.release_engine()
     m = summarize(result)
     uhc = m.get("uhc_fall_time_s")
     fall_t = min(x for x in (m["fall_time_s"], uhc) if x is not None) if (m["fell"] or uhc is not None) else None

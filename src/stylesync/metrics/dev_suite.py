@@ -80,9 +80,15 @@ def run_clip(spec: str, seed: int, duration_s: float, controller: str) -> dict:
     cfg = SessionConfig(duration_s=length, seed=seed, operator=op, control=control, motion=motion,
                         clocks=dataclasses.replace(SessionConfig().clocks, mocap_hz=opened.mocap_hz))
     try:
-        result = Session(cfg, opened.source).run()
+        session = Session(cfg, opened.source)
+    except BaseException:
+        opened.source.close()
+        raise
+    try:
+        result = session.run()
     finally:
         opened.source.close()
+        session.release_engine()
     m = summarize(result)
     keys = ("fell", "fall_time_s", "sim_duration_s", "operator_steps", "character_steps",
             "state_transition_delay_s", "mpjpe_global_mm", "mpjpe_root_mm", "uhc_fall_time_s", "realtime_factor")
