@@ -66,7 +66,7 @@ def test_browser_sees_the_character_move_and_pushes_it(tmp_path):
             assert time.monotonic() < deadline, "the viewer address was not printed"
         else:
             pytest.fail("the run ended before printing the viewer address")
-        assert url == f"http://127.0.0.1:{port}"
+        assert re.fullmatch(rf"http://127\.0\.0\.1:{port}/\?token=[A-Za-z0-9_-]{{22}}", url)
         with playwright.sync_playwright() as p:
             browser = p.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox", "--use-gl=swiftshader",
                                                                         "--enable-unsafe-swiftshader"])
@@ -130,3 +130,93 @@ def test_viewer_process_ends_with_its_session(tmp_path, kill):
     while _port_open(port) and time.monotonic() < deadline:
         time.sleep(0.2)
     assert not _port_open(port), "the viewer process outlived its session"
+
+
+def _viewer_in_process():
+    pytest.importorskip("viser", reason="needs viser (pip install -e '.[viewer]')")
+    from stylesync.export.replay import _rest_pose
+    from stylesync.viewer.web_viewer import WebViewer
+
+    _, shapes = _rest_pose()
+    viewer = WebViewer(shapes, "127.0.0.1", free_port())
+    deadline = time.monotonic() + 20
+    while not _port_open(viewer.port) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    return viewer
+
+
+def test_the_viewer_needs_its_token_and_its_own_origin():
+    import urllib.error
+    import urllib.request
+
+    from websockets.exceptions import InvalidStatus
+    from websockets.sync.client import connect
+
+    viewer = _viewer_in_process()
+    base = f"127.0.0.1:{viewer.port}"
+    try:
+        def get(path, headers=None):
+            try:
+                with urllib.request.urlopen(urllib.request.Request(f"http://{base}{path}", headers=headers or {}),
+                                            timeout=10) as r:
+                    return r.status, r.headers.get("Set-Cookie", "")
+            except urllib.error.HTTPError as exc:
+                return exc.code, ""
+
+        assert get("/")[0] == 403 and get("/?token=wrong")[0] == 403
+        status, cookie = get(f"/?token={viewer.token}")
+        assert status == 200 and "HttpOnly" in cookie and "SameSite=Strict" in cookie
+        jar = cookie.split(";")[0]
+        assert get("/", {"Cookie": jar})[0] == 200  # the page's own requests carry the cookie
+
+        def handshake(headers):
+            try:
+                with connect(f"ws://{base}/", additional_headers=headers, subprotocols=["viser-v1"],
+                             open_timeout=10):
+                    return 101
+            except InvalidStatus as exc:
+                return exc.response.status_code
+
+        assert handshake({"Origin": f"http://{base}"}) == 403  # no token
+        assert handshake({"Origin": "http://evil.example", "Cookie": jar}) == 403  # another site's page
+        assert handshake({"Origin": f"http://{base}", "Cookie": jar}) == 101
+    finally:
+        viewer.close()
+
+
+@pytest.mark.skipif(CHROMIUM is None, reason="needs headless Chromium (Debian package 'chromium')")
+def test_a_page_of_another_origin_cannot_open_the_viewer_socket():
+    playwright = pytest.importorskip("playwright.sync_api", reason="needs playwright (pip install playwright)")
+    import http.server
+    import threading
+
+    viewer = _viewer_in_process()
+
+    class Page(http.server.BaseHTTPRequestHandler):
+        def do_GET(self):
+            body = (f"<script>const ws = new WebSocket('ws://127.0.0.1:{viewer.port}/', ['viser-v1']);"
+                    "ws.onopen = () => document.title = 'opened'; ws.onerror = () => document.title = 'refused';"
+                    "</script>").encode()
+            self.send_response(200)
+            self.send_header("Content-Type", "text/html")
+            self.send_header("Content-Length", str(len(body)))
+            self.end_headers()
+            self.wfile.write(body)
+
+        def log_message(self, *args):
+            pass
+
+    other = http.server.HTTPServer(("127.0.0.1", free_port()), Page)
+    threading.Thread(target=other.serve_forever, daemon=True).start()
+    try:
+        with playwright.sync_playwright() as p:
+            browser = p.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
+            page = browser.new_page()
+            page.goto(viewer.url)  # the user has the viewer open (its cookie is set) ...
+            page.goto(f"http://127.0.0.1:{other.server_address[1]}/")  # ... and visits another site
+            page.wait_for_function("document.title !== ''", timeout=10000)
+            assert page.title() == "refused"
+            browser.close()
+    finally:
+        other.shutdown()
+        viewer.close()

@@ -29,13 +29,13 @@ PARENT_CHECK_S = 1.0  # how often an idle viewer process checks that the session
 
 
 def _serve(shapes: list[LinkShape], host: str, port: int, draw_hz: float, interactive: bool,
-           snapshots: mp.Queue, actions: mp.Queue, ready: Any, parent_pid: int) -> None:
+           snapshots: mp.Queue, actions: mp.Queue, ready: Any, parent_pid: int, token: str) -> None:
     from stylesync.viewer.web_viewer import WebViewer
 
     # The viewer yields to the control loop when they compete for a core: a late frame is harmless, a late
     # control tick is not.
     os.nice(VIEWER_NICENESS)
-    viewer = WebViewer(shapes, host, port, draw_hz, on_action=actions.put if interactive else None)
+    viewer = WebViewer(shapes, host, port, draw_hz, on_action=actions.put if interactive else None, token=token)
     ready.set()
     try:
         while True:
@@ -56,24 +56,41 @@ def _serve(shapes: list[LinkShape], host: str, port: int, draw_hz: float, intera
         viewer.close()
 
 
+def ipaddress_is_loopback(host: str) -> bool:
+    """Whether a listening address is this machine's own (127.0.0.0/8, ::1, localhost)."""
+    import ipaddress
+
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False
+
+
 class ViewerProcess:
     """``publish(snapshot)`` from the loop; ``on_action`` (called in a thread of this process) gets the actions."""
 
     def __init__(self, shapes: list[LinkShape], host: str = "127.0.0.1", port: int | None = None,
                  draw_hz: float = 20.0, on_action: Callable[[str], None] | None = None):
+        from stylesync.viewer.access import new_token
         from stylesync.viewer.web_viewer import free_port, import_viser
 
         import_viser()  # fail here, with the install hint, rather than in the child
 
         ctx = mp.get_context("spawn")
         self.port = port if port else free_port(host)
-        self.url = f"http://{host}:{self.port}"
+        token = new_token()
+        self.url = f"http://{host}:{self.port}/?token={token}"
+        if not ipaddress_is_loopback(host):
+            log.warning("the web viewer listens on %s: anyone on that network who has its address (with the token) "
+                        "can watch and control the run", host)
         self._snapshots: mp.Queue = ctx.Queue(maxsize=2)
         self._actions: mp.Queue = ctx.Queue()
         ready = ctx.Event()
         self._proc = ctx.Process(target=_serve, name="stylesync-viewer", daemon=True,
                                  args=(shapes, host, self.port, draw_hz, on_action is not None, self._snapshots,
-                                       self._actions, ready, os.getpid()))
+                                       self._actions, ready, os.getpid(), token))
         self._proc.start()
         if not ready.wait(START_TIMEOUT_S) or not self._proc.is_alive():
             self._proc.terminate()

@@ -23,6 +23,7 @@ from stylesync import rotations as rot
 from stylesync.errors import ConfigError
 from stylesync.model.state import LinkShape
 from stylesync.motion.stance_fsm import Stance
+from stylesync.viewer import access
 from stylesync.viewer.snapshot import (
     OPERATOR_BONES,
     Snapshot,
@@ -93,11 +94,13 @@ class WebViewer:
     (process.py)."""
 
     def __init__(self, shapes: list[LinkShape], host: str = "127.0.0.1", port: int | None = None,
-                 draw_hz: float = 20.0, on_action: Callable[[str], None] | None = None):
+                 draw_hz: float = 20.0, on_action: Callable[[str], None] | None = None, token: str | None = None):
         viser, uplot = import_viser()
         self.port = port if port else free_port(host)
         self.host = host
-        self.url = f"http://{host}:{self.port}"
+        self.token = token if token is not None else access.new_token()
+        self.url = f"http://{host}:{self.port}/?token={self.token}"
+        access.install(self.token)  # the page and its websocket need the token, from the page's own origin
         self.server = viser.ViserServer(host=host, port=self.port, verbose=False)
         self.shapes = shapes
         self.draw_hz = draw_hz
