@@ -186,3 +186,38 @@ def test_a_run_in_a_used_folder_leaves_no_output_of_the_earlier_run(tmp_path):
     _clear_outputs(out, out / "session.jsonl")
     assert not (out / "metrics.json").exists() and not (out / "report.html").exists()
     assert not (out / "session.jsonl").exists() and (out / "stale.txt").exists()  # only our outputs are removed
+
+
+@pytest.mark.parametrize("paced", [False, True], ids=["unpaced", "paced"])
+def test_a_run_killed_at_a_random_moment_leaves_only_its_own_readable_outputs(tmp_path, paced):
+    import os
+    import random
+    import signal
+    import subprocess
+    import sys
+
+    from stylesync.errors import SourceError
+    from stylesync.export.session_file import read_session
+
+    rng = random.Random(1 if paced else 0)
+    for trial in range(4):
+        out = tmp_path / f"run{trial}"
+        out.mkdir()
+        (out / "metrics.json").write_text('{"from": "an earlier run"}')
+        (out / "report.html").write_text("an earlier run")
+        cmd = [sys.executable, "-m", "stylesync.cli", "demo", "--duration", "3", "--out", str(out)]
+        proc = subprocess.Popen(cmd + (["--realtime"] if paced else []), stdout=subprocess.DEVNULL,
+                                stderr=subprocess.DEVNULL)
+        time.sleep(rng.uniform(0.5, 4.0))
+        os.kill(proc.pid, signal.SIGKILL)
+        proc.wait(timeout=30)
+        if (out / "session.jsonl").exists():
+            try:
+                session = read_session(out / "session.jsonl")
+                assert session.bad_line is None or "not JSON" in session.bad_line  # at most a cut last line
+            except SourceError as exc:
+                assert "is empty" in str(exc)  # killed before the header was written
+        if (out / "metrics.json").exists():
+            metrics = json.loads((out / "metrics.json").read_text())
+            assert metrics.get("from") != "an earlier run" and metrics["session_file"] == str(out / "session.jsonl")
+        assert not (out / "report.html").exists() or "an earlier run" not in (out / "report.html").read_text()

@@ -365,7 +365,8 @@ def _inspect(args: argparse.Namespace) -> int:
     return 0
 
 
-def main(argv: list[str] | None = None) -> int:
+def build_parser() -> argparse.ArgumentParser:
+    """The command line's parser: every value typed and range-checked (cli_args.py)."""
     parser = typed.OneLineParser(prog="stylesync", description="Style-preserving humanoid teleoperation")
     sub = parser.add_subparsers(dest="command", required=True)
     demo = sub.add_parser("demo", help="run the built-in operator through the whole pipeline, headless")
@@ -439,7 +440,11 @@ def main(argv: list[str] | None = None) -> int:
     replay.add_argument("--speed", type=typed.speed, default=1.0, help="viewer playback speed (1 = real time)")
     _add_export_args(replay)
     replay.set_defaults(func=_replay)
-    args = parser.parse_args(argv)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     if threading.current_thread() is threading.main_thread():
         # A termination request (kill, a supervisor stopping the run) ends the run as Ctrl-C does: the session
