@@ -220,3 +220,25 @@ def test_a_page_of_another_origin_cannot_open_the_viewer_socket():
     finally:
         other.shutdown()
         viewer.close()
+
+
+def test_the_floor_follows_the_character_and_a_fall_ends_the_bound_warnings():
+    import dataclasses
+
+    viewer = _viewer_in_process()
+    try:
+        snap = _snap({"left": True, "right": True})
+        snap = dataclasses.replace(snap, com_world=np.array([0.3, 0.1, 0.8]), bounds_active={"lipm_force": True})
+        viewer._draw(snap)
+        viewer._texts(snap)
+        assert "movement bounds" in viewer._warning.content
+        assert tuple(viewer._ground.position) == (0.0, 0.0, 0.0)
+        far = dataclasses.replace(snap, com_world=np.array([31.26, -7.1, 0.8]))  # 30 s of walking away
+        viewer._draw(far)
+        assert np.allclose(viewer._ground.position, (31.5, -7.0, 0.0))  # under it, on whole cells
+        fallen = dataclasses.replace(far, fell=True)
+        viewer._draw(fallen)
+        viewer._texts(fallen)
+        assert "fell" in viewer._warning.content and "bounds" not in viewer._warning.content
+    finally:
+        viewer.close()

@@ -88,6 +88,10 @@ def import_viser():
     return viser, uplot
 
 
+GROUND_SIZE_M = 20.0  # side of the floor grid [m]
+GROUND_CELL_M = 0.5  # its cell [m]
+
+
 class WebViewer:
     """``publish`` a snapshot; ``close`` when done. ``on_action`` receives the controls' actions by name ("reset",
     "push", "pause", "resume"); ``None`` makes the viewer read-only (replay). Runs in the viewer's own process
@@ -124,7 +128,9 @@ class WebViewer:
         sc.set_up_direction("+z")
         # Without a GPU the browser renders WebGL in software; a shadow map is a second render pass per frame.
         sc.configure_default_lights(enabled=True, cast_shadow=False)
-        sc.add_grid("/ground", width=20.0, height=20.0, cell_size=0.5, position=(0.0, 0.0, 0.0))
+        self._ground = sc.add_grid("/ground", width=GROUND_SIZE_M, height=GROUND_SIZE_M, cell_size=GROUND_CELL_M,
+                                   position=(0.0, 0.0, 0.0))
+        self._ground_at = np.zeros(2)
         # The whole body is one mesh whose vertices are re-posed each frame: one message per frame instead of two
         # per shape (the per-shape handles cost the loop measurably more).
         parts = [_shape_mesh(sh) for sh in self.shapes]
@@ -223,6 +229,7 @@ class WebViewer:
                     segs.append(_ring_segments(centre + radius * _CIRCLE[:-1], 0.004))
                 exceeded |= snap.bounds_active.get(kind, False)
             exceeded |= snap.bounds_active.get("lipm_force", False)
+            exceeded &= not snap.fell  # after a fall the operator's bounds say nothing of the character
             self._bounds.visible = show["bounds"] and bool(segs)
             if segs:
                 pts = np.concatenate(segs)
@@ -240,6 +247,7 @@ class WebViewer:
             self._stance_label.visible = show["stance"]
             self._stance_label.position = (com[0], com[1], 1.9)
             self._draw_balls(snap)
+            self._follow_ground(com)
         now = time.perf_counter()
         if now - self._last_text >= TEXT_EVERY_S:
             self._last_text = now
@@ -251,12 +259,22 @@ class WebViewer:
             for client in self.server.get_clients().values():
                 _aim(client, com)
 
+    def _follow_ground(self, com: np.ndarray) -> None:
+        """The floor grid moves under the character in whole cells (its lines stay put on the ground) once the
+        character is more than a quarter of the grid from its centre: the floor never ends under a long walk."""
+        at = np.round(np.asarray(com[:2]) / GROUND_CELL_M) * GROUND_CELL_M
+        if float(np.abs(at - self._ground_at).max()) > GROUND_SIZE_M / 4:
+            self._ground_at = at
+            self._ground.position = (float(at[0]), float(at[1]), 0.0)
+
     def _texts(self, snap: Snapshot) -> None:
         status = (f"**t = {snap.time_s:.2f} s** · character {_STANCE_TEXT[snap.character_stance]} · "
                   f"operator {snap.operator_stance.name} · balls thrown: {len(snap.balls_world)}"
                   + (" · **fallen**" if snap.fell else ""))
         active = [k for k, v in snap.bounds_active.items() if v]
         warning = "⚠️ **operator exceeds the movement bounds: " + ", ".join(active) + "**" if active else ""
+        if snap.fell:
+            warning = "**the character fell** (Reset character stands it up)"
         if status != self._status.content:
             self._status.content = status
         if warning != self._warning.content:
