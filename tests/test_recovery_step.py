@@ -317,3 +317,17 @@ def test_a_rear_foot_on_its_toes_is_read_as_still_standing():
     assert Stance.LS in out[None][0]  # ankle heights alone: he stands on his left (front) foot
     assert set(out[0.02][0]) == {Stance.DS}
     assert out[0.02][1] > out[None][1] + 0.2
+
+
+@pytest.mark.skipif(not (MOCAP / "cmu" / "02_01.bvh").exists(),
+                    reason="../shared/mocap/cmu/02_01.bvh is not available")
+def test_a_recovery_step_that_must_land_lowers_the_body_until_its_foot_reaches_the_ground():
+    """CMU 02_01, seed 2, in the rest after the clip: the first recovery step's landing is near the leg's full
+    reach (0.43 m ahead of the stance ankle); with the pelvis at the operator's height the foot hovered 5-10 cm
+    above the ground for 0.3 s after its nominal swing while the body ran on, and the character fell at 4.65 s.
+    With the pelvis lowered as far as the landing needs (from where the hip is), it comes to rest."""
+    spec = f"bvh:{MOCAP / 'cmu' / '02_01.bvh'}"
+    reach, _ = _run(spec, 5.85, MotionConfig(), seed=2)
+    hover, _ = _run(spec, 5.85, MotionConfig(recovery_landing_reach=False), seed=2)
+    assert not reach.fell
+    assert hover.fell and hover.fall_time_s is not None and hover.fall_time_s > 2.85  # in the rest

@@ -168,6 +168,10 @@ class MotionConfig:
     # During a recovery step the COM task holds the character's own COM state (no pull towards the operator's
     # stance): the body moves as the landing's capture-point prediction assumes
     recovery_step_free_com: bool = True
+    # When a recovery step's foot is due to go down, the pelvis is lowered as far as the leg needs to reach its
+    # landing from where the hip is (a landing at the leg's full reach otherwise hovers above the ground while the
+    # body runs on)
+    recovery_landing_reach: bool = True
 
     def __post_init__(self) -> None:
         lo, hi = self.step_outside_capture_point_m

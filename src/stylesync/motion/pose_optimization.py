@@ -425,10 +425,16 @@ class MotionOptimizer:
         # for a late contact) must be within the leg's reach of its hip: the pelvis is lowered as far as that
         # needs. With the pelvis at the operator's height (Eq. 9) the legs are nearly straight, and a foot ahead
         # of the body could otherwise never land.
+        landing_step = (self.cfg.recovery_landing_reach and self.char_fsm.recovery_step
+                        and self.recovery.landing_due(state.time_s))
         for side, sign in (("left", 1.0), ("right", -1.0)):
-            must_land = tick.weights[side] > 0 or (side == sw and self.char_fsm.hold_reference)
+            must_land = tick.weights[side] > 0 or (side == sw and (self.char_fsm.hold_reference or landing_step))
             if must_land and not tick.contact[side]:
                 hip_xy = (tick.pelvis_d + tick.R_root_d @ np.array([0.0, sign * HIP_HALF_WIDTH_M, 0.0]))[:2]
+                if side == sw and landing_step:
+                    # The character's own step: from where its hip is (the operator's pelvis target may be
+                    # anywhere behind a body that carries momentum he does not have).
+                    hip_xy = state.link_origin_world[_LINK[f"{side}_hip"]][:2]
                 reach = LANDING_REACH * CHAR_LEG_LENGTH_M
                 d2 = float(np.sum((tick.targets[side][:2] - hip_xy) ** 2))
                 tick.pelvis_d[2] = min(tick.pelvis_d[2],

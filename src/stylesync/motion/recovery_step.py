@@ -182,6 +182,10 @@ class RecoveryStepper:
         self.count += 1
         return self.step
 
+    def landing_due(self, time_s: float) -> bool:
+        """Whether the step's foot is past its horizontal travel and should now be going down to the ground."""
+        return self.step is not None and time_s - self.step.start_s >= HORIZONTAL_SHARE * self.cfg.recovery_swing_s
+
     def end(self, time_s: float) -> None:
         """The step is over (the stance FSM saw the foot land, or the operator took over)."""
         if self.step is not None:
