@@ -230,7 +230,7 @@ def _bench(args: argparse.Namespace) -> int:
             raise StylesyncError(f"unknown categories {', '.join(unknown)}; expected some of {', '.join(ORDER)}")
         mocap = shared / "mocap"
         report = run_dev_suite(Path(args.out), args.seeds, args.duration, mocap if mocap.is_dir() else None, only,
-                               workers=args.workers)
+                               workers=args.workers, executor=args.executor)
     else:
         report = run_bench(Path(args.out), args.duration, args.seed, shared if shared.is_dir() else None)
     print(report["table"])
@@ -409,7 +409,9 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--seeds", type=typed.integer(1, 1000), default=2, help="dev suite: sensor seeds 0 .. N-1")
     bench.add_argument("--only", help="dev suite: comma-separated categories (default: all)")
     bench.add_argument("--workers", type=typed.integer(1, 256), default=2,
-                       help="dev suite: runs in parallel (processes)")
+                       help="dev suite: runs in parallel")
+    bench.add_argument("--executor", choices=("processes", "ray", "inline"),
+                       help="dev suite: where the runs go (stylesync batch's executors; default processes)")
     bench.set_defaults(func=_bench)
     batch = sub.add_parser("batch", help="run every clip of a folder, glob or list through the pipeline (Ray)")
     batch.add_argument("input", help="folder (recursive), glob pattern, list file (.list/.lst) or clip file")

@@ -99,38 +99,37 @@ def read_result(out: Path, job: Job) -> dict | None:
     return result if isinstance(result, dict) and result.get("key") == job.key else None
 
 
-def _inline(jobs: list[Job], settings: BatchSettings) -> Iterator[tuple[Job, dict | None, str]]:
-    for job in jobs:
-        yield job, run_job(job, settings), ""
+def _inline(fn: Callable, items: list[tuple]) -> Iterator[tuple[int, object, str]]:
+    for k, args in enumerate(items):
+        yield k, fn(*args), ""
 
 
-def _processes(jobs: list[Job], settings: BatchSettings, workers: int, max_retries: int
-               ) -> Iterator[tuple[Job, dict | None, str]]:
-    """A local process pool; a pool broken by a dying worker is replaced and its jobs submitted again."""
-    attempts = {job.key: 0 for job in jobs}
-    queue = list(jobs)
+def _processes(fn: Callable, items: list[tuple], workers: int, max_retries: int) -> Iterator[tuple[int, object, str]]:
+    """A local process pool; a pool broken by a dying worker is replaced and its items submitted again."""
+    attempts = [0] * len(items)
+    queue = list(range(len(items)))
     while queue:
         with ProcessPoolExecutor(max_workers=workers) as pool:
-            futures: dict[Future, Job] = {pool.submit(run_job, job, settings): job for job in queue}
+            futures: dict[Future, int] = {pool.submit(fn, *items[k]): k for k in queue}
             queue = []
             while futures:
                 finished, _ = wait(list(futures), return_when=FIRST_COMPLETED)
                 for fut in finished:
-                    job = futures.pop(fut)
+                    k = futures.pop(fut)
                     try:
-                        yield job, fut.result(), ""
+                        yield k, fut.result(), ""
                     except BrokenProcessPool as exc:
-                        attempts[job.key] += 1
-                        if attempts[job.key] > max_retries:
-                            yield job, None, f"worker lost {attempts[job.key]} times: {exc}"
+                        attempts[k] += 1
+                        if attempts[k] > max_retries:
+                            yield k, None, f"worker lost {attempts[k]} times: {exc}"
                         else:
-                            yield job, None, "retry"
-                            queue.append(job)
+                            yield k, None, "retry"
+                            queue.append(k)
 
 
-def _ray(jobs: list[Job], settings: BatchSettings, workers: int, address: str | None, max_retries: int
-         ) -> Iterator[tuple[Job, dict | None, str]]:
-    """Ray tasks, one per job; a task whose worker or node dies is submitted again (bounded)."""
+def _ray(fn: Callable, items: list[tuple], workers: int, address: str | None, max_retries: int
+         ) -> Iterator[tuple[int, object, str]]:
+    """Ray tasks, one per item; a task whose worker or node dies is submitted again (bounded)."""
     try:
         import ray
     except ImportError:
@@ -143,34 +142,65 @@ def _ray(jobs: list[Job], settings: BatchSettings, workers: int, address: str | 
             ray.init(address=address, **kwargs)
         else:
             ray.init(num_cpus=workers, **kwargs)
-    task = ray.remote(num_cpus=1, max_retries=0)(run_job)
-    settings_ref = ray.put(settings)
-    pending = {task.remote(job, settings_ref): job for job in jobs}
-    attempts = {job.key: 0 for job in jobs}
+    task = ray.remote(num_cpus=1, max_retries=0)(fn)
+    shared: dict[int, object] = {}  # large arguments shared by many items go to the object store once
+
+    def put(args: tuple) -> tuple:
+        out = []
+        for a in args:
+            if isinstance(a, BatchSettings):
+                if id(a) not in shared:
+                    shared[id(a)] = ray.put(a)
+                out.append(shared[id(a)])
+            else:
+                out.append(a)
+        return tuple(out)
+
+    pending = {task.remote(*put(args)): k for k, args in enumerate(items)}
+    attempts = [0] * len(items)
     try:
         while pending:
             ready, _ = ray.wait(list(pending), num_returns=1, timeout=1.0)
             for ref in ready:
-                job = pending.pop(ref)
+                k = pending.pop(ref)
                 try:
                     result = ray.get(ref)
-                except ray.exceptions.RayTaskError as exc:  # run_job returns errors; this is a bug
-                    yield job, None, f"task error: {str(exc).splitlines()[0]}"
+                except ray.exceptions.RayTaskError as exc:  # the function raised: its result is the error
+                    yield k, None, f"task error: {str(exc).splitlines()[0]}"
                     continue
                 except ray.exceptions.RayError as exc:  # the worker or its node died
-                    attempts[job.key] += 1
-                    if attempts[job.key] > max_retries:
-                        yield job, None, f"worker lost {attempts[job.key]} times: {type(exc).__name__}"
+                    attempts[k] += 1
+                    if attempts[k] > max_retries:
+                        yield k, None, f"worker lost {attempts[k]} times: {type(exc).__name__}"
                     else:
-                        yield job, None, "retry"
-                        pending[task.remote(job, settings_ref)] = job
+                        yield k, None, "retry"
+                        pending[task.remote(*put(items[k]))] = k
                     continue
-                yield job, result, ""
+                yield k, result, ""
     finally:
         for ref in pending:
             ray.cancel(ref, force=True)
         if started_here:
             ray.shutdown()
+
+
+def execute(fn: Callable, items: list[tuple], executor: str = "processes", workers: int | None = None,
+            ray_address: str | None = None, max_retries: int = 2) -> Iterator[tuple[int, object, str]]:
+    """``fn(*item)`` for every item on the executor, yielded as each ends (in any order): (the item's index, its
+    result or None, a note: "" done, "retry" its worker died and it was submitted again, else why it has no
+    result). ``fn`` must be importable by name (a module's function) for the processes and Ray."""
+    if executor not in EXECUTORS:
+        raise StylesyncError(f"unknown executor '{executor}' (one of {', '.join(EXECUTORS)})")
+    workers = workers or os.cpu_count() or 1
+    if executor == "inline":
+        return _inline(fn, items)
+    if executor == "processes":
+        return _processes(fn, items, workers, max_retries)
+    return _ray(fn, items, workers, ray_address, max_retries)
+
+
+def _call_run_job(job: Job, settings: BatchSettings) -> dict:
+    return run_job(job, settings)
 
 
 def run_batch(jobs: list[Job], settings: BatchSettings, out: Path, executor: str = "ray", workers: int | None = None,
@@ -180,7 +210,6 @@ def run_batch(jobs: list[Job], settings: BatchSettings, out: Path, executor: str
     if executor not in EXECUTORS:
         raise StylesyncError(f"unknown executor '{executor}' (one of {', '.join(EXECUTORS)})")
     out.mkdir(parents=True, exist_ok=True)
-    workers = workers or os.cpu_count() or 1
     counts = BatchCounts(total=len(jobs))
     todo = []
     for job in jobs:
@@ -188,19 +217,18 @@ def run_batch(jobs: list[Job], settings: BatchSettings, out: Path, executor: str
             counts.skipped += 1
         else:
             todo.append(job)
-    if executor == "inline":
-        stream = _inline(todo, settings)
-    elif executor == "processes":
-        stream = _processes(todo, settings, workers, max_retries)
-    else:
-        stream = _ray(todo, settings, workers, ray_address, max_retries)
+    # run_job looked up when the batch runs (tests count the calls by replacing it)
+    stream = execute(run_job if executor != "inline" else _call_run_job, [(job, settings) for job in todo],
+                     executor, workers, ray_address, max_retries)
     try:
-        for job, result, note in stream:
+        for k, returned, note in stream:
+            job = todo[k]
             if note == "retry":
                 counts.retried += 1
                 log.warning("batch: %s: its worker was lost; submitted again", job.name)
             else:
-                if result is None:
+                result: dict = returned if isinstance(returned, dict) else {}
+                if not result:
                     result = {"key": job.key, "name": job.name, "clip": str(job.clip), "seed": job.seed,
                               "group": job.group, "status": "failed", "error": note}
                 write_result(out, result)

@@ -18,7 +18,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import logging
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -142,17 +141,25 @@ def table(rows: list[dict], versions: list[str]) -> str:
 
 
 def run_dev_suite(out: Path, seeds: int, duration_s: float, mocap: Path | None, only: tuple[str, ...] = (),
-                  controllers: tuple[str, ...] = SUITE_CONTROLLERS, workers: int = 2) -> dict:
-    """Run the suite; writes dev_suite.md and dev_suite.json under ``out`` and returns {"rows", "table"}."""
+                  controllers: tuple[str, ...] = SUITE_CONTROLLERS, workers: int = 2,
+                  executor: str | None = None) -> dict:
+    """Run the suite on the batch runner's executors (batch/runner.py: "processes" by default, "ray", or "inline"
+    when ``workers`` is 1); writes dev_suite.md and dev_suite.json under ``out`` and returns {"rows", "table"}."""
+    from stylesync.batch.runner import execute
+
     out.mkdir(parents=True, exist_ok=True)
     clips = [c for c in clip_specs(mocap) if not only or c[2] in only]
     jobs = [(spec, name, cat, seed, ctrl, duration_s) for spec, name, cat in clips for seed in range(seeds)
             for ctrl in controllers]
-    if workers > 1:
-        with ProcessPoolExecutor(max_workers=workers) as pool:
-            rows = list(pool.map(_job, jobs))
-    else:
-        rows = [_job(j) for j in jobs]
+    executor = executor or ("processes" if workers > 1 else "inline")
+    found: dict[int, dict] = {}
+    for k, row, note in execute(_job, [(j,) for j in jobs], executor, workers):
+        if note == "retry":
+            continue
+        spec, name, cat, seed, ctrl, _ = jobs[k]
+        found[k] = row if isinstance(row, dict) else {"clip": name, "spec": spec, "category": cat, "seed": seed,
+                                                      "version": ctrl, "error": note}
+    rows = [found[k] for k in sorted(found)]
     md = table(rows, list(controllers))
     (out / "dev_suite.json").write_text(json.dumps(rows, indent=1))
     (out / "dev_suite.md").write_text(md + "\n")
