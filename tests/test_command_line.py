@@ -49,3 +49,28 @@ def test_an_export_into_a_missing_folder_creates_it(tmp_path, capsys):
     bvh = tmp_path / "new" / "deeper" / "walk.bvh"
     assert cli_main(["demo", "--duration", "0.2", "--out", str(tmp_path / "out"), "--export-bvh", str(bvh)]) == 0
     assert bvh.is_file() and bvh.read_text().startswith("HIERARCHY")
+
+
+def test_a_recording_asked_to_run_past_its_end_stops_at_its_end_plus_the_rest(tmp_path, capsys):
+    import json
+    from pathlib import Path
+
+    cmu = Path(__file__).resolve().parents[2] / "shared" / "mocap" / "cmu" / "02_01.bvh"
+    if not cmu.exists():
+        pytest.skip("../shared/mocap/cmu/02_01.bvh is not available")
+    out = tmp_path / "o"
+    # 80 000 s asked for: the frames were made for the whole duration up front (a hang); now cut at 2.85 + 3 s
+    assert cli_main(["run", "--source", f"bvh:{cmu}", "--duration", "80000", "--out", str(out)]) == 0
+    assert "ends (with its rest) at 5.85 s" in capsys.readouterr().err
+    assert json.loads((out / "metrics.json").read_text())["sim_duration_s"] == pytest.approx(5.85, abs=0.01)
+
+
+def test_a_run_shorter_than_its_operator_worker_start_prints_nothing_but_its_result(tmp_path):
+    import subprocess
+    import sys
+
+    for k in range(3):
+        proc = subprocess.run([sys.executable, "-m", "stylesync.cli", "demo", "--duration", "1e-6", "--out",
+                               str(tmp_path / f"o{k}")], capture_output=True, text=True, timeout=120)
+        assert proc.returncode == 0
+        assert "Exception ignored" not in proc.stderr and "Traceback" not in proc.stderr, proc.stderr

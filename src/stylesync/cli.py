@@ -173,6 +173,10 @@ def _run(args: argparse.Namespace) -> int:
     if live and args.duration is None:
         raise StylesyncError("a live source needs --duration (seconds to run)")
     duration = args.duration if args.duration is not None else float(opened.duration_s or 0.0)
+    if not live and opened.duration_s is not None and duration > opened.duration_s:
+        print(f"stylesync: the recording ends (with its rest) at {opened.duration_s:.2f} s: the run stops there",
+              file=sys.stderr)
+        duration = float(opened.duration_s)
     cfg = SessionConfig(duration_s=duration, seed=args.seed, gui=args.gui, stream_timeout_s=args.stream_timeout,
                         realtime=args.realtime or live or args.viewer != "none",
                         clocks=dataclasses.replace(clocks, mocap_hz=opened.mocap_hz),

@@ -120,6 +120,7 @@ def _worker(conn: Connection, session_end: Connection, source: OperatorSource, p
     session_end.close()
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the session ends the worker; a terminal's Ctrl-C is its own
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM})  # held by the session while it forked
     rows: list[np.ndarray] = []
     batch = 1  # the first tick at once, so that the run starts without waiting for a whole batch
     try:
@@ -160,7 +161,18 @@ class OperatorPrefetch:
         self._conn, child = ctx.Pipe(duplex=False)
         self._proc = ctx.Process(target=_worker, args=(child, self._conn, source, processing, list(tick_times_s)),
                                  name="stylesync-operator", daemon=True)
-        self._proc.start()
+        # The worker is ended by SIGTERM when the run no longer needs it, possibly while it is still starting; it
+        # must not inherit a handler of the session's (the command line turns SIGTERM into KeyboardInterrupt),
+        # which would print an ignored exception. The signal is held while forking and restored to its default in
+        # the worker (_worker).
+        held = threading.current_thread() is threading.main_thread()
+        if held:
+            signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGTERM})
+        try:
+            self._proc.start()
+        finally:
+            if held:
+                signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM})
         child.close()
         self._rows = np.zeros((0, ROW_WIDTH))
         self._next = 0

@@ -76,7 +76,11 @@ def _recorded(performer, label: str, sensor: str, clocks: ClockConfig, op: Opera
         lead = _LeadIn(performer, 0.0, op.rest_after_clip_s)
     else:
         lead = _LeadIn(performer, op.standing_lead_in_s)
+    # A recording has nothing to give past its end and the rest after it: a longer duration asked for is cut there
+    # (frames are made for the whole run up front).
     total = lead.duration_s if duration_s is None else duration_s
+    if op.start_in_motion:
+        total = min(total, lead.duration_s)
     if sensor == "kinect":
         model = SensorModel.kinect(op, clocks, seed, KINECT_DROPOUT_PROBABILITY)
         frames, rate = model.sample(lead.frame_at, total), clocks.mocap_hz
