@@ -199,12 +199,14 @@ def test_a_run_killed_at_a_random_moment_leaves_only_its_own_readable_outputs(tm
     from stylesync.errors import SourceError
     from stylesync.export.session_file import read_session
 
-    rng = random.Random(1 if paced else 0)
-    for trial in range(4):
+    import shutil
+
+    earlier, _ = _demo_session(tmp_path)  # a complete earlier run in the folder each killed run writes into
+    earlier_id = json.loads((earlier / "metrics.json").read_text())["run_id"]
+    rng = random.Random(1 if paced else 0)  # 10 paced and 10 unpaced trials
+    for trial in range(10):
         out = tmp_path / f"run{trial}"
-        out.mkdir()
-        (out / "metrics.json").write_text('{"from": "an earlier run"}')
-        (out / "report.html").write_text("an earlier run")
+        shutil.copytree(earlier, out)
         cmd = [sys.executable, "-m", "stylesync.cli", "demo", "--duration", "3", "--out", str(out)]
         proc = subprocess.Popen(cmd + (["--realtime"] if paced else []), stdout=subprocess.DEVNULL,
                                 stderr=subprocess.DEVNULL)
@@ -217,7 +219,21 @@ def test_a_run_killed_at_a_random_moment_leaves_only_its_own_readable_outputs(tm
                 assert session.bad_line is None or "not JSON" in session.bad_line  # at most a cut last line
             except SourceError as exc:
                 assert "is empty" in str(exc)  # killed before the header was written
-        if (out / "metrics.json").exists():
+        if (out / "metrics.json").exists():  # the earlier run's, untouched (killed before it started), or its own
             metrics = json.loads((out / "metrics.json").read_text())
-            assert metrics.get("from") != "an earlier run" and metrics["session_file"] == str(out / "session.jsonl")
-        assert not (out / "report.html").exists() or "an earlier run" not in (out / "report.html").read_text()
+            header = json.loads((out / "session.jsonl").read_text().splitlines()[0])
+            assert metrics["run_id"] == header["run_id"]  # the metrics are of this session file's run
+            if metrics["run_id"] != earlier_id:
+                assert metrics["session_file"] == str(out / "session.jsonl")
+        if (out / "report.html").exists():
+            assert "the session file and the metrics are of this run" in (out / "report.html").read_text()
+
+
+def test_the_report_says_whether_the_metrics_are_of_the_folders_run(tmp_path):
+    from stylesync.metrics.report import write_report
+
+    out, _ = _demo_session(tmp_path)
+    assert "the session file and the metrics are of this run" in (out / "report.html").read_text()
+    metrics = json.loads((out / "metrics.json").read_text())
+    (out / "metrics.json").write_text(json.dumps(metrics | {"run_id": "0123456789abcdef"}))
+    assert "the metrics are not of the run" in write_report(out).read_text()

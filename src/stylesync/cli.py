@@ -6,6 +6,7 @@ import argparse
 import dataclasses
 import json
 import logging
+import secrets
 import signal
 import sys
 import threading
@@ -51,8 +52,9 @@ def _run_session(cfg: SessionConfig, source, out: Path, extra: dict, args: argpa
     record = Path(args.record) if args.record else out / "session.jsonl"
     _clear_outputs(out, record)
     session = Session(cfg, source)
+    run_id = secrets.token_hex(8)  # in the session file's header, metrics.json and the report
     # A run as fast as possible writes its session file when it ends (session_file.py): not in the control loop.
-    recorder = SessionRecorder(record, cfg, session, deferred=not cfg.realtime)
+    recorder = SessionRecorder(record, cfg, session, deferred=not cfg.realtime, run_id=run_id)
     session.on_tick = recorder.tick
     viewer = None
     if args.viewer != "none":
@@ -67,7 +69,7 @@ def _run_session(cfg: SessionConfig, source, out: Path, extra: dict, args: argpa
     metrics: dict | None = None
     try:
         result = session.run(progress=progress, render_every_s=max(cfg.duration_s / 8, 0.25))
-        metrics = summarize(result) | extra
+        metrics = summarize(result) | extra | {"run_id": run_id}
     except KeyboardInterrupt:
         session.closed = True
         raise

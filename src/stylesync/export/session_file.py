@@ -60,7 +60,8 @@ class _TickValues(NamedTuple):
 class SessionRecorder:
     """Writes a session file; ``tick`` is the session's ``on_tick`` hook."""
 
-    def __init__(self, path: str | Path, config: Any, session: Any = None, deferred: bool = False):
+    def __init__(self, path: str | Path, config: Any, session: Any = None, deferred: bool = False,
+                 run_id: str | None = None):
         self.path = Path(path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._f: IO[str] = self.path.open("w", encoding="utf-8")
@@ -72,6 +73,8 @@ class SessionRecorder:
                   "config": _config_dict(config),
                   "joints": [j.name for j in JOINTS], "links": list(LINK_NAMES),
                   "operator_joints": list(TRACKED_POSITIONS), "stance_codes": {"LS": 0, "DS": 1, "RS": 2}}
+        if run_id is not None:
+            header["run_id"] = run_id  # also in the run's metrics.json: which outputs belong together
         self._write(header)
         self._f.flush()
 

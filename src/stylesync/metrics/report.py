@@ -36,21 +36,44 @@ def _versions() -> dict[str, str]:
     return out
 
 
-def _config(folder: Path) -> dict | None:
+def _header(folder: Path) -> dict | None:
+    """The folder's session file header (None: no readable one)."""
     session = folder / "session.jsonl"
     if not session.is_file():
         return None
-    with session.open(encoding="utf-8") as f:
+    with session.open(encoding="utf-8", errors="replace") as f:
         first = f.readline()
     try:
-        return json.loads(first).get("config")
+        header = json.loads(first)
     except json.JSONDecodeError:
         return None
+    return header if isinstance(header, dict) else None
+
+
+def _metrics_run_id(folder: Path) -> str | None:
+    try:
+        metrics = json.loads((folder / "metrics.json").read_text())
+    except (OSError, ValueError):
+        return None
+    return metrics.get("run_id") if isinstance(metrics, dict) else None
+
+
+def _config(folder: Path) -> dict | None:
+    header = _header(folder)
+    return header.get("config") if header is not None else None
 
 
 def write_report(folder: str | Path) -> Path:
     folder = Path(folder)
     parts = [f"<h1>stylesync report: {html.escape(folder.name)}</h1>"]
+    header = _header(folder)
+    metrics_id = _metrics_run_id(folder)
+    if header is not None and metrics_id is not None:
+        if header.get("run_id") == metrics_id:
+            parts.append(f"<p>run {html.escape(str(metrics_id))}: the session file and the metrics are of this run</p>")
+        else:
+            parts.append("<p><b>the metrics are not of the run in this folder's session file "
+                         f"({html.escape(str(metrics_id))} against {html.escape(str(header.get('run_id')))})</b></p>")
     for name in ("metrics.json", "bench.json"):
         p = folder / name
         if p.is_file():
