@@ -74,3 +74,20 @@ def test_a_run_shorter_than_its_operator_worker_start_prints_nothing_but_its_res
                                str(tmp_path / f"o{k}")], capture_output=True, text=True, timeout=120)
         assert proc.returncode == 0
         assert "Exception ignored" not in proc.stderr and "Traceback" not in proc.stderr, proc.stderr
+
+
+def test_exit_codes_input_two_running_one_and_debug_keeps_the_traceback(tmp_path, capsys, monkeypatch):
+    from stylesync import cli
+    from stylesync.errors import SimulationError
+
+    assert cli_main(["replay", str(tmp_path / "none.jsonl"), "--export-bvh", str(tmp_path / "x.bvh")]) == 2  # input
+
+    def failing(args):
+        raise SimulationError("the engine refused the character")
+
+    monkeypatch.setattr(cli, "_demo", failing)
+    capsys.readouterr()
+    assert cli_main(["demo", "--out", str(tmp_path / "d")]) == 1  # a failure while running
+    assert capsys.readouterr().err.strip() == "stylesync: error: the engine refused the character"
+    with pytest.raises(SimulationError):
+        cli_main(["--debug", "demo", "--out", str(tmp_path / "d")])

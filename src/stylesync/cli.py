@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 
 from stylesync import cli_args as typed
 from stylesync.config import SHARED_DIR, VIEWER_DRAW_HZ, ClockConfig, ControlConfig, OperatorConfig, SessionConfig
-from stylesync.errors import StylesyncError
+from stylesync.errors import ConfigError, SourceError, StylesyncError
 
 if TYPE_CHECKING:
     from stylesync.export.session_file import SessionFile
@@ -173,7 +173,7 @@ def _run(args: argparse.Namespace) -> int:
     opened = _open(args, clocks, args.duration)
     live = opened.duration_s is None
     if live and args.duration is None:
-        raise StylesyncError("a live source needs --duration (seconds to run)")
+        raise ConfigError("a live source needs --duration (seconds to run)")
     duration = args.duration if args.duration is not None else float(opened.duration_s or 0.0)
     if not live and opened.duration_s is not None and duration > opened.duration_s:
         print(f"stylesync: the recording ends (with its rest) at {opened.duration_s:.2f} s: the run stops there",
@@ -194,7 +194,7 @@ def _export(record: Path | SessionFile, bvh: str | None, mp4: str | None) -> Non
 
     session = read_session(record) if isinstance(record, Path) else record
     if not session.ticks:
-        raise StylesyncError("the session has no ticks to export (the run was cut short before its first one)")
+        raise SourceError("the session has no ticks to export (the run was cut short before its first one)")
     for path in (bvh, mp4):
         if path:
             Path(path).expanduser().absolute().parent.mkdir(parents=True, exist_ok=True)
@@ -213,9 +213,9 @@ def _replay(args: argparse.Namespace) -> int:
     print(json.dumps({"ticks": len(session.ticks), "duration_s": session.ticks[-1]["t"] if session.ticks else 0.0,
                       "fell": (session.metrics or {}).get("fell")}))
     if not (args.export_bvh or args.export_mp4 or args.viewer != "none"):
-        raise StylesyncError("replay: give --viewer web|gui, --export-bvh FILE and/or --export-mp4 FILE")
+        raise ConfigError("replay: give --viewer web|gui, --export-bvh FILE and/or --export-mp4 FILE")
     if not session.ticks:
-        raise StylesyncError(f"{args.file}: no ticks to replay (the run was cut short before its first one)")
+        raise SourceError(f"{args.file}: no ticks to replay (the run was cut short before its first one)")
     if args.export_bvh or args.export_mp4:
         _export(session, args.export_bvh, args.export_mp4)
     if args.viewer != "none":
@@ -233,7 +233,7 @@ def _bench(args: argparse.Namespace) -> int:
         only = tuple(c.strip() for c in args.only.split(",") if c.strip()) if args.only else ()
         unknown = [c for c in only if c not in ORDER]
         if unknown:
-            raise StylesyncError(f"unknown categories {', '.join(unknown)}; expected some of {', '.join(ORDER)}")
+            raise ConfigError(f"unknown categories {', '.join(unknown)}; expected some of {', '.join(ORDER)}")
         mocap = shared / "mocap"
         report = run_dev_suite(Path(args.out), args.seeds, args.duration, mocap if mocap.is_dir() else None, only,
                                workers=args.workers, executor=args.executor)
@@ -263,7 +263,7 @@ def _report(args: argparse.Namespace) -> int:
     from stylesync.metrics.report import write_report
 
     if not Path(args.folder).is_dir():
-        raise StylesyncError(f"{args.folder}: not a folder")
+        raise ConfigError(f"{args.folder}: not a folder")
     print(write_report(args.folder))
     return 0
 
@@ -301,7 +301,7 @@ def _measure(args: argparse.Namespace) -> int:
             frames = opened.source.poll(0.0)
     opened.source.close()
     if not frames:
-        raise StylesyncError(f"{args.source}: no operator frame to measure")
+        raise SourceError(f"{args.source}: no operator frame to measure")
     cloud = None
     if args.point_cloud:
         from stylesync.processing.point_cloud_volume import load_point_cloud
@@ -336,7 +336,7 @@ def _batch(args: argparse.Namespace) -> int:
 
     executor = args.executor or ("ray" if importlib.util.find_spec("ray") else "processes")
     if args.ray_address and executor != "ray":
-        raise StylesyncError("--ray-address needs the ray executor")
+        raise ConfigError("--ray-address needs the ray executor")
     settings = BatchSettings(seeds=tuple(range(args.seeds)), sensor=args.sensor, duration_s=args.duration,
                              export_bvh=not args.no_bvh, export_mp4=args.mp4, lipm_time_sync=not args.no_lipm)
     jobs = jobs_for(find_clips(args.input), settings)
@@ -374,6 +374,7 @@ def _inspect(args: argparse.Namespace) -> int:
 def build_parser() -> argparse.ArgumentParser:
     """The command line's parser: every value typed and range-checked (cli_args.py)."""
     parser = typed.OneLineParser(prog="stylesync", description="Style-preserving humanoid teleoperation")
+    parser.add_argument("--debug", action="store_true", help="show the traceback of an error (for developers)")
     sub = parser.add_subparsers(dest="command", required=True)
     demo = sub.add_parser("demo", help="run the built-in operator through the whole pipeline, headless")
     demo.add_argument("--clip", default="walk", help="pybullet_data humanoid3d clip, or 'stand'")
@@ -458,18 +459,29 @@ def main(argv: list[str] | None = None) -> int:
         # A termination request (kill, a supervisor stopping the run) ends the run as Ctrl-C does: the session
         # stops, the session file is closed and the viewer process shut down.
         signal.signal(signal.SIGTERM, _interrupt)
+    # Exit codes: 2 for input the parser or a source refuses (options, files, streams, settings); 1 for a failure
+    # while running (the simulation, the system refusing a file); 130 when interrupted. --debug keeps tracebacks.
     try:
         return int(args.func(args))
-    except StylesyncError as exc:
+    except (SourceError, ConfigError) as exc:
+        if args.debug:
+            raise
         print(f"stylesync: error: {exc}", file=sys.stderr)
         return 2
+    except StylesyncError as exc:
+        if args.debug:
+            raise
+        print(f"stylesync: error: {exc}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print("stylesync: interrupted", file=sys.stderr)
         return 130
     except OSError as exc:  # a folder or file the system refuses (permissions, a full disk, a read-only system)
+        if args.debug:
+            raise
         where = f": {exc.filename}" if exc.filename else ""
         print(f"stylesync: error: {exc.strerror or exc}{where}", file=sys.stderr)
-        return 2
+        return 1
 
 
 if __name__ == "__main__":

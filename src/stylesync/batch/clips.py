@@ -15,7 +15,7 @@ import json
 from dataclasses import dataclass
 from pathlib import Path
 
-from stylesync.errors import StylesyncError
+from stylesync.errors import SourceError
 
 KIND_BY_SUFFIX = {".bvh": "bvh", ".json": "k4a-json", ".txt": "deepmimic"}
 LIST_SUFFIXES = (".list", ".lst")
@@ -66,17 +66,17 @@ def find_clips(input_spec: str) -> list[Path]:
                 continue
             f = (p.parent / line).expanduser()
             if not f.is_file():
-                raise StylesyncError(f"{p}, line {k}: no such clip file: {line}")
+                raise SourceError(f"{p}, line {k}: no such clip file: {line}")
             found.append(f)
     elif p.is_file():
         found = [p]
     elif any(c in input_spec for c in "*?["):
         found = [Path(f) for f in glob.glob(str(p), recursive=True) if Path(f).is_file()]
     else:
-        raise StylesyncError(f"{input_spec}: no such folder, list or clip file")
+        raise SourceError(f"{input_spec}: no such folder, list or clip file")
     clips = sorted({f.resolve() for f in found if f.suffix.lower() in KIND_BY_SUFFIX})
     if not clips:
-        raise StylesyncError(f"{input_spec}: no clip files (.bvh, .json, .txt)")
+        raise SourceError(f"{input_spec}: no clip files (.bvh, .json, .txt)")
     return clips
 
 

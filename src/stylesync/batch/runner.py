@@ -29,7 +29,7 @@ import numpy as np
 
 from stylesync.batch.clips import BatchSettings, Job
 from stylesync.batch.job import run_job
-from stylesync.errors import StylesyncError
+from stylesync.errors import ConfigError
 
 log = logging.getLogger("stylesync.batch")
 EXECUTORS = ("ray", "processes", "inline")
@@ -133,7 +133,7 @@ def _ray(fn: Callable, items: list[tuple], workers: int, address: str | None, ma
     try:
         import ray
     except ImportError:
-        raise StylesyncError("the ray executor needs Ray: pip install 'stylesync[batch]'") from None
+        raise ConfigError("the ray executor needs Ray: pip install 'stylesync[batch]'") from None
     started_here = not ray.is_initialized()
     if started_here:
         kwargs: dict = {"include_dashboard": False, "log_to_driver": False, "logging_level": logging.ERROR,
@@ -190,7 +190,7 @@ def execute(fn: Callable, items: list[tuple], executor: str = "processes", worke
     result or None, a note: "" done, "retry" its worker died and it was submitted again, else why it has no
     result). ``fn`` must be importable by name (a module's function) for the processes and Ray."""
     if executor not in EXECUTORS:
-        raise StylesyncError(f"unknown executor '{executor}' (one of {', '.join(EXECUTORS)})")
+        raise ConfigError(f"unknown executor '{executor}' (one of {', '.join(EXECUTORS)})")
     workers = workers or os.cpu_count() or 1
     if executor == "inline":
         return _inline(fn, items)
@@ -208,7 +208,7 @@ def run_batch(jobs: list[Job], settings: BatchSettings, out: Path, executor: str
               progress: Callable[[BatchCounts], None] | None = None) -> BatchCounts:
     """Run the jobs not done yet, write each result as it comes back, then the summary. Returns the counts."""
     if executor not in EXECUTORS:
-        raise StylesyncError(f"unknown executor '{executor}' (one of {', '.join(EXECUTORS)})")
+        raise ConfigError(f"unknown executor '{executor}' (one of {', '.join(EXECUTORS)})")
     out.mkdir(parents=True, exist_ok=True)
     counts = BatchCounts(total=len(jobs))
     todo = []
