@@ -237,3 +237,26 @@ def test_the_report_says_whether_the_metrics_are_of_the_folders_run(tmp_path):
     metrics = json.loads((out / "metrics.json").read_text())
     (out / "metrics.json").write_text(json.dumps(metrics | {"run_id": "0123456789abcdef"}))
     assert "the metrics are not of the run" in write_report(out).read_text()
+
+
+def test_ctrl_c_ends_a_run_with_its_outputs_written(tmp_path):
+    import signal
+    import subprocess
+    import sys
+
+    out = tmp_path / "run"
+    proc = subprocess.Popen([sys.executable, "-m", "stylesync.cli", "demo", "--realtime", "--duration", "60",
+                             "--out", str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while not (out / "session.jsonl").exists() and time.monotonic() < deadline:
+        time.sleep(0.1)
+    time.sleep(2.0)
+    proc.send_signal(signal.SIGINT)
+    t0 = time.monotonic()
+    _, stderr = proc.communicate(timeout=30)
+    assert time.monotonic() - t0 < 5.0
+    assert proc.returncode == 130 and "Traceback" not in stderr
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["ended_by"] == "interrupted" and 0.5 < metrics["sim_duration_s"] < 60
+    header = json.loads((out / "session.jsonl").read_text().splitlines()[0])
+    assert header["run_id"] == metrics["run_id"]

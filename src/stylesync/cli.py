@@ -64,6 +64,7 @@ def _run_session(cfg: SessionConfig, source, out: Path, extra: dict, args: argpa
         session.on_tick = chain(recorder.tick, session_hook(session, viewer, args.viewer_hz))
         session.stop_on_fall = False  # watching: a fall is recorded, the run goes on (Reset stands it up)
         print(f"viewer: {viewer.url}", flush=True)
+    session.finish_on_interrupt = True  # Ctrl-C ends the run with its outputs written (exit 130)
     show = args.progress or sys.stderr.isatty()
     progress = _Progress(cfg.duration_s) if show else None
     metrics: dict | None = None
@@ -92,6 +93,9 @@ def _run_session(cfg: SessionConfig, source, out: Path, extra: dict, args: argpa
 
     write_report(out)
     print(f"outputs in {out} (report.html)")
+    if result.end_reason == "interrupted":
+        print("stylesync: interrupted", file=sys.stderr)
+        return 130
     return 0
 
 

@@ -160,6 +160,9 @@ class Session:
         # An offline run of a recorded operator computes the operator side ahead in a second process
         # (prefetch.py; the same results). False keeps it in this process.
         self.prefetch_operator = True
+        # Ctrl-C (or SIGTERM, turned into it by the command line) ends the run as its duration would, with
+        # end_reason "interrupted", instead of propagating (the command line then writes the outputs and exits 130)
+        self.finish_on_interrupt = False
         self.closed = False
         self.fell = False  # the run has recorded a fall (viewers show it)
 
@@ -288,6 +291,11 @@ class Session:
                 self._physics_step(run)
                 if cfg.realtime:
                     self._pace(t + dt, run)
+        except KeyboardInterrupt:
+            if not self.finish_on_interrupt:
+                raise
+            run.end_reason = "interrupted"  # the run ends here and its outputs are written
+            log.warning("interrupted at t=%.2f s: the run ends there", step * dt)
         finally:
             operator.close()
         _add_after_run_columns(run.log)
