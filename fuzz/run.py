@@ -64,6 +64,8 @@ def fuzz_target(name: str, inputs: int, seed: int, timeout_s: float, out: str) -
             kinds[kind] = kinds.get(kind, 0) + 1
         finally:
             signal.setitimer(signal.ITIMER_REAL, 0)
+    if hasattr(target, "close"):
+        target.close()
     counts["seconds"] = round(time.perf_counter() - t0, 1)
     counts["peak_rss_mb"] = round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 1)
     counts["traceback_kinds"] = kinds

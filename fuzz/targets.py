@@ -264,6 +264,12 @@ class VmcTarget:
         self._source._on_packet(data)
         return self._source.rejected_frames > before
 
+    def close(self) -> None:
+        """Stop the source's listener thread."""
+        if self._source is not None:
+            self._source.close()
+            self._source = None
+
 
 class CliTarget:
     """The command line's parser, given mutated argument lists (parsing only: nothing is run)."""

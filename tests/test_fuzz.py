@@ -17,6 +17,14 @@ from targets import all_targets, mutate  # noqa: E402
 TARGETS = {t.name: t for t in all_targets()}
 
 
+@pytest.fixture(scope="module", autouse=True)
+def _close_targets():
+    yield
+    for target in TARGETS.values():  # the VMC target's listener thread must not outlive these tests
+        if hasattr(target, "close"):
+            target.close()
+
+
 @pytest.mark.parametrize("name", sorted(TARGETS))
 def test_the_valid_seed_is_accepted(name):
     assert TARGETS[name](TARGETS[name].seed) is False  # the mutations start from an input that works

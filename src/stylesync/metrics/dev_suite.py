@@ -145,7 +145,7 @@ def run_dev_suite(out: Path, seeds: int, duration_s: float, mocap: Path | None, 
                   executor: str | None = None) -> dict:
     """Run the suite on the batch runner's executors (batch/runner.py: "processes" by default, "ray", or "inline"
     when ``workers`` is 1); writes dev_suite.md and dev_suite.json under ``out`` and returns {"rows", "table"}."""
-    from stylesync.batch.runner import execute
+    from stylesync.parallel import execute
 
     out.mkdir(parents=True, exist_ok=True)
     clips = [c for c in clip_specs(mocap) if not only or c[2] in only]
