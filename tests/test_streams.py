@@ -192,14 +192,13 @@ def test_a_run_in_a_used_folder_leaves_no_output_of_the_earlier_run(tmp_path):
 def test_a_run_killed_at_a_random_moment_leaves_only_its_own_readable_outputs(tmp_path, paced):
     import os
     import random
+    import shutil
     import signal
     import subprocess
     import sys
 
     from stylesync.errors import SourceError
     from stylesync.export.session_file import read_session
-
-    import shutil
 
     earlier, _ = _demo_session(tmp_path)  # a complete earlier run in the folder each killed run writes into
     earlier_id = json.loads((earlier / "metrics.json").read_text())["run_id"]
