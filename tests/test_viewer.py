@@ -79,6 +79,18 @@ def test_browser_sees_the_character_move_and_pushes_it(tmp_path):
             page.screenshot(path=str(shots[0]))
             page.wait_for_timeout(1500)
             page.screenshot(path=str(shots[1]))
+            # The page keeps up with the run (paced to the wall clock): over 6 s of wall time the simulated time it
+            # shows advances by 6 s, within 15 % (its status text is refreshed every 0.25 s; a page that falls
+            # behind, as one that showed 4.7 s over 7 s did, fails).
+            def shown_t() -> float:
+                match = re.search(r"t = ([0-9.]+) s", page.inner_text("body"))
+                assert match, "the page shows no simulated time"
+                return float(match.group(1))
+
+            t_page0, t_wall0 = shown_t(), time.monotonic()
+            page.wait_for_timeout(6000)
+            advance, wall = shown_t() - t_page0, time.monotonic() - t_wall0
+            assert abs(advance / wall - 1.0) < 0.15, f"the page advanced {advance:.2f} s in {wall:.2f} s"
             page.get_by_text("Push (throw a ball at the chest)").click()
             page.get_by_text(re.compile(r"balls thrown: 1")).wait_for(timeout=10000)
             page.wait_for_timeout(800)
