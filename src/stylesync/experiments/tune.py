@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import itertools
 import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -28,9 +29,11 @@ from stylesync.control.gravity_compensation import gravity_torques
 from stylesync.control.jacobian_transpose import JointFrames
 from stylesync.control.pid import IS_BALL, JointPid, joint_error
 from stylesync.control.stable_pd import flatten_joint_values, implicit_gain, joint_damping, unflatten_joint_values
+from stylesync.errors import SimulationError
 from stylesync.model.character import JOINT_NAMES, JOINTS, N_JOINT_DOFS, ROOT_DOFS, model_quat_from_canonical
 from stylesync.model.character_model import CharacterModel
 from stylesync.model.state import Torques
+from stylesync.parallel import execute
 from stylesync.processing.joint_map import hinge_angle
 from stylesync.sim.factory import make_backend
 from stylesync.sources.deepmimic_clip import DeepMimicClip
@@ -136,14 +139,24 @@ def run(out: Path, duration_s: float = 0.0, seed: int = 0) -> tuple[bool, dict]:
     clip = DeepMimicClip.builtin("walk")
     table3 = JacobianTransposeConfig().pid
     rows: dict[str, dict] = {}
+    # The grid's ramps are independent simulations: run on the batch runner's executors (parallel.py), one per
+    # core; each gives the same figures wherever it runs.
+    specs = {group: ramp_spec(clip, group) for group in GROUPS}
+    items = [(group, PidGains(table3[group].kp * fp, ki, table3[group].kd * fd), *specs[group])
+             for group in GROUPS
+             for fp, fd, ki in itertools.product(KP_KD_FACTORS, KP_KD_FACTORS, (0.0, table3[group].ki))]
+    errors: dict[int, tuple[float, float]] = {}
+    for k, result, note in execute(ramp_error, items, executor="processes" if (os.cpu_count() or 1) > 1
+                                   else "inline"):
+        if note == "retry":
+            continue
+        if not isinstance(result, tuple):
+            raise SimulationError(f"tune: a ramp of {items[k][0]} did not run ({note})")
+        errors[k] = result
     for group in GROUPS:
-        slope, height, axis = ramp_spec(clip, group)
+        slope, height, axis = specs[group]
         base = table3[group]
-        samples = []
-        for fp, fd, ki in itertools.product(KP_KD_FACTORS, KP_KD_FACTORS, (0.0, base.ki)):
-            gains = PidGains(base.kp * fp, ki, base.kd * fd)
-            total, rms = ramp_error(group, gains, slope, height, axis)
-            samples.append((total, rms, gains))
+        samples = [(*errors[k], item[1]) for k, item in enumerate(items) if item[0] == group]
         best = min(samples, key=lambda s: s[0])
         t3 = next(s for s in samples if s[2] == base)
         rows[group] = {"ramp_slope_rad_s": slope, "ramp_height_rad": height,
