@@ -242,7 +242,8 @@ def _bench(args: argparse.Namespace) -> int:
         report = run_dev_suite(Path(args.out), args.seeds, args.duration, mocap if mocap.is_dir() else None, only,
                                workers=args.workers, executor=args.executor)
     else:
-        report = run_bench(Path(args.out), args.duration, args.seed, shared if shared.is_dir() else None)
+        report = run_bench(Path(args.out), args.duration, args.seed, shared if shared.is_dir() else None,
+                           executor=args.executor or "inline", workers=args.workers)
     print(report["table"])
     from stylesync.metrics.report import write_report
 
@@ -420,9 +421,10 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--seeds", type=typed.integer(1, 1000), default=2, help="dev suite: sensor seeds 0 .. N-1")
     bench.add_argument("--only", help="dev suite: comma-separated categories (default: all)")
     bench.add_argument("--workers", type=typed.integer(1, 256), default=2,
-                       help="dev suite: runs in parallel")
+                       help="runs in parallel (with --executor processes or ray, and for the dev suite)")
     bench.add_argument("--executor", choices=("processes", "ray", "inline"),
-                       help="dev suite: where the runs go (stylesync batch's executors; default processes)")
+                       help="where the runs go (stylesync batch's executors); default: processes for the dev suite, "
+                            "inline for the bench (its realtime factors are then measured alone)")
     bench.set_defaults(func=_bench)
     batch = sub.add_parser("batch", help="run every clip of a folder, glob or list through the pipeline (Ray)")
     batch.add_argument("input", help="folder (recursive), glob pattern, list file (.list/.lst) or clip file")
