@@ -259,3 +259,63 @@ def test_ctrl_c_ends_a_run_with_its_outputs_written(tmp_path):
     assert metrics["ended_by"] == "interrupted" and 0.5 < metrics["sim_duration_s"] < 60
     header = json.loads((out / "session.jsonl").read_text().splitlines()[0])
     assert header["run_id"] == metrics["run_id"]
+
+
+def test_a_live_vmc_run_under_hostile_traffic_ends_on_ctrl_c_with_its_counts(tmp_path):
+    """`stylesync run --source vmc://...` in its own process, fed a standing operator, a bundle time-tagged an hour
+    ahead, 1000 random datagrams and a burst of 500 frames, then SIGINT (benchmarks/vmc_hostile.py does 10 000 and
+    5 000): it ends within 2 s, exit 130, no traceback, metrics.json written with every rejection counted."""
+    pytest.importorskip("pythonosc")
+    import signal
+    import subprocess
+    import sys
+
+    from pythonosc import osc_bundle_builder
+
+    from stylesync.sources.vmc import VmcSender
+    from stylesync.viewer.web_viewer import free_port
+
+    port = free_port()
+    out = tmp_path / "run"
+    proc = subprocess.Popen([sys.executable, "-m", "stylesync.cli", "run", "--source", f"vmc://127.0.0.1:{port}",
+                             "--duration", "600", "--out", str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True)
+    human = HumanModel()
+    builder = VmcSender("127.0.0.1", 9)
+    sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    addr = ("127.0.0.1", port)
+    rng = np.random.default_rng(0)
+
+    def frame(t):
+        return builder.messages(human.frame_from_pose(t, np.array([0.0, 0.0, human.hip_height_m]), {}))
+
+    def standing(n, t0):
+        for k in range(n):
+            sock.sendto(_bone_bundle(frame(t0 + k / 60), osc_bundle_builder.IMMEDIATELY), addr)
+            time.sleep(1 / 60)
+
+    try:
+        standing(180, 0.0)
+        sock.sendto(_bone_bundle(frame(3.0), time.time() + 3600.0), addr)
+        for g in range(1000):
+            sock.sendto(rng.bytes(int(rng.integers(1, 300))), addr)
+            if g % 50 == 49:
+                time.sleep(0.01)
+        good = _bone_bundle(frame(3.0), osc_bundle_builder.IMMEDIATELY)
+        for b in range(500):
+            sock.sendto(good, addr)
+            if b % 50 == 49:
+                time.sleep(0.01)
+        standing(60, 4.0)
+        proc.send_signal(signal.SIGINT)
+        t0 = time.monotonic()
+        _, stderr = proc.communicate(timeout=30)
+        assert time.monotonic() - t0 < 2.0
+    finally:
+        sock.close()
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 130 and "Traceback" not in stderr, stderr
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["ended_by"] == "interrupted" and not metrics["fell"]
+    assert sum(metrics["rejections"].values()) == metrics["rejected_frames"] >= 500  # what the kernel delivered
