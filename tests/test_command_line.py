@@ -91,3 +91,14 @@ def test_exit_codes_input_two_running_one_and_debug_keeps_the_traceback(tmp_path
     assert capsys.readouterr().err.strip() == "stylesync: error: the engine refused the character"
     with pytest.raises(SimulationError):
         cli_main(["--debug", "demo", "--out", str(tmp_path / "d")])
+
+
+@pytest.mark.parametrize("metrics, session", [("{garbage", b"\x00\xff"), ("[1, 2", b"[1]\n"), ('"text"', b"null\n"),
+                                              ("{}", b'{"format": "stylesync-session", "config": 3}\n')])
+def test_a_report_on_a_damaged_folder_is_written_and_says_so(tmp_path, capsys, metrics, session):
+    (tmp_path / "metrics.json").write_text(metrics)
+    (tmp_path / "bench.json").write_text(metrics)
+    (tmp_path / "session.jsonl").write_bytes(session)
+    assert cli_main(["report", str(tmp_path)]) == 0
+    text = (tmp_path / "report.html").read_text()
+    assert metrics == "{}" or "not readable as JSON" in text or "not a JSON object" in text

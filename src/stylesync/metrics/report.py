@@ -77,14 +77,21 @@ def write_report(folder: str | Path) -> Path:
     for name in ("metrics.json", "bench.json"):
         p = folder / name
         if p.is_file():
-            data = json.loads(p.read_text())
+            try:
+                data = json.loads(p.read_text(encoding="utf-8", errors="replace"))
+            except ValueError as exc:  # a damaged file is reported, not a reason to write no report
+                parts.append(f"<h2>{name}</h2><p><b>not readable as JSON</b> ({html.escape(str(exc))})</p>")
+                continue
+            if not isinstance(data, dict):
+                parts.append(f"<h2>{name}</h2><p><b>not a JSON object</b></p>")
+                continue
             rows = "".join(f"<tr><td>{html.escape(k)}</td><td>{html.escape(v)}</td></tr>"
                            for k, v in _flatten(data))
             parts.append(f"<h2>{name}</h2><table>{rows}</table>")
     for name in ("bench.md", "dev_suite.md"):
         md = folder / name
         if md.is_file():
-            parts.append(f"<h2>{name}</h2><pre>{html.escape(md.read_text())}</pre>")
+            parts.append(f"<h2>{name}</h2><pre>{html.escape(md.read_text(encoding='utf-8', errors='replace'))}</pre>")
     for png in sorted(folder.glob("*.png")):
         b64 = base64.b64encode(png.read_bytes()).decode()
         parts.append(f"<h2>{html.escape(png.name)}</h2><img src='data:image/png;base64,{b64}'>")
