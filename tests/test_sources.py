@@ -1,4 +1,5 @@
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -60,3 +61,27 @@ def test_builtin_walk_starts_from_standing_and_reaches_the_clip_speed():
     clip_v = (clip.pose_at(t_after - start + 0.01).root_pos_world - clip.pose_at(t_after - start).root_pos_world)
     v_clip = float(np.linalg.norm(clip_v[:2]) / 0.01) * performer.leg_ratio
     assert speed(t_after) == pytest.approx(v_clip, rel=1e-6)
+
+
+@pytest.mark.parametrize("value, says", [("1e300", "NaN or infinite"), ("1e308", "NaN or infinite"),
+                                         ("1e7", "limit 1000 m"), ("nan", "NaN or infinite")])
+def test_bvh_positions_and_rotations_out_of_this_world_are_one_clear_error(tmp_path, value, says):
+    """Positions of 1e300 or 1e308 once became Infinity and NaN in metrics.json, and a NaN rotation silently an
+    identity; a root 100 km from where the recording starts is no human motion either."""
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "fuzz"))
+    from targets import _bvh_seed
+
+    from stylesync.errors import SourceError
+    from stylesync.sources.registry import open_source
+
+    lines = _bvh_seed().decode().splitlines()
+    row = lines.index("MOTION") + 4  # the second frame
+    values = lines[row].split()
+    values[0 if value != "nan" else 4] = value  # root x position, or a root rotation
+    lines[row] = " ".join(values)
+    path = tmp_path / "clip.bvh"
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(SourceError, match=says):
+        open_source(f"bvh:{path}", duration_s=1.0)
