@@ -21,21 +21,14 @@ import time
 from pathlib import Path
 
 import numpy as np
-from pythonosc import osc_bundle_builder, osc_message_builder
 
 from stylesync.sources.human_model import HumanModel
-from stylesync.sources.vmc import VmcSender
+from stylesync.sources.vmc import VmcSender, osc_bundle
 from stylesync.viewer.web_viewer import free_port
 
 
-def bundle(messages, timetag) -> bytes:
-    b = osc_bundle_builder.OscBundleBuilder(timetag)
-    for address, args in messages:
-        m = osc_message_builder.OscMessageBuilder(address=address)
-        for a in args:
-            m.add_arg(a)
-        b.add_content(m.build())
-    return b.build().dgram
+def bundle(messages, timetag: float | None = None) -> bytes:
+    return osc_bundle(messages, timetag).dgram
 
 
 def main() -> None:
@@ -61,13 +54,12 @@ def main() -> None:
             nonlocal k
             for _ in range(n):
                 frame = h.frame_from_pose(k / 60, np.array([0.0, 0.0, h.hip_height_m]), {})
-                sock.sendto(bundle(builder.messages(frame), osc_bundle_builder.IMMEDIATELY), addr)
+                sock.sendto(bundle(builder.messages(frame)), addr)
                 k += 1
                 time.sleep(1 / 60)
 
         standing(180)  # the run starts on these (3 s)
-        good = bundle(builder.messages(h.frame_from_pose(0.0, np.array([0.0, 0.0, h.hip_height_m]), {})),
-                      osc_bundle_builder.IMMEDIATELY)
+        good = bundle(builder.messages(h.frame_from_pose(0.0, np.array([0.0, 0.0, h.hip_height_m]), {})))
         sock.sendto(bundle(builder.messages(h.frame_from_pose(3.0, np.array([0.0, 0.0, h.hip_height_m]), {})),
                            time.time() + 3600.0), addr)
         for g in range(args.garbage):

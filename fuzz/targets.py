@@ -160,20 +160,12 @@ def _npy_seed() -> bytes:
 
 
 def _vmc_seed() -> bytes:
-    from pythonosc import osc_bundle_builder, osc_message_builder
-
     from stylesync.sources.human_model import HumanModel
-    from stylesync.sources.vmc import VmcSender
+    from stylesync.sources.vmc import VmcSender, osc_bundle
 
     h = HumanModel()
-    sender = VmcSender("127.0.0.1", 9)
-    bundle = osc_bundle_builder.OscBundleBuilder(osc_bundle_builder.IMMEDIATELY)
-    for address, args in sender.messages(h.frame_from_pose(0.0, np.array([0.0, 0.0, h.hip_height_m]), {})):
-        m = osc_message_builder.OscMessageBuilder(address=address)
-        for a in args:
-            m.add_arg(a)
-        bundle.add_content(m.build())
-    return bundle.build().dgram
+    frame = h.frame_from_pose(0.0, np.array([0.0, 0.0, h.hip_height_m]), {})
+    return osc_bundle(VmcSender("127.0.0.1", 9).messages(frame)).dgram
 
 
 class FileTarget:

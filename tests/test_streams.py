@@ -62,16 +62,10 @@ def test_a_silent_stream_is_held_then_ends_the_run_cleanly(caplog):
     assert short.sim_duration_s == pytest.approx(2.5, abs=0.05) and not short.fell
 
 
-def _bone_bundle(msgs, timetag):
-    from pythonosc import osc_bundle_builder, osc_message_builder
+def _bone_bundle(msgs, timetag=None):
+    from stylesync.sources.vmc import osc_bundle
 
-    bundle = osc_bundle_builder.OscBundleBuilder(timetag)
-    for address, args in msgs:
-        m = osc_message_builder.OscMessageBuilder(address=address)
-        for a in args:
-            m.add_arg(a)
-        bundle.add_content(m.build())
-    return bundle.build().dgram
+    return osc_bundle(msgs, timetag).dgram
 
 
 def test_vmc_hostile_packets_are_counted_by_reason_and_never_block_shutdown(capfd):
@@ -97,16 +91,16 @@ def test_vmc_hostile_packets_are_counted_by_reason_and_never_block_shutdown(capf
                 time.sleep(0.02)  # what the socket's receive buffer cannot hold never reaches the source
         time.sleep(0.1)
         sock.sendto(b"#bundle\x00" + rng.bytes(40), addr)
-        sock.sendto(_bone_bundle([("/not/vmc", [1.0])], 1), addr)
-        sock.sendto(_bone_bundle([("/VMC/Ext/Bone/Pos", ["Hips", 1.0])], 1), addr)
+        sock.sendto(_bone_bundle([("/not/vmc", [1.0])]), addr)
+        sock.sendto(_bone_bundle([("/VMC/Ext/Bone/Pos", ["Hips", 1.0])]), addr)
         bad = [(a, [x if not isinstance(x, float) else float("nan") for x in args]) if a == "/VMC/Ext/Bone/Pos"
                else (a, args) for a, args in good]
-        sock.sendto(_bone_bundle(bad, 1), addr)
+        sock.sendto(_bone_bundle(bad), addr)
         zero = [(a, [*args[:4], 0.0, 0.0, 0.0, 0.0]) if a == "/VMC/Ext/Root/Pos" else (a, args) for a, args in good]
-        sock.sendto(_bone_bundle(zero, 1), addr)
+        sock.sendto(_bone_bundle(zero), addr)
         # A burst beyond the queue, nobody polling (in chunks the socket's receive buffer holds: what the kernel
         # drops never reaches the source).
-        packet = _bone_bundle(good, 1)
+        packet = _bone_bundle(good)
         for k in range(600):
             sock.sendto(packet, addr)
             if k % 20 == 19:
@@ -270,8 +264,6 @@ def test_a_live_vmc_run_under_hostile_traffic_ends_on_ctrl_c_with_its_counts(tmp
     import subprocess
     import sys
 
-    from pythonosc import osc_bundle_builder
-
     from stylesync.sources.vmc import VmcSender
     from stylesync.viewer.web_viewer import free_port
 
@@ -291,7 +283,7 @@ def test_a_live_vmc_run_under_hostile_traffic_ends_on_ctrl_c_with_its_counts(tmp
 
     def standing(n, t0):
         for k in range(n):
-            sock.sendto(_bone_bundle(frame(t0 + k / 60), osc_bundle_builder.IMMEDIATELY), addr)
+            sock.sendto(_bone_bundle(frame(t0 + k / 60), None), addr)
             time.sleep(1 / 60)
 
     try:
@@ -301,7 +293,7 @@ def test_a_live_vmc_run_under_hostile_traffic_ends_on_ctrl_c_with_its_counts(tmp
             sock.sendto(rng.bytes(int(rng.integers(1, 300))), addr)
             if g % 50 == 49:
                 time.sleep(0.01)
-        good = _bone_bundle(frame(3.0), osc_bundle_builder.IMMEDIATELY)
+        good = _bone_bundle(frame(3.0), None)
         for b in range(500):
             sock.sendto(good, addr)
             if b % 50 == 49:

@@ -470,3 +470,18 @@ def _add_after_run_columns(lg: TickLog) -> None:
                       np.asarray(ch_com), np.asarray(raw["_ch_root_quat"]))
     for k, name in enumerate(_FEATURES):
         lg.columns[f"ch_{name}"] = rows[:, k].tolist()
+
+
+def run_and_release(config: SessionConfig, source: OperatorSource) -> SessionResult:
+    """One session of ``config`` on ``source`` run to its end, the source closed and the engine released however
+    it ends (processes that run many sessions: bench, the development suite)."""
+    try:
+        session = Session(config, source)
+    except BaseException:
+        source.close()
+        raise
+    try:
+        return session.run()
+    finally:
+        source.close()
+        session.release_engine()

@@ -32,7 +32,7 @@ from stylesync.config import ControlConfig, JacobianTransposeConfig, MotionConfi
 from stylesync.errors import SimulationError
 from stylesync.metrics.summary import summarize
 from stylesync.model.state import Torques
-from stylesync.session import Session
+from stylesync.session import run_and_release
 from stylesync.sim.factory import make_backend
 from stylesync.sources.deepmimic_clip import builtin_clip_names
 from stylesync.sources.registry import open_source
@@ -80,16 +80,7 @@ def _run(spec: str, name: str, duration_s: float, seed: int) -> dict:
     cfg = SessionConfig(duration_s=length, seed=seed, control=control, motion=motion,
                         clocks=dataclasses.replace(SessionConfig().clocks, mocap_hz=opened.mocap_hz),
                         operator=OperatorConfig())
-    try:
-        session = Session(cfg, opened.source)
-    except BaseException:
-        opened.source.close()
-        raise
-    try:
-        result = session.run()
-    finally:
-        opened.source.close()
-        session.release_engine()
+    result = run_and_release(cfg, opened.source)
     m = summarize(result)
     uhc = m.get("uhc_fall_time_s")
     fall_t = min(x for x in (m["fall_time_s"], uhc) if x is not None) if (m["fell"] or uhc is not None) else None

@@ -63,7 +63,7 @@ def clip_specs(mocap: Path | None) -> list[tuple[str, str, str]]:
 def run_clip(spec: str, seed: int, duration_s: float, controller: str) -> dict:
     """One run of the suite: the clip through the Kinect sensor model with ``seed``; a clip that cannot be opened
     gives ``{"error": ...}``."""
-    from stylesync.session import Session
+    from stylesync.session import run_and_release
     from stylesync.sources.registry import open_source
 
     logging.disable(logging.WARNING)
@@ -78,16 +78,7 @@ def run_clip(spec: str, seed: int, duration_s: float, controller: str) -> dict:
     clip_end = length - (min(op.rest_after_clip_s, length) if in_motion else 0.0)
     cfg = SessionConfig(duration_s=length, seed=seed, operator=op, control=control, motion=motion,
                         clocks=dataclasses.replace(SessionConfig().clocks, mocap_hz=opened.mocap_hz))
-    try:
-        session = Session(cfg, opened.source)
-    except BaseException:
-        opened.source.close()
-        raise
-    try:
-        result = session.run()
-    finally:
-        opened.source.close()
-        session.release_engine()
+    result = run_and_release(cfg, opened.source)
     m = summarize(result)
     keys = ("fell", "fall_time_s", "sim_duration_s", "operator_steps", "character_steps",
             "state_transition_delay_s", "mpjpe_global_mm", "mpjpe_root_mm", "uhc_fall_time_s", "realtime_factor")
@@ -143,7 +134,7 @@ def table(rows: list[dict], versions: list[str]) -> str:
 def run_dev_suite(out: Path, seeds: int, duration_s: float, mocap: Path | None, only: tuple[str, ...] = (),
                   controllers: tuple[str, ...] = SUITE_CONTROLLERS, workers: int = 2,
                   executor: str | None = None) -> dict:
-    """Run the suite on the batch runner's executors (batch/runner.py: "processes" by default, "ray", or "inline"
+    """Run the suite on the executors of parallel.py ("processes" by default, "ray", or "inline"
     when ``workers`` is 1); writes dev_suite.md and dev_suite.json under ``out`` and returns {"rows", "table"}."""
     from stylesync.parallel import execute
 

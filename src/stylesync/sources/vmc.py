@@ -355,13 +355,19 @@ class VmcSender:
 
     def send(self, frame: OperatorFrame, sender_time_s: float | None = None) -> None:
         """Send one frame as one OSC bundle."""
-        from pythonosc.osc_bundle_builder import IMMEDIATELY, OscBundleBuilder
-        from pythonosc.osc_message_builder import OscMessageBuilder
+        self._client.send(osc_bundle(self.messages(frame, sender_time_s)))
 
-        bundle = OscBundleBuilder(IMMEDIATELY)
-        for addr, args in self.messages(frame, sender_time_s):
-            m = OscMessageBuilder(address=addr)
-            for a in args:
-                m.add_arg(a)
-            bundle.add_content(m.build())  # type: ignore[arg-type]
-        self._client.send(bundle.build())
+
+def osc_bundle(messages: list[tuple[str, list]], timetag: float | None = None) -> Any:
+    """One OSC bundle (python-osc's; ``.dgram`` its bytes) of (address, arguments) messages, time-tagged
+    ``timetag`` (seconds since the epoch; None: immediately)."""
+    from pythonosc.osc_bundle_builder import IMMEDIATELY, OscBundleBuilder
+    from pythonosc.osc_message_builder import OscMessageBuilder
+
+    bundle = OscBundleBuilder(IMMEDIATELY if timetag is None else timetag)  # type: ignore[arg-type]
+    for addr, args in messages:
+        m = OscMessageBuilder(address=addr)
+        for a in args:
+            m.add_arg(a)
+        bundle.add_content(m.build())  # type: ignore[arg-type]
+    return bundle.build()
