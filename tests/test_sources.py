@@ -85,3 +85,41 @@ def test_bvh_positions_and_rotations_out_of_this_world_are_one_clear_error(tmp_p
     path.write_text("\n".join(lines) + "\n")
     with pytest.raises(SourceError, match=says):
         open_source(f"bvh:{path}", duration_s=1.0)
+
+
+def test_a_looping_clip_costs_work_in_its_cycles_not_their_square(monkeypatch):
+    """A looping clip's root travel over n cycles is Σ_{k<n} R_z(k·yaw) offset (each cycle's offset turned by the
+    heading gained before it), and asking for the pose at every frame of a long run builds each cycle's rotation
+    once: opening a looping clip used to take time quadratic in the run's length."""
+    from stylesync import rotations as rot
+    from stylesync.sources import deepmimic_clip
+
+    def frame(x_m: float, yaw_rad: float) -> list[float]:
+        f = [0.001, x_m, 0.9, 0.0, float(np.cos(yaw_rad / 2)), 0.0, float(np.sin(yaw_rad / 2)), 0.0]
+        for _, kind, _width in deepmimic_clip._CLIP_LAYOUT:
+            f += [1.0, 0.0, 0.0, 0.0] if kind == "ball" else [0.0]
+        return f
+
+    clip = DeepMimicClip(np.array([frame(0.0, 0.0), frame(0.01, np.radians(1.0))]), loop=True)
+    calls = {"n": 0}
+    real = rot.quat_from_yaw
+
+    def counted(yaw: float) -> np.ndarray:
+        calls["n"] += 1
+        return real(yaw)
+
+    monkeypatch.setattr(rot, "quat_from_yaw", counted)
+    times = np.arange(0.0, 2.0, 0.0005)  # 4000 poses over 2000 cycles
+    poses = [clip.pose_at(float(t)) for t in times]
+    # each pose builds its own heading once; the travel's rotations are built once per cycle (2000), not per pose
+    # and cycle (about 4 million)
+    assert calls["n"] <= 2 * len(times) + 2000 + 1
+    n = 1500
+    z = np.exp(1j * clip.cycle_yaw)
+    travel = complex(*clip.cycle_offset[:2]) * (1 - z ** n) / (1 - z)
+    start = clip.root_pos[0] * np.array([1.0, 1.0, 0.0])
+    pose = clip.pose_at(n * clip.duration_s)
+    expected = start + np.array([travel.real, travel.imag, 0.0]) + rot.matrix_from_quat(
+        real(n * clip.cycle_yaw)) @ (clip.root_pos[0] - start)
+    assert np.allclose(pose.root_pos_world, expected, atol=1e-9)
+    assert np.linalg.norm(poses[-1].root_pos_world - poses[0].root_pos_world) > 0.5

@@ -78,6 +78,10 @@ class DeepMimicClip:
         self.cycle_offset = self.root_pos[-1] - self.root_pos[0]
         self.cycle_offset[2] = 0.0
         self.cycle_yaw = rot.yaw_from_quat(self.root_quat[-1]) - rot.yaw_from_quat(self.root_quat[0])
+        # _drift_m[k]: the root's travel over the first k cycles, each cycle's offset turned by the heading the
+        # cycles before it gained (Σ_{j<k} R_z(j·yaw) offset), extended as later cycles are asked for: the work of
+        # a run grows with its number of cycles, not with that number squared.
+        self._drift_m: list[np.ndarray] = [np.zeros(3)]
 
     @classmethod
     def load(cls, path: str | Path) -> DeepMimicClip:
@@ -110,6 +114,14 @@ class DeepMimicClip:
             raise SourceError(f"unknown clip '{name}'; expected one of {', '.join(builtin_clip_names())}")
         return cls.load(path)
 
+    def _drift(self, cycles: int) -> np.ndarray:
+        """(3,) the root's travel over the first ``cycles`` cycles of a looping clip [m]."""
+        drift = self._drift_m
+        while len(drift) <= cycles:
+            k = len(drift) - 1
+            drift.append(drift[k] + rot.matrix_from_quat(rot.quat_from_yaw(k * self.cycle_yaw)) @ self.cycle_offset)
+        return drift[cycles]
+
     def pose_at(self, t_s: float) -> ClipPose:
         """Pose at clip time ``t_s`` [s]; a looping clip repeats with its per-cycle drift, others hold the end."""
         cycle = 0
@@ -130,9 +142,7 @@ class DeepMimicClip:
             R = rot.matrix_from_quat(q_cycle)
             start = self.root_pos[0].copy()
             start[2] = 0.0
-            drift = sum((rot.matrix_from_quat(rot.quat_from_yaw(k * self.cycle_yaw)) @ self.cycle_offset
-                         for k in range(cycle)), np.zeros(3))
-            root = start + drift + R @ (root - start)
+            root = start + self._drift(cycle) + R @ (root - start)
             q_root = rot.multiply(q_cycle, q_root)
         quats["PELVIS"] = q_root
         return ClipPose(root, quats)
