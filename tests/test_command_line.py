@@ -1,5 +1,7 @@
 """Bad command lines end with exit 2 and one line naming the option, before anything runs."""
 
+from pathlib import Path
+
 import pytest
 
 from stylesync.cli import main as cli_main
@@ -43,6 +45,19 @@ def test_out_naming_a_file_or_an_export_into_a_file(tmp_path, capsys):
         assert _exit_code(argv) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and ("--out" in err or "--export-bvh" in err), err
+
+
+@pytest.mark.skipif(not Path("/proc/self").is_dir(), reason="needs Linux's /proc, a folder nobody can write into")
+def test_out_that_cannot_be_written_even_by_root(tmp_path, capsys):
+    """Tried, not read from permission bits: root may write anywhere the bits say, but not into /proc."""
+    for argv, option in ((["demo", "--out", "/proc/stylesync-out"], "--out"),
+                         (["demo", "--export-bvh", "/proc/stylesync.bvh"], "--export-bvh")):
+        assert _exit_code(argv) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and option in err and "Traceback" not in err, err
+    # a folder that can be made is made only by the run itself: the check leaves nothing behind
+    assert _exit_code(["demo", "--out", str(tmp_path / "new" / "out"), "--duration", "nan"]) == 2
+    assert not (tmp_path / "new").exists()
 
 
 def test_an_export_into_a_missing_folder_creates_it(tmp_path, capsys):

@@ -7,6 +7,7 @@ import argparse
 import math
 import os
 import sys
+import tempfile
 from collections.abc import Callable
 from pathlib import Path
 from typing import NoReturn
@@ -55,18 +56,35 @@ def integer(lo: int, hi: int) -> Callable[[str], int]:
 
 
 def _creatable_dir(path: Path) -> str | None:
-    """Why ``path`` cannot be (or become) a writable folder; None if it can."""
+    """Why ``path`` cannot be (or become) a writable folder; None if it can. Tried, not guessed from permission
+    bits (which say nothing to root, nor of read-only mounts and pseudo-filesystems): the missing folders are made
+    and a temporary file is written in it; what the trial made is removed again."""
     p = path.expanduser().absolute()
-    if p.exists():
-        if not p.is_dir():
-            return f"{path} exists and is not a folder"
-        return None if os.access(p, os.W_OK | os.X_OK) else f"{path} is not writable"
-    parent = p.parent
+    if p.exists() and not p.is_dir():
+        return f"{path} exists and is not a folder"
+    missing: list[Path] = []
+    parent = p
     while not parent.exists():
+        missing.append(parent)
         parent = parent.parent
     if not parent.is_dir():
         return f"{parent} is not a folder"
-    return None if os.access(parent, os.W_OK | os.X_OK) else f"cannot create {path}: {parent} is not writable"
+    made: list[Path] = []
+    try:
+        for folder in reversed(missing):
+            folder.mkdir()
+            made.append(folder)
+        with tempfile.TemporaryFile(dir=p):
+            pass
+    except OSError as exc:
+        return f"cannot write into {path}: {exc.strerror or exc}"
+    finally:
+        for folder in reversed(made):
+            try:
+                folder.rmdir()
+            except OSError:
+                pass
+    return None
 
 
 def out_dir(text: str) -> Path:
