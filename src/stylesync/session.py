@@ -414,10 +414,12 @@ class Session:
         self.last_com_world = com
         # Vectors are recorded whole and split into their x, y, z columns after the run (_add_after_run_columns):
         # the tick pays for one append per vector. The arrays recorded are new at every tick, never changed later.
+        reading = self.motion.reading
+        assert reading is not None  # the motion stage has run this tick
         lg.add(
             t=t, tick_ms=tick_ms,
-            op_state=STANCE_CODE[ref.operator_stance], char_state=STANCE_CODE[ref.character_stance],
-            held=float(ref.held), scale=ref.scale,
+            op_state=STANCE_CODE[reading.operator_stance], char_state=STANCE_CODE[ref.character_stance],
+            held=float(reading.held), scale=reading.scale,
             _v_com=com, _v_com_d=ref.com_world, _v_op_com=sample.com_world,
             _v_op_al=sample.pos["ANKLE_LEFT"], _v_op_ar=sample.pos["ANKLE_RIGHT"],
             _v_al=state.link_origin_world[_LINK["left_ankle"]], _v_ar=state.link_origin_world[_LINK["right_ankle"]],
@@ -426,7 +428,7 @@ class Session:
             ch_joints=state.link_origin_world[CHARACTER_LINKS],
             _op_pos=sample.pos,
             _v_lipm=self.controller.telemetry.lipm_force_n,
-            _op_features=ref.operator_features,
+            _op_features=reading.operator_features,
             # The joint error and the character's style features are computed from these after the run
             # (_add_after_run_columns). The arrays are the state's and the reference's own, new at every tick.
             _q=state.joint_pos, _q_ref=ref.joint_pos,

@@ -149,7 +149,7 @@ class WholeBodyController(ControllerBase):
         swing = swing_side(ref.character_stance)
         for s, task in self.foot_press.items():
             ws = ref.stance_weight[s]
-            task.active = (ws > 0 and w[s] <= 0) or (ref.held and s == swing)
+            task.active = (ws > 0 and w[s] <= 0) or (ref.press_swing_foot and s == swing)
         for s, task in self.hands.items():
             task.active = ref.hand_world is not None
             if ref.hand_world is not None:

@@ -60,7 +60,7 @@ class _TickValues(NamedTuple):
 class SessionRecorder:
     """Writes a session file; ``tick`` is the session's ``on_tick`` hook."""
 
-    def __init__(self, path: str | Path, config: Any, session: Any = None, deferred: bool = False,
+    def __init__(self, path: str | Path, config: Any, session: Any, deferred: bool = False,
                  run_id: str | None = None):
         self.path = Path(path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
@@ -83,9 +83,10 @@ class SessionRecorder:
 
     def tick(self, state: Any, ref: Any) -> None:
         sess = self._session
+        reading = sess.motion.reading
         values = _TickValues(state.time_s, state.root_pos_world, state.root_quat_wxyz, state.joint_pos,
-                             state.link_quat_wxyz, getattr(sess, "last_torques", None), ref.scale,
-                             ref.operator_stance, ref.character_stance, ref.operator_features,
+                             state.link_quat_wxyz, getattr(sess, "last_torques", None), reading.scale,
+                             reading.operator_stance, ref.character_stance, reading.operator_features,
                              getattr(sess, "last_com_world", None), getattr(sess, "last_sample", None))
         if self.deferred and len(self._held) < MAX_DEFERRED_TICKS:
             self._held.append(values)

@@ -51,7 +51,7 @@ from stylesync.motion.recovery_step import (
     operator_stands,
     stands_on,
 )
-from stylesync.motion.reference import LipmMap, ReferencePose
+from stylesync.motion.reference import LipmMap, MotionReading, ReferencePose
 from stylesync.motion.stance_fsm import (
     CharacterStanceFsm,
     OperatorStanceFsm,
@@ -213,6 +213,7 @@ class MotionOptimizer:
         self._op_last_ds_s = 0.0
         self.recovery = RecoveryStepper(cfg, CHAR_LEG_LENGTH_M, gravity_mps2)
         self._operator_stands_since_s: float | None = None
+        self.reading: MotionReading | None = None  # the last tick's reading of the operator, besides the targets
 
     def update(self, sample: OperatorSample, state: CharacterState, mass: MassProperties,
                analysis: OperatorAnalysis | None = None) -> ReferencePose:
@@ -643,12 +644,12 @@ class MotionOptimizer:
             # is in the air, and the foot would land where the capture point no longer goes.
             com_d = np.array([tick.com_c[0], tick.com_c[1], tick.com_d[2]])
             com_vel_d = np.array([tick.com_vel_c[0], tick.com_vel_c[1], 0.0])
+        self.reading = MotionReading(tick.op_state, tick.analysis.features, self.char_fsm.hold_reference, tick.scale,
+                                     tick.step_exceeded)
         return ReferencePose(
             time_s=state.time_s, joint_pos=joint_pos, root_quat_wxyz=tick.q_root_d, pelvis_world=tick.pelvis_d,
-            com_world=com_d, com_vel_world=com_vel_d, operator_stance=tick.op_state,
-            character_stance=tick.ch_state, stance_weight=tick.weights, ankle_world=tick.a_c, lipm=lipm,
-            operator_features=tick.analysis.features, held=self.char_fsm.hold_reference, scale=tick.scale,
-            step_bound_exceeded=tick.step_exceeded, hand_world=hands,
+            com_world=com_d, com_vel_world=com_vel_d, character_stance=tick.ch_state, stance_weight=tick.weights,
+            ankle_world=tick.a_c, lipm=lipm, press_swing_foot=self.char_fsm.hold_reference, hand_world=hands,
         )
 
     @staticmethod

@@ -22,20 +22,31 @@ class LipmMap:
 
 @dataclass
 class ReferencePose:
+    """The targets of one control tick, all in the character's terms (world frame): what the controller tracks."""
+
     time_s: float
     joint_pos: np.ndarray  # (n_joints, 4) desired local rotations (model axes), hinge angle in column 0
     root_quat_wxyz: np.ndarray  # desired canonical pelvis orientation (level, heading H)
     pelvis_world: np.ndarray  # desired pelvis origin (Eq. 9-10) [m]
     com_world: np.ndarray  # desired character COM [m]
     com_vel_world: np.ndarray  # [m/s]
-    operator_stance: Stance
-    character_stance: Stance
+    character_stance: Stance  # the feet the character is to stand on
     stance_weight: dict[str, float]
     ankle_world: dict[str, np.ndarray]  # current character ankle joints [m]
     lipm: LipmMap | None
-    operator_features: StyleFeatures
-    held: bool  # the reference is held waiting for a late contact
-    scale: float  # character / operator size ratio (h_C / h_H of Eq. 9)
-    step_bound_exceeded: bool
+    # The swing foot is to be pressed onto the ground: a late contact (Sec. 5.1) holds the reference until it touches
+    press_swing_foot: bool
     # The operator's wrists relative to his pelvis (world axes), scaled, placed at the character's pelvis [m]
     hand_world: dict[str, np.ndarray] | None = None
+
+
+@dataclass(frozen=True)
+class MotionReading:
+    """What the motion stage read from the operator and decided at one tick, besides the targets: for the run's
+    log, the session file and the viewer (``MotionOptimizer.reading``)."""
+
+    operator_stance: Stance
+    operator_features: StyleFeatures
+    held: bool  # the reference is held waiting for a late contact (Sec. 5.1)
+    scale: float  # character / operator size ratio (h_C / h_H of Eq. 9)
+    step_bound_exceeded: bool  # the swing foot's target was cut to the step-length bound (Eq. 28)
