@@ -91,6 +91,12 @@ def test_browser_sees_the_character_move_and_pushes_it(tmp_path):
             page.wait_for_timeout(6000)
             advance, wall = shown_t() - t_page0, time.monotonic() - t_wall0
             assert abs(advance / wall - 1.0) < 0.15, f"the page advanced {advance:.2f} s in {wall:.2f} s"
+            # The COM the page shows (the marker's position, sent with the same snapshot) is the session's COM at
+            # the time the page shows: checked against the session file after the run.
+            shown = re.search(r"t = ([0-9.]+) s.*COM \((-?[0-9.]+), (-?[0-9.]+), (-?[0-9.]+)\) m",
+                              page.inner_text("body"), re.S)
+            assert shown, "the page shows no COM"
+            t_com, com_shown = float(shown.group(1)), np.array([float(shown.group(k)) for k in (2, 3, 4)])
             page.get_by_text("Push (throw a ball at the chest)").click()
             page.get_by_text(re.compile(r"balls thrown: 1")).wait_for(timeout=10000)
             page.wait_for_timeout(800)
@@ -104,6 +110,14 @@ def test_browser_sees_the_character_move_and_pushes_it(tmp_path):
             proc.wait(timeout=10)
         except subprocess.TimeoutExpired:
             proc.kill()
+    from stylesync.export.session_file import read_session
+
+    ticks = read_session(tmp_path / "run" / "session.jsonl").ticks
+    times = np.array([tk["t"] for tk in ticks])
+    k = int(np.argmin(np.abs(times - t_com)))
+    assert abs(times[k] - t_com) < 0.01, f"no tick at the page's t = {t_com} s"
+    error_m = float(np.linalg.norm(np.asarray(ticks[k]["character_com_world"]) - com_shown))
+    assert error_m < 0.02, f"the page's COM is {error_m:.3f} m from the session's at t = {t_com} s"
 
 
 def _port_open(port: int) -> bool:

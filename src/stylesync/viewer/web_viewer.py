@@ -268,8 +268,10 @@ class WebViewer:
             self._ground.position = (float(at[0]), float(at[1]), 0.0)
 
     def _texts(self, snap: Snapshot) -> None:
+        c = snap.com_world  # the COM marker's position, the same value
         status = (f"**t = {snap.time_s:.2f} s** · character {_STANCE_TEXT[snap.character_stance]} · "
-                  f"operator {snap.operator_stance.name} · balls thrown: {len(snap.balls_world)}"
+                  f"operator {snap.operator_stance.name} · balls thrown: {len(snap.balls_world)} · "
+                  f"COM ({c[0]:.3f}, {c[1]:.3f}, {c[2]:.3f}) m"
                   + (" · **fallen**" if snap.fell else ""))
         active = [k for k, v in snap.bounds_active.items() if v]
         warning = "⚠️ **operator exceeds the movement bounds: " + ", ".join(active) + "**" if active else ""
