@@ -1,6 +1,8 @@
 """The video source: MediaPipe Pose run on real frames of a file (no mock), frames timed at the file's rate, the
 camera's tilt estimated and removed, and one clear line for files it cannot use."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -64,3 +66,37 @@ def test_camera_tilt_is_found_from_the_standing_legs_and_removed():
     assert deg == pytest.approx(12.0, abs=1e-6)
     leg = (pos @ tilt.T @ R.T)[0, JOINT_INDEX["HIP_LEFT"]] - (pos @ tilt.T @ R.T)[0, JOINT_INDEX["ANKLE_LEFT"]]
     assert leg[:2] == pytest.approx([0.0, 0.0], abs=1e-9)
+
+
+# People walking in front of a building, filmed from a first floor: OpenCV's sample video (Debian's opencv-doc,
+# installed by .ci/run; 795 frames at 10 fps, 768 x 576). Never copied into the repository.
+PEOPLE_VIDEO = Path("/usr/share/doc/opencv-doc/examples/data/vtest.avi")
+
+
+@pytest.mark.skipif(not PEOPLE_VIDEO.is_file(),
+                    reason=f"needs the sample video of people walking {PEOPLE_VIDEO} (apt-get install opencv-doc)")
+def test_a_video_of_people_walking_runs_through_mediapipe_at_the_files_rate(tmp_path):
+    """MediaPipe Pose on the real frames of a recorded video of people (no mock): a person is found, his frames are
+    timed at the file's rate, the camera's tilt is estimated, and a run on it exits 0 with both in its metrics."""
+    import json
+
+    from stylesync.cli import main as cli_main
+    from stylesync.sources.webcam import VideoRecording
+
+    cap = cv2.VideoCapture(str(PEOPLE_VIDEO))
+    n_file, fps_file = int(cap.get(cv2.CAP_PROP_FRAME_COUNT)), float(cap.get(cv2.CAP_PROP_FPS))
+    cap.release()
+    rec = VideoRecording(PEOPLE_VIDEO)
+    assert rec.frames == n_file == 795 and rec.frame_rate_hz == fps_file == 10.0
+    times = rec.performer.times_s
+    # the frames with a person, at the file's frame times (whole tenths of a second), within the file's duration
+    assert np.allclose(times * fps_file, np.round(times * fps_file), atol=1e-6)
+    assert times[-1] <= (n_file - 1) / fps_file + 1e-9
+    assert rec.frames_without_person < 0.6 * n_file and times[-1] > 30.0
+    assert np.isfinite(rec.camera_tilt_deg)
+    out = tmp_path / "run"
+    assert cli_main(["run", "--source", f"video:{PEOPLE_VIDEO}", "--duration", "3", "--out", str(out)]) == 0
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["video_frame_rate_hz"] == 10.0 and metrics["video_frames"] == 795
+    assert metrics["camera_tilt_deg"] == pytest.approx(rec.camera_tilt_deg, abs=0.01)
+    assert metrics["sim_duration_s"] == pytest.approx(3.0, abs=0.02)
