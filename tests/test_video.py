@@ -94,9 +94,15 @@ def test_a_video_of_people_walking_runs_through_mediapipe_at_the_files_rate(tmp_
     assert times[-1] <= (n_file - 1) / fps_file + 1e-9
     assert rec.frames_without_person < 0.6 * n_file and times[-1] > 30.0
     assert np.isfinite(rec.camera_tilt_deg)
+    # the run goes through the whole track (from the first frame with a person to the last) and the rest after it,
+    # past a fall
     out = tmp_path / "run"
-    assert cli_main(["run", "--source", f"video:{PEOPLE_VIDEO}", "--duration", "3", "--out", str(out)]) == 0
+    assert cli_main(["run", "--source", f"video:{PEOPLE_VIDEO}", "--continue-after-fall", "--out", str(out)]) == 0
     metrics = json.loads((out / "metrics.json").read_text())
     assert metrics["video_frame_rate_hz"] == 10.0 and metrics["video_frames"] == 795
     assert metrics["camera_tilt_deg"] == pytest.approx(rec.camera_tilt_deg, abs=0.01)
-    assert metrics["sim_duration_s"] == pytest.approx(3.0, abs=0.02)
+    from stylesync.config import OperatorConfig
+
+    rest_s = OperatorConfig().rest_after_clip_s
+    assert metrics["sim_duration_s"] == pytest.approx(times[-1] + rest_s, abs=0.02)
+    assert metrics["ended_by"] == "duration"

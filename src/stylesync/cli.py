@@ -64,6 +64,8 @@ def _run_session(cfg: SessionConfig, source, out: Path, extra: dict, args: argpa
         session.on_tick = chain(recorder.tick, session_hook(session, viewer, args.viewer_hz))
         session.stop_on_fall = False  # watching: a fall is recorded, the run goes on (Reset stands it up)
         print(f"viewer: {viewer.url}", flush=True)
+    if args.continue_after_fall:
+        session.stop_on_fall = False
     session.finish_on_interrupt = True  # Ctrl-C ends the run with its outputs written (exit 130)
     show = args.progress or sys.stderr.isatty()
     progress = _Progress(cfg.duration_s) if show else None
@@ -292,6 +294,8 @@ def _add_session_args(p: argparse.ArgumentParser, out_default: str, realtime_hel
     p.add_argument("--no-lipm", action="store_true", help="switch the LIPM time-sync compensation off (Eq. 21-23)")
     p.add_argument("--record", type=typed.out_file, help="session file to write (default: OUT/session.jsonl)")
     p.add_argument("--progress", action="store_true", help="show a progress line (default: when on a terminal)")
+    p.add_argument("--continue-after-fall", action="store_true",
+                   help="go on to the end after a fall (the fall is recorded; default: a fall ends the run)")
     _add_export_args(p)
 
 

@@ -65,7 +65,9 @@ def summarize(result: SessionResult) -> dict:
         "joint_error_deg": {"mean": float(lg.array("joint_err_deg").mean()) if len(t) else 0.0},
         "rejected_frames": result.rejected_frames,
         "rejections": dict(result.rejections),  # a live source's rejected packets or frames by reason
-        "ended_by": "fall" if result.fell else (result.end_reason or "duration"),
+        # a run that went on after its fall (--continue-after-fall, a viewer) ended by its duration or its reason
+        "ended_by": ("fall" if result.fell and abs(result.sim_duration_s - (result.fall_time_s or 0.0)) < 1e-6
+                     else (result.end_reason or "duration")),
         "dropped_joint_values": result.dropped_joint_values,
         "bound_violations": result.bound_counts,
         "input_latency_ms": _latency(result.input_latency_ms),
