@@ -94,6 +94,14 @@ def test_a_video_of_people_walking_runs_through_mediapipe_at_the_files_rate(tmp_
     assert times[-1] <= (n_file - 1) / fps_file + 1e-9
     assert rec.frames_without_person < 0.6 * n_file and times[-1] > 30.0
     assert np.isfinite(rec.camera_tilt_deg)
+    # one person followed: from one frame with him to the next, his hips stay within the window he was searched in
+    # (three people walk in this video; the pose model alone switches between them)
+    from stylesync.sources.person_follower import TRAVEL_TORSOS_PER_S, WINDOW_TORSOS
+
+    track = rec.hip_track_px
+    step_px = np.linalg.norm(np.diff(track[:, 1:3], axis=0), axis=1)
+    window_px = np.maximum(track[:-1, 3] * (WINDOW_TORSOS + TRAVEL_TORSOS_PER_S * np.diff(track[:, 0])), 48.0)
+    assert len(track) == len(times) and np.all(step_px <= np.sqrt(2) * window_px + 1.0)
     # the run goes through the whole track (from the first frame with a person to the last) and the rest after it,
     # past a fall
     out = tmp_path / "run"
@@ -106,3 +114,55 @@ def test_a_video_of_people_walking_runs_through_mediapipe_at_the_files_rate(tmp_
     rest_s = OperatorConfig().rest_after_clip_s
     assert metrics["sim_duration_s"] == pytest.approx(times[-1] + rest_s, abs=0.02)
     assert metrics["ended_by"] == "duration"
+
+
+class _BoxPose:
+    """A stand-in for MediaPipe Pose on images of boxes: each person is a box of his own value in channel 0, and the
+    pose found is that of the biggest box in the image (MediaPipe's "most prominent person"), its hips at the box's
+    centre and its shoulders a third of the box's height above."""
+
+    def process(self, rgb):
+        from types import SimpleNamespace
+
+        ids = [v for v in np.unique(rgb[..., 0]) if v]
+        if not ids:
+            return SimpleNamespace(pose_landmarks=None, pose_world_landmarks=None)
+        boxes = {}
+        for v in ids:
+            ys, xs = np.nonzero(rgb[..., 0] == v)
+            boxes[v] = (xs.min(), ys.min(), xs.max() + 1, ys.max() + 1)
+        x0, y0, x1, y1 = max(boxes.values(), key=lambda b: (b[2] - b[0]) * (b[3] - b[1]))
+        h, w = rgb.shape[:2]
+        hip, shoulder = ((x0 + x1) / 2 / w, (y0 + y1) / 2 / h), ((x0 + x1) / 2 / w, ((y0 + y1) / 2 - (y1 - y0) / 3) / h)
+        image = [SimpleNamespace(x=0.0, y=0.0) for _ in range(33)]
+        for k in (23, 24):
+            image[k] = SimpleNamespace(x=hip[0], y=hip[1])
+        for k in (11, 12):
+            image[k] = SimpleNamespace(x=shoulder[0], y=shoulder[1])
+        world = [SimpleNamespace(x=0.0, y=0.0, z=0.0, visibility=1.0) for _ in range(33)]
+        return SimpleNamespace(pose_landmarks=SimpleNamespace(landmark=image),
+                               pose_world_landmarks=SimpleNamespace(landmark=world))
+
+
+def test_one_person_is_followed_when_a_more_prominent_one_comes_into_view():
+    """Person 1 walks left to right; person 2, bigger (nearer the camera), walks in at the far side from t = 1 s.
+    The pose model alone would switch to person 2; the follower stays with person 1 (person_follower.py)."""
+    from stylesync.sources.person_follower import PersonFollower
+
+    def image(t: float) -> np.ndarray:
+        img = np.zeros((480, 640, 3), np.uint8)
+        x1 = int(100 + 60 * t)  # person 1: 30 x 90 px, 60 px/s
+        img[200:290, x1:x1 + 30, 0] = 1
+        if t >= 1.0:
+            x2 = int(560 - 40 * (t - 1.0))  # person 2: 50 x 150 px
+            img[150:300, x2:x2 + 50, 0] = 2
+        return img
+
+    follower, alone = PersonFollower(_BoxPose()), _BoxPose()
+    for k in range(40):  # 4 s at 10 fps
+        t = 0.1 * k
+        found = follower.find(image(t), t)
+        assert found is not None
+        assert abs(found.hip_px[0] - (int(100 + 60 * t) + 15)) <= 1, f"t = {t:.1f} s: followed {found.hip_px}"
+    hip_alone = alone.process(image(2.0)).pose_landmarks.landmark[23].x * 640
+    assert hip_alone > 400  # on its own, the pose model takes person 2

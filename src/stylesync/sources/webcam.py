@@ -12,13 +12,15 @@ second with a person (he stands) and removed; the estimate is reported (metrics.
 
 Limits: one monocular camera, so depth is inferred and noisy; the body's travel over the ground is not measured
 (world landmarks are centred on the hips, so the pelvis stays at the origin: the operator's steps show in the
-legs, not as travel); no point cloud; coarse hands and feet; one person (MediaPipe Pose follows the most prominent
-one). Landmarks with visibility below 0.5 are marked as lost.
+legs, not as travel); no point cloud; coarse hands and feet. One person: the first one found, then followed where
+he was last seen (person_follower.py), not whichever is the most prominent in each frame. Landmarks with visibility
+below 0.5 are marked as lost.
 """
 
 from __future__ import annotations
 
 import logging
+import time
 from pathlib import Path
 
 import numpy as np
@@ -28,6 +30,7 @@ from stylesync.errors import SourceError
 from stylesync.sources.frame import JOINT_INDEX, N_JOINTS
 from stylesync.sources.k4abt_json import R_WORLD_CAMERA
 from stylesync.sources.live_positions import LivePositionSource
+from stylesync.sources.person_follower import PersonFollower
 from stylesync.sources.segment_frames import canonical_quats_from_positions
 from stylesync.sources.skeleton_tracks import TrackPerformer, fill_canonical, place_on_floor
 
@@ -77,20 +80,18 @@ class MediaPipeSource(LivePositionSource):
                 raise SourceError(f"webcam index must be a number, got '{device_or_path}'") from None
         if not cap.isOpened():
             raise SourceError(f"cannot open {'video' if is_file else 'webcam'} '{device_or_path}'")
-        pose = mp.solutions.pose.Pose(model_complexity=1, static_image_mode=False)
+        follower = PersonFollower(mp.solutions.pose.Pose(model_complexity=1, static_image_mode=False))
+        clock = time.monotonic
 
         def read():
             ok, image = cap.read()
             if not ok:
                 cap.release()
                 return None
-            res = pose.process(cv2.cvtColor(image, cv2.COLOR_BGR2RGB))
-            if res.pose_world_landmarks is None:
+            found = follower.find(cv2.cvtColor(image, cv2.COLOR_BGR2RGB), clock())
+            if found is None:
                 return np.full((N_JOINTS, 3), np.nan), np.zeros(N_JOINTS)
-            lm = res.pose_world_landmarks.landmark
-            xyz = np.array([[p.x, p.y, p.z] for p in lm])
-            vis = np.array([p.visibility for p in lm])
-            return canonical_from_landmarks(xyz, vis)
+            return canonical_from_landmarks(found.world_xyz, found.visibility)
 
         super().__init__(read, name=f"{'video' if is_file else 'webcam'}:{device_or_path}")
 
@@ -133,7 +134,9 @@ class VideoRecording:
         positions: list[np.ndarray] = []
         confs: list[np.ndarray] = []
         n = 0
+        hips_px: list[np.ndarray] = []
         with mp.solutions.pose.Pose(model_complexity=1, static_image_mode=False) as pose:
+            follower = PersonFollower(pose)  # one person, followed where he was last seen (person_follower.py)
             while True:
                 ok, image = cap.read()
                 if not ok:
@@ -141,12 +144,10 @@ class VideoRecording:
                 # The file's frame rate times its frames; without one, the container's time of each frame.
                 t = n / fps if fps > 0 and np.isfinite(fps) else float(cap.get(cv2.CAP_PROP_POS_MSEC)) * 1e-3
                 n += 1
-                res = pose.process(cv2.cvtColor(image, cv2.COLOR_BGR2RGB))
-                if res.pose_world_landmarks is None:
+                found = follower.find(cv2.cvtColor(image, cv2.COLOR_BGR2RGB), t)
+                if found is None:
                     continue
-                lm = res.pose_world_landmarks.landmark
-                pos, conf = canonical_from_landmarks(np.array([[q.x, q.y, q.z] for q in lm]),
-                                                     np.array([q.visibility for q in lm]))
+                pos, conf = canonical_from_landmarks(found.world_xyz, found.visibility)
                 if not all(conf[JOINT_INDEX[j]] > 0 for j in _REQUIRED_LANDMARK_JOINTS):
                     continue
                 if times and t <= times[-1]:
@@ -154,6 +155,7 @@ class VideoRecording:
                 times.append(t)
                 positions.append(pos)
                 confs.append(conf)
+                hips_px.append(np.array([t, *found.hip_px, found.torso_px]))
         cap.release()
         if n == 0:
             raise SourceError(f"video {p}: no frames")
@@ -173,6 +175,8 @@ class VideoRecording:
         Q = canonical_quats_from_positions(P)
         fill_canonical(P, Q, C)
         self.path = p
+        # (t [s], hip x, hip y [px], torso [px]) of the followed person in each frame he was found in
+        self.hip_track_px = np.array(hips_px)
         self.frame_rate_hz = fps
         self.frames = n
         self.performer = TrackPerformer(T, P, Q, C, name=f"video:{p.name}")
