@@ -13,7 +13,8 @@ holds his whole body: a standing person is about 3.3 torso lengths tall, his hip
 far he can have walked since he was last seen. It grows while he is not found, so he is found again after he has
 been hidden. World landmarks (metres, centred on the hips) do not depend on the crop; image landmarks are mapped
 back to the whole image. A pose whose hips lie outside the window (landmarks guessed beyond the image, as for a
-person who walks out of it) or whose torso is more than twice or less than half his last one is not his.
+person who walks out of it) is not his, and neither is one whose torso is more than twice or less than half the one
+he had less than a second before.
 """
 
 from __future__ import annotations
@@ -26,7 +27,8 @@ import numpy as np
 WINDOW_TORSOS = 2.5  # half the window's side around the hips, in torso lengths
 TRAVEL_TORSOS_PER_S = 3.0  # a walking person moves about 3 torso lengths a second (1.4 m/s, 0.45 m torso)
 MIN_HALF_PX = 48  # the window is never smaller than this (half its side) [px]
-MAX_SIZE_CHANGE = 2.0  # the followed person's torso in the image grows or shrinks at most by this factor at a time
+MAX_SIZE_CHANGE = 2.0  # the followed person's torso in the image grows or shrinks at most by this factor ...
+SIZE_MEMORY_S = 1.0  # ... within this time [s]; after longer, whoever is found in the window is taken
 _HIPS, _SHOULDERS = (23, 24), (11, 12)  # BlazePose landmarks
 
 
@@ -76,8 +78,9 @@ class PersonFollower:
         torso = float(np.linalg.norm(image[list(_SHOULDERS)].mean(axis=0) - hip))
         if not (x0 <= hip[0] < x1 and y0 <= hip[1] < y1):
             return None  # landmarks guessed beyond the image: a person leaving it
-        if self.hip_px is not None and not 1 / MAX_SIZE_CHANGE <= torso / self.torso_px <= MAX_SIZE_CHANGE:
-            return None  # not the same person's size
+        recent = self.hip_px is not None and t_s - self.last_seen_s <= SIZE_MEMORY_S
+        if recent and not 1 / MAX_SIZE_CHANGE <= torso / self.torso_px <= MAX_SIZE_CHANGE:
+            return None  # not the size he had a moment ago
         self.hip_px, self.torso_px, self.last_seen_s = hip, max(torso, 1.0), t_s
         world = res.pose_world_landmarks.landmark
         return Followed(np.array([[q.x, q.y, q.z] for q in world]), np.array([q.visibility for q in world]),
