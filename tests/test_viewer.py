@@ -268,3 +268,36 @@ def test_the_floor_follows_the_character_and_a_fall_ends_the_bound_warnings():
         assert "fell" in viewer._warning.content and "bounds" not in viewer._warning.content
     finally:
         viewer.close()
+
+
+@pytest.mark.skipif(CHROMIUM is None, reason="needs headless Chromium (Debian package 'chromium')")
+def test_the_browser_shows_the_floor_under_a_character_30_s_of_walking_away():
+    """In the browser: with the character 32 m from the start (about 30 s of walking), the floor is drawn under it.
+    Hiding the floor changes the picture around the character's ground point; a floor left at the start (as before
+    the floor followed the character) would change nothing there."""
+    import dataclasses
+
+    playwright = pytest.importorskip("playwright.sync_api", reason="needs playwright (pip install playwright)")
+    ARTEFACTS.mkdir(parents=True, exist_ok=True)
+    viewer = _viewer_in_process()
+    try:
+        far = dataclasses.replace(_snap({"left": True, "right": True}), com_world=np.array([31.26, -7.1, 0.8]))
+        viewer.publish(far)  # drawn by the viewer's thread; a page that connects looks at its COM
+        with playwright.sync_playwright() as p:
+            browser = p.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox", "--use-gl=swiftshader",
+                                                                        "--enable-unsafe-swiftshader"])
+            page = browser.new_page(viewport={"width": 1000, "height": 700})
+            page.goto(viewer.url)
+            page.get_by_text("Push (throw a ball at the chest)").wait_for(timeout=30000)
+            page.wait_for_timeout(2000)
+            shots = [ARTEFACTS / "floor-shown.png", ARTEFACTS / "floor-hidden.png"]
+            page.screenshot(path=str(shots[0]))
+            viewer._ground.visible = False
+            page.wait_for_timeout(1000)
+            page.screenshot(path=str(shots[1]))
+            browser.close()
+        around_ground_point = (200, 300, 600, 650)  # the 3D view below its centre, where the camera looks at the COM
+        assert _region_change(shots[0], shots[1], around_ground_point) > 0.01
+        assert np.allclose(viewer._ground.position, (31.5, -7.0, 0.0))
+    finally:
+        viewer.close()
