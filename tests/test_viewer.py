@@ -97,6 +97,14 @@ def test_browser_sees_the_character_move_and_pushes_it(tmp_path):
                               page.inner_text("body"), re.S)
             assert shown, "the page shows no COM"
             t_com, com_shown = float(shown.group(1)), np.array([float(shown.group(k)) for k in (2, 3, 4)])
+            # How far behind the run the page is: the time it shows against the time of the tick that computed it
+            # (the session file's host monotonic clock, which this process shares).
+            shown_at = []
+            for _ in range(12):
+                page.wait_for_timeout(350)
+                before = time.monotonic()
+                t_shown = shown_t()
+                shown_at.append((t_shown, 0.5 * (before + time.monotonic())))  # the page read mid-call
             page.get_by_text("Push (throw a ball at the chest)").click()
             page.get_by_text(re.compile(r"balls thrown: 1")).wait_for(timeout=10000)
             page.wait_for_timeout(800)
@@ -118,6 +126,9 @@ def test_browser_sees_the_character_move_and_pushes_it(tmp_path):
     assert abs(times[k] - t_com) < 0.01, f"no tick at the page's t = {t_com} s"
     error_m = float(np.linalg.norm(np.asarray(ticks[k]["character_com_world"]) - com_shown))
     assert error_m < 0.02, f"the page's COM is {error_m:.3f} m from the session's at t = {t_com} s"
+    computed_at = {round(tk["t"], 4): tk["monotonic_s"] for tk in ticks}
+    lags = [seen - computed_at[round(float(times[np.argmin(np.abs(times - t))]), 4)] for t, seen in shown_at]
+    assert float(np.median(lags)) < 0.2, f"the page shows the run's time {lags} s after it was computed"
 
 
 def _port_open(port: int) -> bool:

@@ -54,7 +54,8 @@ def _run_session(cfg: SessionConfig, source, out: Path, extra: dict, args: argpa
     session = Session(cfg, source)
     run_id = secrets.token_hex(8)  # in the session file's header, metrics.json and the report
     # A run as fast as possible writes its session file when it ends (session_file.py): not in the control loop.
-    recorder = SessionRecorder(record, cfg, session, deferred=not cfg.realtime, run_id=run_id)
+    recorder = SessionRecorder(record, cfg, session, deferred=not cfg.realtime, run_id=run_id,
+                               wall_clock=cfg.realtime)
     session.on_tick = recorder.tick
     viewer = None
     if args.viewer != "none":

@@ -6,8 +6,11 @@ tick: ``t`` [s], ``root_pos_world`` [3], ``root_quat_wxyz`` [4], ``joint_pos`` [
 model axes, hinge angle first; with the root pose they fix every link), ``link_quat_wxyz`` [n_links][4] (canonical),
 ``torques_nm`` [n_joints][3] (ball: child frame; hinge: first), ``scale`` (Eq. 9),
 ``operator_stance`` and ``character_stance``
-(LS/DS/RS), ``operator_features`` [7], ``character_com_world`` [3], ``operator_pos`` [n_operator_joints][3]. The
-last line, when the run ends, is ``{"metrics": {...}}``. Floats are written with Python's shortest exact
+(LS/DS/RS), ``operator_features`` [7], ``character_com_world`` [3], ``operator_pos`` [n_operator_joints][3],
+and, in a run paced to the wall clock (``wall_clock=True``), ``monotonic_s``: the host's monotonic clock when the
+tick ran [s], to align the run with other records of the same machine, such as a viewer's or a sender's. It is not
+part of the replayed state, and it is left out of unpaced runs, whose files are byte-identical from run to run.
+The last line, when the run ends, is ``{"metrics": {...}}``. Floats are written with Python's shortest exact
 representation, so a replay reads back identical states. Units: m, s, rad, N·m; world frame z up. Lines are
 flushed every 50 ticks, so a run cut short leaves a readable file.
 
@@ -22,6 +25,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import logging
+import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any, NamedTuple
@@ -55,19 +59,21 @@ class _TickValues(NamedTuple):
     operator_features: Any
     character_com_world: np.ndarray | None
     sample: Any  # the operator sample, for its joint positions
+    monotonic_s: float | None  # the host's monotonic clock when the tick ran [s] (paced runs only)
 
 
 class SessionRecorder:
     """Writes a session file; ``tick`` is the session's ``on_tick`` hook."""
 
     def __init__(self, path: str | Path, config: Any, session: Any, deferred: bool = False,
-                 run_id: str | None = None):
+                 run_id: str | None = None, wall_clock: bool = False):
         self.path = Path(path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._f: IO[str] = self.path.open("w", encoding="utf-8")
         self._session = session
         self._n = 0
         self.deferred = deferred
+        self.wall_clock = wall_clock  # each tick's line says when it ran (monotonic_s)
         self._held: list[_TickValues] = []  # deferred ticks' values
         header = {"format": FORMAT, "version": VERSION,
                   "config": _config_dict(config),
@@ -87,7 +93,8 @@ class SessionRecorder:
         values = _TickValues(state.time_s, state.root_pos_world, state.root_quat_wxyz, state.joint_pos,
                              state.link_quat_wxyz, getattr(sess, "last_torques", None), reading.scale,
                              reading.operator_stance, ref.character_stance, reading.operator_features,
-                             getattr(sess, "last_com_world", None), getattr(sess, "last_sample", None))
+                             getattr(sess, "last_com_world", None), getattr(sess, "last_sample", None),
+                             time.monotonic() if self.wall_clock else None)
         if self.deferred and len(self._held) < MAX_DEFERRED_TICKS:
             self._held.append(values)
             return
@@ -100,7 +107,7 @@ class SessionRecorder:
         self._held = []
 
     def _write_tick(self, v: _TickValues) -> None:
-        self._write({
+        line = {
             "t": v.t, "root_pos_world": v.root_pos_world.tolist(),
             "root_quat_wxyz": v.root_quat_wxyz.tolist(), "joint_pos": v.joint_pos.tolist(),
             "link_quat_wxyz": v.link_quat_wxyz.tolist(),
@@ -110,7 +117,10 @@ class SessionRecorder:
             "operator_features": list(v.operator_features.as_row()),
             "character_com_world": v.character_com_world,
             "operator_pos": None if v.sample is None else [v.sample.pos[n].tolist() for n in TRACKED_POSITIONS],
-        })
+        }
+        if v.monotonic_s is not None:
+            line["monotonic_s"] = v.monotonic_s
+        self._write(line)
         self._n += 1
         if self._n % FLUSH_EVERY_TICKS == 0:
             self._f.flush()

@@ -36,7 +36,7 @@ from stylesync.viewer.snapshot import (
 log = logging.getLogger("stylesync.viewer")
 PLOT_WINDOW_S = 10.0  # live plots show this much history [s]
 PLOT_EVERY_S = 0.25  # live plots are redrawn at most this often [s]
-TEXT_EVERY_S = 0.25  # status and warning texts are refreshed at most this often [s]
+TEXT_EVERY_S = 0.05  # status and warning texts are refreshed at most this often [s]
 CAMERA_DEADBAND_M = 0.05  # a following camera moves once the COM has moved this far [m]
 OPERATOR_BESIDE_M = np.array([0.0, 0.9, 0.0])  # operator skeleton beside the character (world, +y) [m]
 CAMERA_OFFSET_M = (2.6, -1.6, 1.4)  # camera position relative to the COM's ground point [m]
