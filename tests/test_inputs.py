@@ -372,7 +372,7 @@ def test_vmc_frames_close_with_their_own_packet_whatever_the_message_order():
 def test_vmc_from_vmcp_own_sender_arrives_frame_by_frame():
     """A third-party VMC sender (vmcp, PyPI, over osc4py3: ``pip install 'vmcp[osc4py3]'``, an optional test
     dependency) sending bundles in its documented order (root, bones, /VMC/Ext/OK, /VMC/Ext/T): every frame is
-    received before the next is sent."""
+    received before the next is sent; then 30 s at 60 Hz lose no frame."""
     pytest.importorskip("pythonosc")
     pytest.importorskip("vmcp")
     pytest.importorskip("osc4py3")
@@ -406,9 +406,40 @@ def test_vmc_from_vmcp_own_sender_arrives_frame_by_frame():
                     osc.run()
                     time.sleep(0.0005)
                 assert source.frames_received == k + 1
-        assert source.rejected_frames == 0
-        frame = source.poll(1e9)[-1]
-        assert np.linalg.norm(frame.pos("PELVIS")[:2] - np.array([0.3, -0.2])) < 0.01
+            assert source.rejected_frames == 0
+            frame = source.poll(1e9)[-1]
+            assert np.linalg.norm(frame.pos("PELVIS")[:2] - np.array([0.3, -0.2])) < 0.01
+            # Then at 60 Hz for 30 s (osc4py3 starts once per process, so in the same session): every frame
+            # arrives, none is rejected, and each exists within 2 ms (median) of its packet's receipt: it closes
+            # with its own packet, not when the next one comes (16.7 ms later at 60 Hz).
+            n = 30 * 60
+            steady = VmcSource("127.0.0.1", 0, max_queue=n)
+            bundles = []
+            for k in range(n):
+                msgs = builder.messages(h.frame_from_pose(k / 60, np.array([0.01 * k, 0.0, h.hip_height_m]), {}))
+                tail = [m for m in msgs if m[0] == "/VMC/Ext/OK"] + [m for m in msgs if m[0] == "/VMC/Ext/T"]
+                body = [m for m in msgs if m[0] not in ("/VMC/Ext/OK", "/VMC/Ext/T")]
+                bundles.append(tuple(Message(a, typetags(v), tuple(v)) for a, v in body + tail))
+            try:
+                to_steady = osc.create_sender("127.0.0.1", steady.port, "stylesync-test-60hz").open()
+                t0 = time.perf_counter()
+                for k, bundle in enumerate(bundles):
+                    while time.perf_counter() < t0 + k / 60:
+                        time.sleep(0.0005)
+                    to_steady.send(bundle)
+                    osc.run()
+                deadline = time.perf_counter() + 2.0
+                while steady.frames_received < n and time.perf_counter() < deadline:
+                    osc.run()
+                    time.sleep(0.001)
+                assert steady.frames_received == n and steady.rejected_frames == 0
+                frames = steady.poll(1e9)
+                xs = np.array([f.pos("PELVIS")[0] for f in frames])
+                assert len(frames) == n and np.allclose(np.diff(xs), 0.01, atol=1e-3)  # in order, each its own
+                to_frame_ms = [1e3 * (f.extras["arrival_wall_s"] - f.extras["received_wall_s"]) for f in frames]
+                assert float(np.median(to_frame_ms)) < 2.0
+            finally:
+                steady.close()
     finally:
         source.close()
 
@@ -520,3 +551,4 @@ def test_k4a_json_frames_far_in_time_or_space_are_rejected_and_counted(tmp_path)
     rec = K4abtRecording(p)
     assert rec.rejected_frames == 2
     assert rec.performer.times_s[-1] < 1.0
+

@@ -13,7 +13,9 @@ from the bones' local positions (sources/skeleton_tracks.py).
 
 The socket listens on 127.0.0.1 unless another host is given. Each completed frame is stamped with its arrival
 time (``extras["arrival_wall_s"]``, ``time.perf_counter``) so that the session can measure the latency from
-arrival to the first control tick that uses it. Frames with NaN, missing bones or garbage arguments are rejected,
+arrival to the first control tick that uses it, and with its packet's receipt before parsing
+(``extras["received_wall_s"]``): a frame closes with its own packet, so receipt to frame is the parsing alone.
+Frames with NaN, missing bones or garbage arguments are rejected,
 counted and logged. :class:`VmcSender` sends operator frames in the same protocol (for tests and for relaying).
 """
 
@@ -146,6 +148,7 @@ class VmcSource(QueuedLiveSource):
         self._q_rest: dict[str, np.ndarray] | None = None
         self._t0 = time.perf_counter()
         self.frames_received = 0
+        self._received_s = self._t0
         self._root_in_packet = False
         self._frame_spoiled = False
         self._parse = osc_packet.OscPacket
@@ -183,6 +186,7 @@ class VmcSource(QueuedLiveSource):
     def _on_packet(self, data: bytes) -> None:
         """One UDP packet: its messages in order, then the end of the packet. Time tags are not waited on: a frame
         is timed on its arrival."""
+        self._received_s = time.perf_counter()  # the packet's receipt, before it is parsed
         self._root_in_packet = False
         try:
             messages = [m.message for m in self._parse(data).messages]
@@ -265,6 +269,7 @@ class VmcSource(QueuedLiveSource):
             return
         self._q_rest = q_rest
         frame.extras["arrival_wall_s"] = arrival
+        frame.extras["received_wall_s"] = self._received_s  # its (last) packet's receipt: arrival minus the parsing
         if sender_time_s is not None:
             frame.extras["sender_time_s"] = sender_time_s
         self.push(frame)
