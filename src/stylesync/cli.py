@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 from stylesync import cli_args as typed
 from stylesync.config import SHARED_DIR, VIEWER_DRAW_HZ, ClockConfig, ControlConfig, OperatorConfig, SessionConfig
 from stylesync.errors import ConfigError, SourceError, StylesyncError
+from stylesync.files import write_atomically
 
 if TYPE_CHECKING:
     from stylesync.export.session_file import SessionFile
@@ -63,10 +64,9 @@ def _run_session(cfg: SessionConfig, source, out: Path, extra: dict, args: argpa
 
         viewer = open_viewer(args.viewer, session, args.viewer_host, args.viewer_port, args.viewer_hz)
         session.on_tick = chain(recorder.tick, session_hook(session, viewer, args.viewer_hz))
-        session.stop_on_fall = False  # watching: a fall is recorded, the run goes on (Reset stands it up)
         print(f"viewer: {viewer.url}", flush=True)
-    if args.continue_after_fall:
-        session.stop_on_fall = False
+    # A fall is recorded; asked to go on, or watched (Reset stands the character up), the run does not end there.
+    session.stop_on_fall = not (args.continue_after_fall or viewer is not None)
     session.finish_on_interrupt = True  # Ctrl-C ends the run with its outputs written (exit 130)
     show = args.progress or sys.stderr.isatty()
     progress = _Progress(cfg.duration_s) if show else None
@@ -85,7 +85,7 @@ def _run_session(cfg: SessionConfig, source, out: Path, extra: dict, args: argpa
     if progress is not None:
         progress.done(result.fell, result.fall_time_s)
     metrics["session_file"] = str(record)
-    _write_atomically(out / "metrics.json", json.dumps(metrics, indent=2))
+    write_atomically(out / "metrics.json", json.dumps(metrics, indent=2))
     if args.export_bvh or args.export_mp4:
         _export(record, args.export_bvh, args.export_mp4)
     write_plots(result, out)
@@ -112,13 +112,6 @@ def _clear_outputs(out: Path, record: Path) -> None:
     for path in [out / name for name in RUN_OUTPUTS] + [record]:
         if path.is_file():
             path.unlink()
-
-
-def _write_atomically(path: Path, text: str) -> None:
-    """Write under a temporary name, then rename: a reader sees the old file or the whole new one."""
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(text)
-    tmp.replace(path)
 
 
 def _hold_viewer(viewer) -> None:

@@ -1,8 +1,8 @@
 """Where independent runs go: this process, a local process pool, or Ray (a local Ray or a cluster).
 
-:func:`execute` maps a function over argument tuples and yields each result as it ends; a run whose worker or node
-dies is submitted again (bounded). ``stylesync batch`` (batch/runner.py) and the development suite
-(metrics/dev_suite.py) use it.
+:func:`execute` maps a function over argument tuples and yields each result as it ends (:func:`execute_all`: all of
+them, in order); a run whose worker or node dies is submitted again (bounded). ``stylesync batch``
+(batch/runner.py), the bench, the development suite and the gain grid of ``experiment tune`` use it.
 """
 
 from __future__ import annotations
@@ -121,3 +121,17 @@ def execute(fn: Callable, items: list[tuple], executor: str = "processes", worke
     if executor == "processes":
         return _processes(fn, items, workers, max_retries)
     return _ray(fn, items, workers, ray_address, max_retries)
+
+
+def execute_all(fn: Callable, items: list[tuple], executor: str = "processes", workers: int | None = None,
+                on_result: Callable[[int, object, str], None] | None = None) -> list[tuple[object, str]]:
+    """:func:`execute` run to its end: each item's (result or None, note) in the items' order, its resubmissions
+    ("retry") left out. ``on_result(index, result, note)`` is called as each item ends (progress lines)."""
+    outcome: dict[int, tuple[object, str]] = {}
+    for k, result, note in execute(fn, items, executor, workers):
+        if note == "retry":
+            continue
+        outcome[k] = (result, note)
+        if on_result is not None:
+            on_result(k, result, note)
+    return [outcome[k] for k in range(len(items))]

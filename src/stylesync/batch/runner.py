@@ -27,6 +27,7 @@ import numpy as np
 from stylesync.batch.clips import BatchSettings, Job
 from stylesync.batch.job import run_job
 from stylesync.errors import ConfigError
+from stylesync.files import write_atomically
 from stylesync.parallel import EXECUTORS, execute
 
 log = logging.getLogger("stylesync.batch")
@@ -52,30 +53,21 @@ class BatchCounts:
                 f"{self.retried} retried, {rate:.1f} clips/min, ETA {eta}")
 
 
-def _write_atomically(path: Path, data: str | bytes) -> None:
-    tmp = path.with_name(f".{path.name}.tmp")
-    if isinstance(data, bytes):
-        tmp.write_bytes(data)
-    else:
-        tmp.write_text(data, encoding="utf-8")
-    tmp.replace(path)
-
-
 def write_result(out: Path, result: dict) -> None:
     """A job's files under OUT/clips/NAME; ``result.json`` last."""
     folder = out / "clips" / result["name"]
     folder.mkdir(parents=True, exist_ok=True)
     if result.get("session") is not None:
-        _write_atomically(folder / "session.jsonl", result["session"])
+        write_atomically(folder / "session.jsonl", result["session"])
     if result.get("metrics") is not None:
-        _write_atomically(folder / "metrics.json", json.dumps(result["metrics"], indent=2))
+        write_atomically(folder / "metrics.json", json.dumps(result["metrics"], indent=2))
     if result.get("bvh") is not None:
-        _write_atomically(folder / "motion.bvh", result["bvh"])
+        write_atomically(folder / "motion.bvh", result["bvh"])
     if result.get("mp4") is not None:
-        _write_atomically(folder / "motion.mp4", result["mp4"])
+        write_atomically(folder / "motion.mp4", result["mp4"])
     summary = {k: result[k] for k in ("key", "name", "clip", "seed", "group", "status", "error")}
     summary["metrics"] = _headline(result.get("metrics"))
-    _write_atomically(folder / "result.json", json.dumps(summary, indent=2))
+    write_atomically(folder / "result.json", json.dumps(summary, indent=2))
 
 
 def _headline(metrics: dict | None) -> dict | None:
@@ -177,12 +169,12 @@ def write_summary(out: Path, jobs: list[Job], settings: BatchSettings, counts: B
     summary = {"settings": settings.as_dict(), "total": counts.total, "with_result": len(results),
                "done_now": counts.done, "failed_now": counts.failed, "retried": counts.retried,
                "skipped": counts.skipped, "runs": results}
-    _write_atomically(out / "batch.json", json.dumps(summary, indent=2))
-    _write_atomically(out / "batch.md", text)
+    write_atomically(out / "batch.json", json.dumps(summary, indent=2))
+    write_atomically(out / "batch.md", text)
     rows = "".join("<tr>" + "".join(f"<td>{c.strip()}</td>" for c in line.strip("|").split("|")) + "</tr>"
                    for line in lines if not line.startswith("|---"))
     fails = "".join(f"<li>{f[2:]}</li>" for f in failures)
-    _write_atomically(out / "report.html", "<!doctype html><meta charset='utf-8'><title>stylesync batch</title>"
+    write_atomically(out / "report.html", "<!doctype html><meta charset='utf-8'><title>stylesync batch</title>"
                       "<style>body{font-family:sans-serif;max-width:1100px;margin:auto}table{border-collapse:collapse}"
                       "td{border:1px solid #ccc;padding:2px 8px}</style>"
                       f"<h1>stylesync batch</h1><p>{text.splitlines()[2]}</p><table>{rows}</table>"

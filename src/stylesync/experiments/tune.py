@@ -33,7 +33,7 @@ from stylesync.errors import SimulationError
 from stylesync.model.character import JOINT_NAMES, JOINTS, N_JOINT_DOFS, ROOT_DOFS, model_quat_from_canonical
 from stylesync.model.character_model import CharacterModel
 from stylesync.model.state import Torques
-from stylesync.parallel import execute
+from stylesync.parallel import execute_all
 from stylesync.processing.joint_map import hinge_angle
 from stylesync.sim.factory import make_backend
 from stylesync.sources.deepmimic_clip import DeepMimicClip
@@ -145,18 +145,16 @@ def run(out: Path, duration_s: float = 0.0, seed: int = 0) -> tuple[bool, dict]:
     items = [(group, PidGains(table3[group].kp * fp, ki, table3[group].kd * fd), *specs[group])
              for group in GROUPS
              for fp, fd, ki in itertools.product(KP_KD_FACTORS, KP_KD_FACTORS, (0.0, table3[group].ki))]
-    errors: dict[int, tuple[float, float]] = {}
-    for k, result, note in execute(ramp_error, items, executor="processes" if (os.cpu_count() or 1) > 1
-                                   else "inline"):
-        if note == "retry":
-            continue
+    errors: list[tuple[float, float]] = []
+    for item, (result, note) in zip(items, execute_all(ramp_error, items, executor="processes"
+                                                       if (os.cpu_count() or 1) > 1 else "inline"), strict=True):
         if not isinstance(result, tuple):
-            raise SimulationError(f"tune: a ramp of {items[k][0]} did not run ({note})")
-        errors[k] = result
+            raise SimulationError(f"tune: a ramp of {item[0]} did not run ({note})")
+        errors.append(result)
     for group in GROUPS:
         slope, height, axis = specs[group]
         base = table3[group]
-        samples = [(*errors[k], item[1]) for k, item in enumerate(items) if item[0] == group]
+        samples = [(*error, item[1]) for item, error in zip(items, errors, strict=True) if item[0] == group]
         best = min(samples, key=lambda s: s[0])
         t3 = next(s for s in samples if s[2] == base)
         rows[group] = {"ramp_slope_rad_s": slope, "ramp_height_rad": height,

@@ -129,22 +129,20 @@ def run_bench(out: Path, duration_s: float = 10.0, seed: int = 0, shared: Path |
     """The suite on the batch runner's executors (parallel.py). By default one run after another in this process:
     the realtime factors are then comparable with the physics-alone figure measured alone; runs in parallel
     (``executor`` "processes" or "ray") share the cores and their realtime factors say less."""
-    from stylesync.parallel import execute
+    from stylesync.parallel import execute_all
 
     out.mkdir(parents=True, exist_ok=True)
     specs = clip_suite(shared)
     physics = physics_only_rtf(SessionConfig(), 10.0)
     items = [(spec, name, duration_s, seed) for spec in specs for name in CONTROLLERS]
-    found: dict[int, dict] = {}
-    for k, row, note in execute(_run, items, executor, workers):
-        if note == "retry":
-            continue
+
+    def show(k: int, row: object, note: str) -> None:
         if not isinstance(row, dict):
             raise SimulationError(f"bench: {items[k][0]} with {items[k][1]} did not run ({note})")
-        found[k] = row
         status = f"fell at {row['time_to_fall_s']:.2f} s" if row["fell"] else "no fall"
         progress(f"{row['source']:<40} {row['controller']:<16} {status:<16} MPJPE {row['mpjpe_global_mm']} mm")
-    rows = [found[k] for k in sorted(found)]
+
+    rows = [row for row, _ in execute_all(_run, items, executor, workers, on_result=show) if isinstance(row, dict)]
     agg = aggregate(rows)
     stamp = datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")
     machine = f"{platform.machine()}, {platform.processor() or 'cpu'}, Python {platform.python_version()}"

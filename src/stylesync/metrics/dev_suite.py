@@ -136,21 +136,17 @@ def run_dev_suite(out: Path, seeds: int, duration_s: float, mocap: Path | None, 
                   executor: str | None = None) -> dict:
     """Run the suite on the executors of parallel.py ("processes" by default, "ray", or "inline"
     when ``workers`` is 1); writes dev_suite.md and dev_suite.json under ``out`` and returns {"rows", "table"}."""
-    from stylesync.parallel import execute
+    from stylesync.parallel import execute_all
 
     out.mkdir(parents=True, exist_ok=True)
     clips = [c for c in clip_specs(mocap) if not only or c[2] in only]
     jobs = [(spec, name, cat, seed, ctrl, duration_s) for spec, name, cat in clips for seed in range(seeds)
             for ctrl in controllers]
     executor = executor or ("processes" if workers > 1 else "inline")
-    found: dict[int, dict] = {}
-    for k, row, note in execute(_job, [(j,) for j in jobs], executor, workers):
-        if note == "retry":
-            continue
-        spec, name, cat, seed, ctrl, _ = jobs[k]
-        found[k] = row if isinstance(row, dict) else {"clip": name, "spec": spec, "category": cat, "seed": seed,
-                                                      "version": ctrl, "error": note}
-    rows = [found[k] for k in sorted(found)]
+    rows = [row if isinstance(row, dict) else {"clip": name, "spec": spec, "category": cat, "seed": seed,
+                                               "version": ctrl, "error": note}
+            for (row, note), (spec, name, cat, seed, ctrl, _) in zip(
+                execute_all(_job, [(j,) for j in jobs], executor, workers), jobs, strict=True)]
     md = table(rows, list(controllers))
     (out / "dev_suite.json").write_text(json.dumps(rows, indent=1))
     (out / "dev_suite.md").write_text(md + "\n")

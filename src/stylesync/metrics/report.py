@@ -10,6 +10,8 @@ import platform
 from importlib import metadata
 from pathlib import Path
 
+from stylesync.files import write_atomically
+
 _PACKAGES = ("stylesync", "pybullet", "numpy", "scipy", "viser", "bvhio")
 
 
@@ -103,8 +105,6 @@ def write_report(folder: str | Path) -> Path:
     style = ("body{font-family:sans-serif;max-width:1100px;margin:auto}table{border-collapse:collapse}"
              "td{border:1px solid #ccc;padding:2px 8px;font-size:13px}img{max-width:100%}")
     out = folder / "report.html"
-    tmp = folder / ".report.html.tmp"  # then renamed: a reader sees the old report or the whole new one
-    tmp.write_text(f"<!doctype html><meta charset='utf-8'><title>stylesync report</title><style>{style}</style>"
-                   + "".join(parts), encoding="utf-8")
-    tmp.replace(out)
+    write_atomically(out, f"<!doctype html><meta charset='utf-8'><title>stylesync report</title><style>{style}</style>"
+                     + "".join(parts))
     return out

@@ -15,8 +15,8 @@ The socket listens on 127.0.0.1 unless another host is given. Each completed fra
 time (``extras["arrival_wall_s"]``, ``time.perf_counter``) so that the session can measure the latency from
 arrival to the first control tick that uses it, and with its packet's receipt before parsing
 (``extras["received_wall_s"]``): a frame closes with its own packet, so receipt to frame is the parsing alone.
-Frames with NaN, missing bones or garbage arguments are rejected,
-counted and logged. :class:`VmcSender` sends operator frames in the same protocol (for tests and for relaying).
+Frames with NaN, missing bones or garbage arguments are rejected, counted and logged. :class:`VmcSender` sends
+operator frames in the same protocol (for tests and for relaying).
 """
 
 from __future__ import annotations
