@@ -172,6 +172,10 @@ class MotionConfig:
     # landing from where the hip is (a landing at the leg's full reach otherwise hovers above the ground while the
     # body runs on)
     recovery_landing_reach: bool = True
+    # The COM target asks for no capture point outside the soles the character stands on, each shrunk to this share
+    # of its length and width about its centre, in double stance, and in single stance while the operator balances
+    # over his stance sole (motion/capture_bound.py; 0: off) [-]
+    capture_bound_sole_share: float = 0.8
 
     def __post_init__(self) -> None:
         lo, hi = self.step_outside_capture_point_m
@@ -183,6 +187,9 @@ class MotionConfig:
                               f"got '{self.swing_placement}'")
         _positive("MotionConfig.stance_height_threshold_m", self.stance_height_threshold_m)
         _non_negative("MotionConfig.recovery_step_margin_m", self.recovery_step_margin_m)
+        if not 0.0 <= self.capture_bound_sole_share <= 1.0:
+            raise ConfigError(f"MotionConfig.capture_bound_sole_share must be within [0, 1], got "
+                              f"{self.capture_bound_sole_share}")
         _positive("MotionConfig.recovery_swing_s", self.recovery_swing_s)
         _non_negative("MotionConfig.recovery_step_height_m", self.recovery_step_height_m)
         _non_negative("MotionConfig.recovery_min_stance_s", self.recovery_min_stance_s)

@@ -42,6 +42,7 @@ from stylesync.model.sole import sole_outside_m, sole_within_m
 from stylesync.model.state import CharacterState, MassProperties
 from stylesync.motion.balance_strategy import stance_hip_blend, swing_hip_feedback
 from stylesync.motion.bounds import BoundsMonitor, step_length_bound_m
+from stylesync.motion.capture_bound import bounded_com_target
 from stylesync.motion.leg_ik import solve_leg
 from stylesync.motion.operator_analysis import UPPER_JOINTS, OperatorAnalysis, analyse_operator, upper_local
 from stylesync.motion.recovery_step import (
@@ -453,6 +454,29 @@ class MotionOptimizer:
         yaw_h = {k: rot.twist_angle(tick.s.quat[f"ANKLE_{v}"], _UP) for k, v in _SIDE_UP.items()}
         return operator_stands(xi_h, tick.a_h, yaw_h, tick.scale)
 
+    def _capture_bounded(self, tick: _Tick) -> bool:
+        """Whether the COM target's capture point is bounded to the character's soles this tick (capture_bound.py):
+        in the character's double stance, and in its single stance while the operator's capture point is within the
+        soles he stands on (he balances on one leg, as in a kick, or he has stopped while the character's foot is
+        still in the air)."""
+        if tick.ch_state is Stance.DS:
+            return True
+        sides = [s for s in _SIDE_UP if tick.op_state is Stance.DS or swing_side(tick.op_state) != s]
+        yaw_h = {s: rot.twist_angle(tick.s.quat[f"ANKLE_{_SIDE_UP[s]}"], _UP) for s in sides}
+        return operator_stands(self._operator_capture_point(tick), {s: tick.a_h[s] for s in sides}, yaw_h,
+                               tick.scale)
+
+    def _bounded_com_target(self, tick: _Tick, state: CharacterState, com_d: np.ndarray,
+                            com_vel_d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The COM target with its capture point within the soles the character stands on (capture_bound.py)."""
+        soles = []
+        for s in _SIDE_UP:
+            q = state.link_quat_wxyz[_LINK[f"{s}_ankle"]]
+            if tick.weights[s] > 0.0 and (tick.contact[s] or sole_within_m(tick.a_c[s], q, ON_GROUND_GAP_M)):
+                soles.append((tick.a_c[s], q))
+        _, omega = capture_point(tick.com_c, tick.com_vel_c, self.g)
+        return bounded_com_target(com_d, com_vel_d, omega, soles, self.cfg.capture_bound_sole_share)
+
     def _stopping_landing(self, tick: _Tick, state: CharacterState, side: str, xi_h: np.ndarray,
                           landing: np.ndarray) -> np.ndarray:
         """The swing foot's landing when the operator stops on this step (his capture point within his soles,
@@ -644,6 +668,8 @@ class MotionOptimizer:
             # is in the air, and the foot would land where the capture point no longer goes.
             com_d = np.array([tick.com_c[0], tick.com_c[1], tick.com_d[2]])
             com_vel_d = np.array([tick.com_vel_c[0], tick.com_vel_c[1], 0.0])
+        elif self.cfg.capture_bound_sole_share > 0.0 and self._capture_bounded(tick):
+            com_d, com_vel_d = self._bounded_com_target(tick, state, com_d, com_vel_d)
         self.reading = MotionReading(tick.op_state, tick.analysis.features, self.char_fsm.hold_reference, tick.scale,
                                      tick.step_exceeded)
         return ReferencePose(

@@ -1,0 +1,54 @@
+"""A bound on the COM target's capture point: the character is not asked to be less balanced than it can be.
+
+A capture point ξ = c + ċ / ω (Eq. 21's pendulum) outside the soles a body stands on cannot be brought back by any
+centre of pressure (recovery_step.py): following a COM target (c_d, ċ_d) of Eq. 19 whose capture point
+ξ_d = c_d + ċ_d / ω lies there, the character accelerates towards a place it cannot stop at, and must step where
+the operator does not. The retargeted target asks for that whenever the operator leans further over his feet than
+the character's smaller, differently placed feet allow: a lunge, a punch, the crouch before a jump, a walk cut off
+mid-stride. So the target's capture point is kept within the soles the character stands on:
+* in the character's double stance, always: it leaves double stance only with the operator's step, and before that
+  step there is nothing to catch a capture point outside both feet;
+* in its single stance, while the operator's own capture point is within the soles he stands on (he balances on one
+  leg, as in a kick, or has stopped while the character's foot is still in the air). Where his balance leans out of
+  his support (a walk's single stance), the character's target is left as it is: the swing foot catches it.
+
+Where ξ_d is outside, by d, the target's capture point becomes the nearest point ξ_d' of the (shrunk) support
+polygon, and its velocity is cut to ċ_d' = ċ_d max(0, 1 - d / BAND_M): c_d' = ξ_d' - ċ_d' / ω. With the
+capture-point gains of the COM task (kp = K ω², kd = (1 + K) ω, docs/decisions.md, "The COM force's gains"), the
+COM force is then the capture-point law aiming at ξ_d' with ξ̇_d' = ċ_d': beyond the band, a body standing still over
+ξ_d' (the centre of pressure brakes the body towards a capture point it can stand on); at the polygon's edge, the
+unbounded target, so that the force does not jump as ξ_d crosses it (a jump of m ω ċ_d, 150 N at 1 m/s, made runs
+from inputs a micrometre apart differ by a centimetre within 2 s).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from stylesync.model.sole import convex_hull_xy, outside_distance_m, sole_corners_in_foot, sole_corners_world
+
+# Over this distance of ξ_d beyond the polygon [m], the bounded target's velocity goes from ċ_d to zero
+BAND_M = 0.05
+
+
+def bounded_com_target(com_d_world: np.ndarray, com_vel_d_world: np.ndarray, omega_1ps: float,
+                       sole_poses: list[tuple[np.ndarray, np.ndarray]], sole_share: float
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """The COM target (position (3,) [m], velocity (3,) [m/s]) with its capture point ξ_d = c_d + ċ_d / ω
+    (``omega_1ps`` [1/s]) within the support polygon of the soles ``sole_poses`` ((ankle world position, foot
+    quaternion wxyz) each), every sole shrunk to ``sole_share`` of its size about its centre: unchanged where it is
+    within (or without soles); otherwise with its capture point on the polygon's point nearest to ξ_d and its
+    velocity cut over BAND_M (horizontally; the height and vertical velocity are kept)."""
+    if not sole_poses:
+        return com_d_world, com_vel_d_world
+    corners = sole_corners_in_foot(sole_share)
+    hull = convex_hull_xy(np.vstack([sole_corners_world(a, q, corners)[:, :2] for a, q in sole_poses]))
+    xi_d = np.asarray(com_d_world, dtype=float)[:2] + np.asarray(com_vel_d_world, dtype=float)[:2] / omega_1ps
+    outside, nearest = outside_distance_m(xi_d, hull)
+    if outside <= 0.0:
+        return com_d_world, com_vel_d_world
+    vel = np.array(com_vel_d_world, dtype=float)
+    vel[:2] *= max(0.0, 1.0 - outside / BAND_M)
+    com = np.array(com_d_world, dtype=float)
+    com[:2] = nearest - vel[:2] / omega_1ps
+    return com, vel

@@ -1,0 +1,110 @@
+"""The bound on the COM target's capture point (motion/capture_bound.py)."""
+
+import numpy as np
+import pytest
+
+from stylesync.config import ConfigError, MotionConfig, OperatorConfig, SessionConfig
+from stylesync.model.character import ANKLE_HEIGHT_M
+from stylesync.model.sole import convex_hull_xy, outside_distance_m, sole_corners_in_foot, sole_corners_world
+from stylesync.motion.capture_bound import bounded_com_target
+from stylesync.motion.recovery_step import capture_point
+
+IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
+OMEGA = 3.5
+FEET = [(np.array([0.0, 0.09, ANKLE_HEIGHT_M]), IDENTITY), (np.array([0.0, -0.09, ANKLE_HEIGHT_M]), IDENTITY)]
+
+
+def _xi(com, vel):
+    return com[:2] + vel[:2] / OMEGA
+
+
+def _outside(point, soles, share):
+    hull = convex_hull_xy(np.vstack([sole_corners_world(a, q, sole_corners_in_foot(share))[:, :2] for a, q in soles]))
+    return outside_distance_m(point, hull)[0]
+
+
+def test_a_target_whose_capture_point_is_over_the_feet_is_left_as_it_is():
+    com, vel = np.array([0.02, 0.0, 0.85]), np.array([0.1, 0.05, 0.0])
+    out_com, out_vel = bounded_com_target(com, vel, OMEGA, FEET, 0.8)
+    assert out_com is com and out_vel is vel
+    fast = 10 * vel
+    out_com, out_vel = bounded_com_target(com, fast, OMEGA, [], 0.8)
+    assert out_com is com and out_vel is fast  # no soles: nothing to bound by
+
+
+def test_a_target_leaning_past_the_toes_becomes_a_body_standing_at_the_shrunk_edge():
+    """A punch's lunge: the target 0.2 m ahead of the ankles, moving on at 0.8 m/s."""
+    com, vel = np.array([0.2, 0.0, 0.8]), np.array([0.8, 0.0, 0.1])
+    assert _outside(_xi(com, vel), FEET, 1.0) > 0.25
+    out_com, out_vel = bounded_com_target(com, vel, OMEGA, FEET, 0.8)
+    assert out_vel[:2] == pytest.approx([0.0, 0.0]) and out_vel[2] == pytest.approx(0.1)
+    assert out_com[2] == pytest.approx(0.8)
+    xi = _xi(out_com, out_vel)
+    assert _outside(xi, FEET, 0.8) == pytest.approx(0.0, abs=1e-12)  # on the shrunk polygon's edge
+    assert _outside(xi, FEET, 1.0) < -0.01  # within the whole soles, with a margin
+    assert xi[1] == pytest.approx(0.0)  # straight ahead: the nearest point of the front edge
+
+
+def test_the_bounded_target_is_continuous_as_its_capture_point_crosses_the_edge():
+    """The COM force (the PD of Eq. 16 with the capture-point gains) changes smoothly with the target: no jump as
+    ξ_d leaves the polygon, and the full cut only beyond the band."""
+    kp, kd = OMEGA ** 2, 2 * OMEGA
+    vel = np.array([0.9, 0.0, 0.0])
+    front = max(float(sole_corners_world(a, q, sole_corners_in_foot(0.8))[:, 0].max()) for a, q in FEET)
+    forces, bounded = [], []
+    for d in np.linspace(-0.01, 0.01, 201):  # ξ_d from 1 cm inside the shrunk front edge to 1 cm outside it
+        xi_d = np.array([front + d, 0.0])
+        com = np.array([*(xi_d - vel[:2] / OMEGA), 0.8])
+        c, v = bounded_com_target(com, vel, OMEGA, FEET, 0.8)
+        forces.append(kp * c[0] + kd * v[0])
+        bounded.append(c is not com)
+    assert not bounded[0] and bounded[-1]
+    assert np.max(np.abs(np.diff(forces))) < 0.1  # per 0.1 mm of ξ_d [N/kg]
+    far = np.array([*(np.array([front + 0.2, 0.0]) - vel[:2] / OMEGA), 0.8])
+    assert bounded_com_target(far, vel, OMEGA, FEET, 0.8)[1][0] == 0.0
+
+
+def test_on_one_foot_the_bound_is_that_sole():
+    stance = FEET[:1]
+    com, vel = np.array([0.0, 0.0, 0.8]), np.array([0.0, -0.4, 0.0])  # drifting off the left sole, inwards
+    out_com, out_vel = bounded_com_target(com, vel, OMEGA, stance, 0.8)
+    assert _outside(_xi(out_com, out_vel), stance, 0.8) == pytest.approx(0.0, abs=1e-12)
+    assert out_com[1] > 0.05  # over the left sole, not between the feet
+
+
+def test_the_share_is_checked():
+    with pytest.raises(ConfigError):
+        MotionConfig(capture_bound_sole_share=1.2)
+
+
+def test_a_lunge_the_character_cannot_stop_from_is_not_asked_for():
+    """The built-in punch (seed 1): the operator lunges and punches. Without the bound the character's COM target
+    leans past its feet in double stance, it runs forward into the operator's step and falls (measured: 3.3 s); with
+    it the punch holds for 12 s. And wherever the character stood on both feet, the target it was given had its
+    capture point within its soles."""
+    from stylesync.session import Session
+    from stylesync.sources.registry import open_source
+
+    def run(motion: MotionConfig):
+        opened = open_source("builtin:punch", seed=1, duration_s=12.0)
+        cfg = SessionConfig(duration_s=12.0, seed=1, operator=OperatorConfig(), motion=motion)
+        session = Session(cfg, opened.source)
+        worst = [-np.inf]
+
+        def on_tick(state, ref):
+            if ref.character_stance.name == "DS" and motion.capture_bound_sole_share > 0.0:
+                _, omega = capture_point(session.mass.com(state), session.mass.com_velocity(state), 9.8)
+                xi = ref.com_world[:2] + ref.com_vel_world[:2] / omega
+                feet = [(state.link_origin_world[k], state.link_quat_wxyz[k]) for k in (5, 11)]
+                worst[0] = max(worst[0], _outside(xi, feet, 1.0))
+
+        session.on_tick = on_tick
+        result = session.run()
+        opened.source.close()
+        return result, worst[0]
+
+    bounded, worst = run(MotionConfig())
+    assert not bounded.fell
+    assert worst <= 0.0
+    unbounded, _ = run(MotionConfig(capture_bound_sole_share=0.0))
+    assert unbounded.fell and unbounded.fall_time_s < 6.0
