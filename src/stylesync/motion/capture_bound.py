@@ -1,4 +1,4 @@
-"""A bound on the COM target's capture point: the character is not asked to be less balanced than it can be.
+"""A bound on the COM target's capture point: the character is not asked for a lean it cannot come back from.
 
 A capture point ξ = c + ċ / ω (Eq. 21's pendulum) outside the soles a body stands on cannot be brought back by any
 centre of pressure (recovery_step.py): following a COM target (c_d, ċ_d) of Eq. 19 whose capture point
@@ -14,8 +14,9 @@ mid-stride. So the target's capture point is kept within the soles the character
 
 Where ξ_d is outside, by d, the target's capture point becomes the nearest point ξ_d' of the (shrunk) support
 polygon, and its velocity is cut to ċ_d' = ċ_d max(0, 1 - d / BAND_M): c_d' = ξ_d' - ċ_d' / ω. With the
-capture-point gains of the COM task (kp = K ω², kd = (1 + K) ω, docs/decisions.md, "The COM force's gains"), the
-COM force is then the capture-point law aiming at ξ_d' with ξ̇_d' = ċ_d': beyond the band, a body standing still over
+capture-point gains of the COM task (kp = K ω², kd = (1 + K) ω, docs/decisions.md, "The COM force's gains"; exact
+where the COM height gives their ω, about 3.4 1/s), the COM force is then the capture-point law aiming at ξ_d' with
+ξ̇_d' = ċ_d': beyond the band, a body standing still over
 ξ_d' (the centre of pressure brakes the body towards a capture point it can stand on); at the polygon's edge, the
 unbounded target, so that the force does not jump as ξ_d crosses it (a jump of m ω ċ_d, 150 N at 1 m/s, made runs
 from inputs a micrometre apart differ by a centimetre within 2 s).
