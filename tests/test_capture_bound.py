@@ -6,12 +6,17 @@ import pytest
 from stylesync.config import ConfigError, MotionConfig, OperatorConfig, SessionConfig
 from stylesync.model.character import ANKLE_HEIGHT_M
 from stylesync.model.sole import convex_hull_xy, outside_distance_m, sole_corners_in_foot, sole_corners_world
+from stylesync.motion import capture_bound as cb
 from stylesync.motion.capture_bound import bounded_com_target
 from stylesync.motion.recovery_step import capture_point
 
 IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
 OMEGA = 3.5
 FEET = [(np.array([0.0, 0.09, ANKLE_HEIGHT_M]), IDENTITY), (np.array([0.0, -0.09, ANKLE_HEIGHT_M]), IDENTITY)]
+
+
+def _soles(feet, share):
+    return [cb.sole_xy(a, q, cb.corners_in_foot(share)) for a, q in feet]
 
 
 def _xi(com, vel):
@@ -25,10 +30,10 @@ def _outside(point, soles, share):
 
 def test_a_target_whose_capture_point_is_over_the_feet_is_left_as_it_is():
     com, vel = np.array([0.02, 0.0, 0.85]), np.array([0.1, 0.05, 0.0])
-    out_com, out_vel = bounded_com_target(com, vel, OMEGA, FEET, 0.8)
+    out_com, out_vel = bounded_com_target(com, vel, OMEGA, _soles(FEET, 0.8))
     assert out_com is com and out_vel is vel
     fast = 10 * vel
-    out_com, out_vel = bounded_com_target(com, fast, OMEGA, [], 0.8)
+    out_com, out_vel = bounded_com_target(com, fast, OMEGA, [])
     assert out_com is com and out_vel is fast  # no soles: nothing to bound by
 
 
@@ -36,7 +41,7 @@ def test_a_target_leaning_past_the_toes_becomes_a_body_standing_at_the_shrunk_ed
     """A punch's lunge: the target 0.2 m ahead of the ankles, moving on at 0.8 m/s."""
     com, vel = np.array([0.2, 0.0, 0.8]), np.array([0.8, 0.0, 0.1])
     assert _outside(_xi(com, vel), FEET, 1.0) > 0.25
-    out_com, out_vel = bounded_com_target(com, vel, OMEGA, FEET, 0.8)
+    out_com, out_vel = bounded_com_target(com, vel, OMEGA, _soles(FEET, 0.8))
     assert out_vel[:2] == pytest.approx([0.0, 0.0]) and out_vel[2] == pytest.approx(0.1)
     assert out_com[2] == pytest.approx(0.8)
     xi = _xi(out_com, out_vel)
@@ -55,21 +60,43 @@ def test_the_bounded_target_is_continuous_as_its_capture_point_crosses_the_edge(
     for d in np.linspace(-0.01, 0.01, 201):  # ξ_d from 1 cm inside the shrunk front edge to 1 cm outside it
         xi_d = np.array([front + d, 0.0])
         com = np.array([*(xi_d - vel[:2] / OMEGA), 0.8])
-        c, v = bounded_com_target(com, vel, OMEGA, FEET, 0.8)
+        c, v = bounded_com_target(com, vel, OMEGA, _soles(FEET, 0.8))
         forces.append(kp * c[0] + kd * v[0])
         bounded.append(c is not com)
     assert not bounded[0] and bounded[-1]
     assert np.max(np.abs(np.diff(forces))) < 0.1  # per 0.1 mm of ξ_d [N/kg]
     far = np.array([*(np.array([front + 0.2, 0.0]) - vel[:2] / OMEGA), 0.8])
-    assert bounded_com_target(far, vel, OMEGA, FEET, 0.8)[1][0] == 0.0
+    assert bounded_com_target(far, vel, OMEGA, _soles(FEET, 0.8))[1][0] == 0.0
 
 
 def test_on_one_foot_the_bound_is_that_sole():
     stance = FEET[:1]
     com, vel = np.array([0.0, 0.0, 0.8]), np.array([0.0, -0.4, 0.0])  # drifting off the left sole, inwards
-    out_com, out_vel = bounded_com_target(com, vel, OMEGA, stance, 0.8)
+    out_com, out_vel = bounded_com_target(com, vel, OMEGA, _soles(stance, 0.8))
     assert _outside(_xi(out_com, out_vel), stance, 0.8) == pytest.approx(0.0, abs=1e-12)
     assert out_com[1] > 0.05  # over the left sole, not between the feet
+
+
+def test_the_plain_float_geometry_is_the_sole_modules():
+    """The per-tick polygon tests on plain floats give the support polygon, distance and nearest point of
+    model/sole.py's numpy versions (to rounding), for tilted, turned feet and points inside and out."""
+    rng = np.random.default_rng(0)
+    for _ in range(200):
+        feet = []
+        for side in (1.0, -1.0):
+            axis = rng.normal(size=3)
+            angle = rng.uniform(-0.4, 0.4)
+            q = np.array([np.cos(angle / 2), *(np.sin(angle / 2) * axis / np.linalg.norm(axis))])
+            feet.append((np.array([rng.uniform(-0.3, 0.3), side * rng.uniform(0.05, 0.2), ANKLE_HEIGHT_M]), q))
+        share = rng.uniform(0.5, 1.0)
+        points = np.vstack([sole_corners_world(a, q, sole_corners_in_foot(share))[:, :2] for a, q in feet])
+        polygon = cb.hull([p for sole in _soles(feet, share) for p in sole])
+        assert np.array(polygon) == pytest.approx(convex_hull_xy(points), abs=1e-12)
+        point = rng.uniform(-0.5, 0.5, size=2)
+        distance, nearest = cb.outside((float(point[0]), float(point[1])), polygon)
+        expected, expected_nearest = outside_distance_m(point, convex_hull_xy(points))
+        assert distance == pytest.approx(expected, abs=1e-12)
+        assert np.array(nearest) == pytest.approx(expected_nearest, abs=1e-12)
 
 
 def test_the_share_is_checked():

@@ -40,9 +40,9 @@ from stylesync.model.character import (
 )
 from stylesync.model.sole import sole_outside_m, sole_within_m
 from stylesync.model.state import CharacterState, MassProperties
+from stylesync.motion import capture_bound as cb
 from stylesync.motion.balance_strategy import stance_hip_blend, swing_hip_feedback
 from stylesync.motion.bounds import BoundsMonitor, step_length_bound_m
-from stylesync.motion.capture_bound import bounded_com_target
 from stylesync.motion.leg_ik import solve_leg
 from stylesync.motion.operator_analysis import UPPER_JOINTS, OperatorAnalysis, analyse_operator, upper_local
 from stylesync.motion.recovery_step import (
@@ -214,6 +214,8 @@ class MotionOptimizer:
         self._op_last_ds_s = 0.0
         self.recovery = RecoveryStepper(cfg, CHAR_LEG_LENGTH_M, gravity_mps2)
         self._operator_stands_since_s: float | None = None
+        self._sole_full = cb.corners_in_foot()  # the character's sole, relative to the ankle [m]
+        self._sole_bound = cb.corners_in_foot(cfg.capture_bound_sole_share)  # shrunk for capture_bound.py
         self.reading: MotionReading | None = None  # the last tick's reading of the operator, besides the targets
 
     def update(self, sample: OperatorSample, state: CharacterState, mass: MassProperties,
@@ -458,13 +460,14 @@ class MotionOptimizer:
         """Whether the COM target's capture point is bounded to the character's soles this tick (capture_bound.py):
         in the character's double stance, and in its single stance while the operator's capture point is within the
         soles he stands on (he balances on one leg, as in a kick, or he has stopped while the character's foot is
-        still in the air)."""
+        still in the air); his soles the character's scaled to him, as in recovery_step.operator_stands."""
         if tick.ch_state is Stance.DS:
             return True
-        sides = [s for s in _SIDE_UP if tick.op_state is Stance.DS or swing_side(tick.op_state) != s]
-        yaw_h = {s: rot.twist_angle(tick.s.quat[f"ANKLE_{_SIDE_UP[s]}"], _UP) for s in sides}
-        return operator_stands(self._operator_capture_point(tick), {s: tick.a_h[s] for s in sides}, yaw_h,
-                               tick.scale)
+        corners = [(x / tick.scale, y / tick.scale, z / tick.scale) for x, y, z in self._sole_full]
+        soles = [cb.sole_xy_yaw(tick.a_h[s], rot.twist_angle(tick.s.quat[f"ANKLE_{_SIDE_UP[s]}"], _UP), corners)
+                 for s in _SIDE_UP if tick.op_state is Stance.DS or swing_side(tick.op_state) != s]
+        xi_h = self._operator_capture_point(tick)
+        return cb.outside((float(xi_h[0]), float(xi_h[1])), cb.hull([p for sole in soles for p in sole]))[0] <= 0.0
 
     def _bounded_com_target(self, tick: _Tick, state: CharacterState, com_d: np.ndarray,
                             com_vel_d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -473,9 +476,9 @@ class MotionOptimizer:
         for s in _SIDE_UP:
             q = state.link_quat_wxyz[_LINK[f"{s}_ankle"]]
             if tick.weights[s] > 0.0 and (tick.contact[s] or sole_within_m(tick.a_c[s], q, ON_GROUND_GAP_M)):
-                soles.append((tick.a_c[s], q))
+                soles.append(cb.sole_xy(tick.a_c[s], q, self._sole_bound))
         _, omega = capture_point(tick.com_c, tick.com_vel_c, self.g)
-        return bounded_com_target(com_d, com_vel_d, omega, soles, self.cfg.capture_bound_sole_share)
+        return cb.bounded_com_target(com_d, com_vel_d, omega, soles)
 
     def _stopping_landing(self, tick: _Tick, state: CharacterState, side: str, xi_h: np.ndarray,
                           landing: np.ndarray) -> np.ndarray:
