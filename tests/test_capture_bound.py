@@ -5,7 +5,13 @@ import pytest
 
 from stylesync.config import ConfigError, MotionConfig, OperatorConfig, SessionConfig
 from stylesync.model.character import ANKLE_HEIGHT_M
-from stylesync.model.sole import convex_hull_xy, outside_distance_m, sole_corners_in_foot, sole_corners_world
+from stylesync.model.sole import (
+    convex_hull_points,
+    convex_hull_xy,
+    outside_distance_m,
+    sole_corners_in_foot,
+    sole_corners_world,
+)
 from stylesync.motion import capture_bound as cb
 from stylesync.motion.capture_bound import bounded_com_target
 from stylesync.motion.recovery_step import capture_point
@@ -90,7 +96,7 @@ def test_the_plain_float_geometry_is_the_sole_modules():
             feet.append((np.array([rng.uniform(-0.3, 0.3), side * rng.uniform(0.05, 0.2), ANKLE_HEIGHT_M]), q))
         share = rng.uniform(0.5, 1.0)
         points = np.vstack([sole_corners_world(a, q, sole_corners_in_foot(share))[:, :2] for a, q in feet])
-        polygon = cb.hull([p for sole in _soles(feet, share) for p in sole])
+        polygon = convex_hull_points([p for sole in _soles(feet, share) for p in sole])
         assert np.array(polygon) == pytest.approx(convex_hull_xy(points), abs=1e-12)
         point = rng.uniform(-0.5, 0.5, size=2)
         distance, nearest = cb.outside((float(point[0]), float(point[1])), polygon)

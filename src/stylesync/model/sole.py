@@ -34,14 +34,17 @@ def sole_within_m(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray, gap_m: fl
     return float(sole_corners_world(ankle_world, foot_quat_wxyz, corners_in_foot)[:, 2].min()) < gap_m
 
 
-def convex_hull_xy(points_xy: np.ndarray) -> np.ndarray:
-    """(k, 2) counter-clockwise convex hull of horizontal points (n, 2) (Andrew's monotone chain)."""
-    pts = sorted({(float(x), float(y)) for x, y in np.asarray(points_xy, dtype=float)[:, :2]})
+Point = tuple[float, float]
+
+
+def convex_hull_points(points: list[Point]) -> list[Point]:
+    """Counter-clockwise convex hull of horizontal points given as plain floats (Andrew's monotone chain)."""
+    pts = sorted(set(points))
     if len(pts) <= 2:
-        return np.array(pts)
+        return pts
 
     def half(seq):
-        out: list[tuple[float, float]] = []
+        out: list[Point] = []
         for p in seq:
             while len(out) >= 2 and ((out[-1][0] - out[-2][0]) * (p[1] - out[-2][1])
                                      - (out[-1][1] - out[-2][1]) * (p[0] - out[-2][0])) <= 0.0:
@@ -50,7 +53,12 @@ def convex_hull_xy(points_xy: np.ndarray) -> np.ndarray:
         return out
 
     lower, upper = half(pts), half(reversed(pts))
-    return np.array(lower[:-1] + upper[:-1])
+    return lower[:-1] + upper[:-1]
+
+
+def convex_hull_xy(points_xy: np.ndarray) -> np.ndarray:
+    """(k, 2) counter-clockwise convex hull of horizontal points (n, 2) (:func:`convex_hull_points`)."""
+    return np.array(convex_hull_points([(float(x), float(y)) for x, y in np.asarray(points_xy, dtype=float)[:, :2]]))
 
 
 def outside_distance_m(point_xy: np.ndarray, hull_xy: np.ndarray) -> tuple[float, np.ndarray]:

@@ -31,12 +31,11 @@ import math
 
 import numpy as np
 
-from stylesync.model.sole import sole_corners_in_foot
+from stylesync.model.sole import Point, convex_hull_points, sole_corners_in_foot
 
 # Over this distance of ξ_d beyond the polygon [m], the bounded target's velocity goes from ċ_d to zero
 BAND_M = 0.05
 
-Point = tuple[float, float]
 Corner = tuple[float, float, float]
 
 
@@ -62,28 +61,10 @@ def sole_xy_yaw(ankle_world: np.ndarray, yaw_rad: float, corners: list[Corner]) 
     return [(ax + c * cx - s * cy, ay + s * cx + c * cy) for cx, cy, _ in corners]
 
 
-def hull(points: list[Point]) -> list[Point]:
-    """Counter-clockwise convex hull (Andrew's monotone chain)."""
-    pts = sorted(set(points))
-    if len(pts) <= 2:
-        return pts
-
-    def half(seq):
-        out: list[Point] = []
-        for p in seq:
-            while len(out) >= 2 and ((out[-1][0] - out[-2][0]) * (p[1] - out[-2][1])
-                                     - (out[-1][1] - out[-2][1]) * (p[0] - out[-2][0])) <= 0.0:
-                out.pop()
-            out.append(p)
-        return out
-
-    lower, upper = half(pts), half(list(reversed(pts)))
-    return lower[:-1] + upper[:-1]
-
-
 def outside(point: Point, polygon: list[Point]) -> tuple[float, Point]:
-    """Signed distance of a point from a convex polygon (:func:`hull`): > 0 outside, < 0 inside [m]; and the
-    polygon's point nearest to it (the point itself when inside)."""
+    """Signed distance of a point from a convex polygon (model/sole.convex_hull_points): > 0 outside, < 0 inside
+    [m]; and the polygon's point nearest to it (the point itself when inside). model/sole.outside_distance_m on
+    plain floats."""
     px, py = point
     n = len(polygon)
     best, nearest, margin = math.inf, point, math.inf
@@ -118,7 +99,7 @@ def bounded_com_target(com_d_world: np.ndarray, com_vel_d_world: np.ndarray, ome
     height and vertical velocity are kept)."""
     if not soles_xy:
         return com_d_world, com_vel_d_world
-    polygon = hull([p for sole in soles_xy for p in sole])
+    polygon = convex_hull_points([p for sole in soles_xy for p in sole])
     vx, vy = float(com_vel_d_world[0]), float(com_vel_d_world[1])
     xi_d = (float(com_d_world[0]) + vx / omega_1ps, float(com_d_world[1]) + vy / omega_1ps)
     distance, (nx, ny) = outside(xi_d, polygon)

@@ -38,7 +38,7 @@ from stylesync.model.character import (
     batch_model_quat_from_canonical,
     canonical_quat_from_model,
 )
-from stylesync.model.sole import sole_outside_m, sole_within_m
+from stylesync.model.sole import convex_hull_points, sole_outside_m, sole_within_m
 from stylesync.model.state import CharacterState, MassProperties
 from stylesync.motion import capture_bound as cb
 from stylesync.motion.balance_strategy import stance_hip_blend, swing_hip_feedback
@@ -467,7 +467,8 @@ class MotionOptimizer:
         soles = [cb.sole_xy_yaw(tick.a_h[s], rot.twist_angle(tick.s.quat[f"ANKLE_{_SIDE_UP[s]}"], _UP), corners)
                  for s in _SIDE_UP if tick.op_state is Stance.DS or swing_side(tick.op_state) != s]
         xi_h = self._operator_capture_point(tick)
-        return cb.outside((float(xi_h[0]), float(xi_h[1])), cb.hull([p for sole in soles for p in sole]))[0] <= 0.0
+        polygon = convex_hull_points([p for sole in soles for p in sole])
+        return cb.outside((float(xi_h[0]), float(xi_h[1])), polygon)[0] <= 0.0
 
     def _bounded_com_target(self, tick: _Tick, state: CharacterState, com_d: np.ndarray,
                             com_vel_d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
