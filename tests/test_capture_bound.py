@@ -9,10 +9,12 @@ from stylesync.model.sole import (
     convex_hull_points,
     convex_hull_xy,
     outside_distance_m,
+    outside_distance_points,
+    sole_corner_points,
     sole_corners_in_foot,
     sole_corners_world,
+    sole_points_xy,
 )
-from stylesync.motion import capture_bound as cb
 from stylesync.motion.capture_bound import bounded_com_target
 from stylesync.motion.recovery_step import capture_point
 
@@ -22,7 +24,7 @@ FEET = [(np.array([0.0, 0.09, ANKLE_HEIGHT_M]), IDENTITY), (np.array([0.0, -0.09
 
 
 def _soles(feet, share):
-    return [cb.sole_xy(a, q, cb.corners_in_foot(share)) for a, q in feet]
+    return [sole_points_xy(a, q, sole_corner_points(share)) for a, q in feet]
 
 
 def _xi(com, vel):
@@ -99,7 +101,7 @@ def test_the_plain_float_geometry_is_the_sole_modules():
         polygon = convex_hull_points([p for sole in _soles(feet, share) for p in sole])
         assert np.array(polygon) == pytest.approx(convex_hull_xy(points), abs=1e-12)
         point = rng.uniform(-0.5, 0.5, size=2)
-        distance, nearest = cb.outside((float(point[0]), float(point[1])), polygon)
+        distance, nearest = outside_distance_points((float(point[0]), float(point[1])), polygon)
         expected, expected_nearest = outside_distance_m(point, convex_hull_xy(points))
         assert distance == pytest.approx(expected, abs=1e-12)
         assert np.array(nearest) == pytest.approx(expected_nearest, abs=1e-12)

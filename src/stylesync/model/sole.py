@@ -3,6 +3,8 @@ span on the ground."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from stylesync import rotations as rot
@@ -35,6 +37,29 @@ def sole_within_m(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray, gap_m: fl
 
 
 Point = tuple[float, float]
+Corner = tuple[float, float, float]
+
+
+def sole_corner_points(share: float = 1.0) -> list[Corner]:
+    """:func:`sole_corners_in_foot` as plain floats, for the per-tick polygon tests [m]."""
+    return [(float(x), float(y), float(z)) for x, y, z in sole_corners_in_foot(share)]
+
+
+def sole_points_xy(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray, corners: list[Corner]) -> list[Point]:
+    """World horizontal positions [m] of a foot's sole corners ``corners`` (:func:`sole_corner_points`):
+    :func:`sole_corners_world` on plain floats."""
+    w, x, y, z = (float(v) for v in foot_quat_wxyz)
+    r00, r01, r02 = 1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z), 2.0 * (x * z + w * y)
+    r10, r11, r12 = 2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - w * x)
+    ax, ay = float(ankle_world[0]), float(ankle_world[1])
+    return [(ax + r00 * cx + r01 * cy + r02 * cz, ay + r10 * cx + r11 * cy + r12 * cz) for cx, cy, cz in corners]
+
+
+def sole_points_xy_yaw(ankle_world: np.ndarray, yaw_rad: float, corners: list[Corner]) -> list[Point]:
+    """As :func:`sole_points_xy` for a flat foot turned by ``yaw_rad`` about the vertical."""
+    c, s = math.cos(yaw_rad), math.sin(yaw_rad)
+    ax, ay = float(ankle_world[0]), float(ankle_world[1])
+    return [(ax + c * cx - s * cy, ay + s * cx + c * cy) for cx, cy, _ in corners]
 
 
 def convex_hull_points(points: list[Point]) -> list[Point]:
@@ -85,6 +110,34 @@ def outside_distance_m(point_xy: np.ndarray, hull_xy: np.ndarray) -> tuple[float
                 inside_margin = min(inside_margin, cross / np.sqrt(length2))
     if inside:
         return -float(inside_margin), p.copy()
+    return best, nearest
+
+
+def outside_distance_points(point: Point, polygon: list[Point]) -> tuple[float, Point]:
+    """:func:`outside_distance_m` on plain floats (a polygon from :func:`convex_hull_points`): the signed distance
+    [m], > 0 outside, and the polygon's point nearest to the point (the point itself when inside)."""
+    px, py = point
+    n = len(polygon)
+    best, nearest, margin = math.inf, point, math.inf
+    inside = n >= 3
+    for k in range(n):
+        ax, ay = polygon[k]
+        bx, by = polygon[(k + 1) % n]
+        ex, ey = bx - ax, by - ay
+        length2 = ex * ex + ey * ey
+        t = 0.0 if length2 < 1e-12 else min(max(((px - ax) * ex + (py - ay) * ey) / length2, 0.0), 1.0)
+        qx, qy = ax + t * ex, ay + t * ey
+        d = math.hypot(px - qx, py - qy)
+        if d < best:
+            best, nearest = d, (qx, qy)
+        if n >= 3:
+            cross = ex * (py - ay) - ey * (px - ax)  # > 0: left of the edge (inside)
+            if cross < 0.0:
+                inside = False
+            elif length2 > 1e-12:
+                margin = min(margin, cross / math.sqrt(length2))
+    if inside:
+        return -margin, point
     return best, nearest
 
 

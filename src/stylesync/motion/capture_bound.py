@@ -21,88 +21,33 @@ where the COM height gives their ω, about 3.4 1/s), the COM force is then the c
 unbounded target, so that the force does not jump as ξ_d crosses it (a jump of m ω ċ_d, 150 N at 1 m/s, made runs
 from inputs a micrometre apart differ by a centimetre within 2 s).
 
-The polygon tests run on every control tick, so they are written on plain floats (a few corners; numpy's per-call
-overhead was most of their cost).
+The polygon tests run on every control tick, on plain floats (model/sole.py's ``*_points`` functions: a few
+corners, where numpy's per-call overhead was most of the cost).
 """
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from stylesync.model.sole import Point, convex_hull_points, sole_corners_in_foot
+from stylesync.model.sole import Point, convex_hull_points, outside_distance_points
 
 # Over this distance of ξ_d beyond the polygon [m], the bounded target's velocity goes from ċ_d to zero
 BAND_M = 0.05
-
-Corner = tuple[float, float, float]
-
-
-def corners_in_foot(share: float = 1.0) -> list[Corner]:
-    """The sole's corners relative to the ankle in the foot frame (model/sole.py), shrunk to ``share`` of its length
-    and width about its centre [m]."""
-    return [(float(x), float(y), float(z)) for x, y, z in sole_corners_in_foot(share)]
-
-
-def sole_xy(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray, corners: list[Corner]) -> list[Point]:
-    """World horizontal positions [m] of a foot's sole corners ``corners`` (:func:`corners_in_foot`)."""
-    w, x, y, z = (float(v) for v in foot_quat_wxyz)
-    r00, r01, r02 = 1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z), 2.0 * (x * z + w * y)
-    r10, r11, r12 = 2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - w * x)
-    ax, ay = float(ankle_world[0]), float(ankle_world[1])
-    return [(ax + r00 * cx + r01 * cy + r02 * cz, ay + r10 * cx + r11 * cy + r12 * cz) for cx, cy, cz in corners]
-
-
-def sole_xy_yaw(ankle_world: np.ndarray, yaw_rad: float, corners: list[Corner]) -> list[Point]:
-    """As :func:`sole_xy` for a flat foot turned by ``yaw_rad`` about the vertical."""
-    c, s = math.cos(yaw_rad), math.sin(yaw_rad)
-    ax, ay = float(ankle_world[0]), float(ankle_world[1])
-    return [(ax + c * cx - s * cy, ay + s * cx + c * cy) for cx, cy, _ in corners]
-
-
-def outside(point: Point, polygon: list[Point]) -> tuple[float, Point]:
-    """Signed distance of a point from a convex polygon (model/sole.convex_hull_points): > 0 outside, < 0 inside
-    [m]; and the polygon's point nearest to it (the point itself when inside). model/sole.outside_distance_m on
-    plain floats."""
-    px, py = point
-    n = len(polygon)
-    best, nearest, margin = math.inf, point, math.inf
-    inside = n >= 3
-    for k in range(n):
-        ax, ay = polygon[k]
-        bx, by = polygon[(k + 1) % n]
-        ex, ey = bx - ax, by - ay
-        length2 = ex * ex + ey * ey
-        t = 0.0 if length2 < 1e-12 else min(max(((px - ax) * ex + (py - ay) * ey) / length2, 0.0), 1.0)
-        qx, qy = ax + t * ex, ay + t * ey
-        d = math.hypot(px - qx, py - qy)
-        if d < best:
-            best, nearest = d, (qx, qy)
-        if n >= 3:
-            cross = ex * (py - ay) - ey * (px - ax)  # > 0: left of the edge (inside)
-            if cross < 0.0:
-                inside = False
-            elif length2 > 1e-12:
-                margin = min(margin, cross / math.sqrt(length2))
-    if inside:
-        return -margin, point
-    return best, nearest
 
 
 def bounded_com_target(com_d_world: np.ndarray, com_vel_d_world: np.ndarray, omega_1ps: float,
                        soles_xy: list[list[Point]]) -> tuple[np.ndarray, np.ndarray]:
     """The COM target (position (3,) [m], velocity (3,) [m/s]) with its capture point ξ_d = c_d + ċ_d / ω
     (``omega_1ps`` [1/s]) within the support polygon of the soles ``soles_xy`` (each its corners' world horizontal
-    positions, :func:`sole_xy`, shrunk as wanted): unchanged where it is within (or without soles); otherwise with
-    its capture point on the polygon's point nearest to ξ_d and its velocity cut over BAND_M (horizontally; the
-    height and vertical velocity are kept)."""
+    positions, model/sole.sole_points_xy, shrunk as wanted): unchanged where it is within (or without soles);
+    otherwise with its capture point on the polygon's point nearest to ξ_d and its velocity cut over BAND_M
+    (horizontally; the height and vertical velocity are kept)."""
     if not soles_xy:
         return com_d_world, com_vel_d_world
     polygon = convex_hull_points([p for sole in soles_xy for p in sole])
     vx, vy = float(com_vel_d_world[0]), float(com_vel_d_world[1])
     xi_d = (float(com_d_world[0]) + vx / omega_1ps, float(com_d_world[1]) + vy / omega_1ps)
-    distance, (nx, ny) = outside(xi_d, polygon)
+    distance, (nx, ny) = outside_distance_points(xi_d, polygon)
     if distance <= 0.0:
         return com_d_world, com_vel_d_world
     keep = max(0.0, 1.0 - distance / BAND_M)

@@ -38,11 +38,11 @@ from stylesync.model.character import (
     batch_model_quat_from_canonical,
     canonical_quat_from_model,
 )
-from stylesync.model.sole import convex_hull_points, sole_outside_m, sole_within_m
+from stylesync.model.sole import sole_corner_points, sole_outside_m, sole_points_xy, sole_within_m
 from stylesync.model.state import CharacterState, MassProperties
-from stylesync.motion import capture_bound as cb
 from stylesync.motion.balance_strategy import stance_hip_blend, swing_hip_feedback
 from stylesync.motion.bounds import BoundsMonitor, step_length_bound_m
+from stylesync.motion.capture_bound import bounded_com_target
 from stylesync.motion.leg_ik import solve_leg
 from stylesync.motion.operator_analysis import UPPER_JOINTS, OperatorAnalysis, analyse_operator, upper_local
 from stylesync.motion.recovery_step import (
@@ -214,8 +214,7 @@ class MotionOptimizer:
         self._op_last_ds_s = 0.0
         self.recovery = RecoveryStepper(cfg, CHAR_LEG_LENGTH_M, gravity_mps2)
         self._operator_stands_since_s: float | None = None
-        self._sole_full = cb.corners_in_foot()  # the character's sole, relative to the ankle [m]
-        self._sole_bound = cb.corners_in_foot(cfg.capture_bound_sole_share)  # shrunk for capture_bound.py
+        self._sole_bound = sole_corner_points(cfg.capture_bound_sole_share)  # shrunk for capture_bound.py [m]
         self.reading: MotionReading | None = None  # the last tick's reading of the operator, besides the targets
 
     def update(self, sample: OperatorSample, state: CharacterState, mass: MassProperties,
@@ -460,26 +459,27 @@ class MotionOptimizer:
         """Whether the COM target's capture point is bounded to the character's soles this tick (capture_bound.py):
         in the character's double stance, and in its single stance while the operator's capture point is within the
         soles he stands on (he balances on one leg, as in a kick, or he has stopped while the character's foot is
-        still in the air); his soles the character's scaled to him, as in recovery_step.operator_stands."""
+        still in the air)."""
         if tick.ch_state is Stance.DS:
             return True
-        corners = [(x / tick.scale, y / tick.scale, z / tick.scale) for x, y, z in self._sole_full]
-        soles = [cb.sole_xy_yaw(tick.a_h[s], rot.twist_angle(tick.s.quat[f"ANKLE_{_SIDE_UP[s]}"], _UP), corners)
-                 for s in _SIDE_UP if tick.op_state is Stance.DS or swing_side(tick.op_state) != s]
-        xi_h = self._operator_capture_point(tick)
-        polygon = convex_hull_points([p for sole in soles for p in sole])
-        return cb.outside((float(xi_h[0]), float(xi_h[1])), polygon)[0] <= 0.0
+        sides = [s for s in _SIDE_UP if tick.op_state is Stance.DS or swing_side(tick.op_state) != s]
+        yaw_h = {s: rot.twist_angle(tick.s.quat[f"ANKLE_{_SIDE_UP[s]}"], _UP) for s in sides}
+        return operator_stands(self._operator_capture_point(tick), {s: tick.a_h[s] for s in sides}, yaw_h,
+                               tick.scale)
 
     def _bounded_com_target(self, tick: _Tick, state: CharacterState, com_d: np.ndarray,
                             com_vel_d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The COM target with its capture point within the soles the character stands on (capture_bound.py)."""
-        soles = []
-        for s in _SIDE_UP:
-            q = state.link_quat_wxyz[_LINK[f"{s}_ankle"]]
-            if tick.weights[s] > 0.0 and (tick.contact[s] or sole_within_m(tick.a_c[s], q, ON_GROUND_GAP_M)):
-                soles.append(cb.sole_xy(tick.a_c[s], q, self._sole_bound))
+        soles = [sole_points_xy(tick.a_c[s], state.link_quat_wxyz[_LINK[f"{s}_ankle"]], self._sole_bound)
+                 for s in self._soles_on_ground(tick, state) if tick.weights[s] > 0.0]
         _, omega = capture_point(tick.com_c, tick.com_vel_c, self.g)
-        return cb.bounded_com_target(com_d, com_vel_d, omega, soles)
+        return bounded_com_target(com_d, com_vel_d, omega, soles)
+
+    @staticmethod
+    def _soles_on_ground(tick: _Tick, state: CharacterState) -> list[str]:
+        """The feet whose soles touch the ground, or are within ON_GROUND_GAP_M of it."""
+        return [s for s in _SIDE_UP if tick.contact[s]
+                or sole_within_m(tick.a_c[s], state.link_quat_wxyz[_LINK[f"{s}_ankle"]], ON_GROUND_GAP_M)]
 
     def _stopping_landing(self, tick: _Tick, state: CharacterState, side: str, xi_h: np.ndarray,
                           landing: np.ndarray) -> np.ndarray:
@@ -517,8 +517,8 @@ class MotionOptimizer:
         if state.time_s - self._operator_stands_since_s < self.cfg.recovery_min_stance_s:
             return  # a double stance shorter than this is a walk's: his next step is the character's
         quats = {s: state.link_quat_wxyz[_LINK[f"{s}_ankle"]] for s in _SIDE_UP}
-        on_ground = [s for s in _SIDE_UP if tick.contact[s] or sole_within_m(tick.a_c[s], quats[s], ON_GROUND_GAP_M)]
-        step = stepper.trigger(state.time_s, tick.com_c, tick.com_vel_c, tick.a_c, quats, on_ground, tick.R_root_d)
+        step = stepper.trigger(state.time_s, tick.com_c, tick.com_vel_c, tick.a_c, quats,
+                               self._soles_on_ground(tick, state), tick.R_root_d)
         if step is not None:
             timeout_s = self.cfg.recovery_swing_s + self.cfg.late_contact_timeout_s
             tick.ch_state = self.char_fsm.begin_recovery_step(step.side, state.time_s, timeout_s)

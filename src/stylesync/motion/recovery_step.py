@@ -47,11 +47,14 @@ from stylesync.model.character import (
     HIP_HALF_WIDTH_M,
 )
 from stylesync.model.sole import (
+    convex_hull_points,
     convex_hull_xy,
     outside_distance_m,
-    sole_corners_in_foot,
+    outside_distance_points,
+    sole_corner_points,
     sole_corners_world,
     sole_outside_m,
+    sole_points_xy_yaw,
 )
 from stylesync.processing.interpolation import smooth_step
 
@@ -62,6 +65,7 @@ LANDING_PRESS_M = 0.02  # after the nominal swing time the foot is aimed this fa
 # lowers it there).
 HORIZONTAL_SHARE = 0.8
 ON_GROUND_GAP_M = 0.01  # a sole whose lowest corner is this close to the ground counts in the support polygon [m]
+_SOLE_POINTS = sole_corner_points()  # the character's sole relative to its ankle [m]
 _OTHER = {"left": "right", "right": "left"}
 _OUT = {"left": 1.0, "right": -1.0}
 
@@ -77,10 +81,10 @@ def operator_stands(xi_h_world: np.ndarray, ankles_h_world: dict[str, np.ndarray
                     scale: float) -> bool:
     """Whether the operator's capture point (horizontal) is within the support polygon of his soles, each the
     character's sole scaled by 1 / ``scale`` (h_C / h_H, Eq. 9) at his ankle, turned by his foot's yaw."""
-    in_foot = sole_corners_in_foot() / scale
-    corners = [sole_corners_world(ankles_h_world[s], rot.quat_from_yaw(foot_yaw_h_rad[s]), in_foot)[:, :2]
-               for s in ankles_h_world]
-    return outside_distance_m(xi_h_world, convex_hull_xy(np.vstack(corners)))[0] <= 0.0
+    in_foot = [(x / scale, y / scale, z / scale) for x, y, z in _SOLE_POINTS]
+    corners = [p for s in ankles_h_world for p in sole_points_xy_yaw(ankles_h_world[s], foot_yaw_h_rad[s], in_foot)]
+    xi = (float(xi_h_world[0]), float(xi_h_world[1]))
+    return outside_distance_points(xi, convex_hull_points(corners))[0] <= 0.0
 
 
 def outside_step_m(xi_world: np.ndarray, stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray,
