@@ -28,11 +28,10 @@ from pathlib import Path
 
 import numpy as np
 
-from stylesync.config import OperatorConfig, SessionConfig
-from stylesync.metrics.dev_suite import clip_specs
+from stylesync.metrics.dev_suite import clip_specs, suite_config
 from stylesync.model.character import LINK_NAMES
-from stylesync.model.sole import convex_hull_xy, outside_distance_m, sole_corners_world, sole_within_m
-from stylesync.motion.recovery_step import ON_GROUND_GAP_M, capture_point
+from stylesync.model.sole import convex_hull_xy, outside_distance_m, sole_corners_world
+from stylesync.motion.recovery_step import capture_point, soles_on_ground
 from stylesync.session import Session
 from stylesync.sources.registry import open_source
 
@@ -64,13 +63,9 @@ def main() -> None:
     logging.disable(logging.WARNING)
     spec = resolve(args.clip)
     opened = open_source(spec, seed=args.seed, duration_s=args.duration)
-    op = OperatorConfig()
-    length = min(args.duration, float(opened.duration_s or args.duration))
-    in_motion = spec.startswith(("bvh:", "k4a-json:")) and op.start_in_motion
-    clip_end = length - (min(op.rest_after_clip_s, length) if in_motion else 0.0)
-    cfg = SessionConfig(duration_s=min(length, args.t1), seed=args.seed, operator=op,
-                        clocks=dataclasses.replace(SessionConfig().clocks, mocap_hz=opened.mocap_hz))
-    session = Session(cfg, opened.source)
+    cfg, clip_end = suite_config(spec, opened, args.seed, args.duration)
+    length = cfg.duration_s
+    session = Session(dataclasses.replace(cfg, duration_s=min(length, args.t1)), opened.source)
     mass_kg = session.mass.total_kg
     g = cfg.world.gravity_mps2
     last: dict = {"v": None, "t": None, "key": None, "n": 0}
@@ -93,10 +88,8 @@ def main() -> None:
             return
         last["key"] = key
         xi, _ = capture_point(com, vel, g)
-        corners = [sole_corners_world(state.link_origin_world[i], state.link_quat_wxyz[i])[:, :2]
-                   for s, i in _ANKLE.items()
-                   if state.feet_pressing()[s]
-                   or sole_within_m(state.link_origin_world[i], state.link_quat_wxyz[i], ON_GROUND_GAP_M)]
+        corners = [sole_corners_world(state.link_origin_world[_ANKLE[s]], state.link_quat_wxyz[_ANKLE[s]])[:, :2]
+                   for s in soles_on_ground(state)]
         out = outside_distance_m(xi, convex_hull_xy(np.vstack(corners)))[0] if corners else float("nan")
         force = session.controller.telemetry.com_force_n
         taken = mass_kg * accel

@@ -19,6 +19,7 @@ import dataclasses
 import json
 import logging
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -26,6 +27,9 @@ from stylesync.config import OperatorConfig, SessionConfig
 from stylesync.errors import StylesyncError
 from stylesync.metrics.bench import CONTROLLERS
 from stylesync.metrics.summary import summarize
+
+if TYPE_CHECKING:
+    from stylesync.sources.registry import OpenedSource
 
 # Category of each clip, from the clips' READMEs (../shared/mocap/*/README.md) and the humanoid3d clip names.
 CATEGORIES = {
@@ -60,6 +64,18 @@ def clip_specs(mocap: Path | None) -> list[tuple[str, str, str]]:
     return [(spec, name, CATEGORIES.get(name, "other")) for spec, name in out]
 
 
+def suite_config(spec: str, opened: OpenedSource, seed: int, duration_s: float) -> tuple[SessionConfig, float]:
+    """A suite run's configuration for the opened source ``spec`` (default settings, the source's frame rate, at
+    most ``duration_s``, the rest after a recorded file included) and the time its clip ends [s]."""
+    op = OperatorConfig()
+    length = min(duration_s, float(opened.duration_s or duration_s))
+    in_motion = spec.startswith(("bvh:", "k4a-json:")) and op.start_in_motion
+    clip_end = length - (min(op.rest_after_clip_s, length) if in_motion else 0.0)
+    cfg = SessionConfig(duration_s=length, seed=seed, operator=op,
+                        clocks=dataclasses.replace(SessionConfig().clocks, mocap_hz=opened.mocap_hz))
+    return cfg, clip_end
+
+
 def run_clip(spec: str, seed: int, duration_s: float, controller: str) -> dict:
     """One run of the suite: the clip through the Kinect sensor model with ``seed``; a clip that cannot be opened
     gives ``{"error": ...}``."""
@@ -72,12 +88,8 @@ def run_clip(spec: str, seed: int, duration_s: float, controller: str) -> dict:
         opened = open_source(spec, seed=seed, duration_s=duration_s)
     except StylesyncError as exc:
         return {"error": str(exc)[:200]}
-    op = OperatorConfig()
-    length = min(duration_s, float(opened.duration_s or duration_s))
-    in_motion = spec.startswith(("bvh:", "k4a-json:")) and op.start_in_motion
-    clip_end = length - (min(op.rest_after_clip_s, length) if in_motion else 0.0)
-    cfg = SessionConfig(duration_s=length, seed=seed, operator=op, control=control, motion=motion,
-                        clocks=dataclasses.replace(SessionConfig().clocks, mocap_hz=opened.mocap_hz))
+    cfg, clip_end = suite_config(spec, opened, seed, duration_s)
+    cfg = dataclasses.replace(cfg, control=control, motion=motion)
     result = run_and_release(cfg, opened.source)
     m = summarize(result)
     keys = ("fell", "fall_time_s", "sim_duration_s", "operator_steps", "character_steps",

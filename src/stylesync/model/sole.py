@@ -88,29 +88,11 @@ def convex_hull_xy(points_xy: np.ndarray) -> np.ndarray:
 
 def outside_distance_m(point_xy: np.ndarray, hull_xy: np.ndarray) -> tuple[float, np.ndarray]:
     """Signed distance of a horizontal point from a convex polygon (counter-clockwise, :func:`convex_hull_xy`):
-    > 0 outside, < 0 inside [m]; and the polygon's point nearest to it (the point itself when inside)."""
-    p = np.asarray(point_xy, dtype=float)[:2]
-    n = len(hull_xy)
-    best, nearest, inside_margin = np.inf, p.copy(), np.inf
-    inside = n >= 3
-    for k in range(n):
-        a, b = hull_xy[k], hull_xy[(k + 1) % n]
-        ab = b - a
-        length2 = float(ab @ ab)
-        t = 0.0 if length2 < 1e-12 else min(max(float((p - a) @ ab) / length2, 0.0), 1.0)
-        q = a + t * ab
-        d = float(np.linalg.norm(p - q))
-        if d < best:
-            best, nearest = d, q
-        if n >= 3:
-            cross = ab[0] * (p[1] - a[1]) - ab[1] * (p[0] - a[0])  # > 0: left of the edge (inside)
-            if cross < 0.0:
-                inside = False
-            elif length2 > 1e-12:
-                inside_margin = min(inside_margin, cross / np.sqrt(length2))
-    if inside:
-        return -float(inside_margin), p.copy()
-    return best, nearest
+    > 0 outside, < 0 inside [m]; and the polygon's point nearest to it (the point itself when inside)
+    (:func:`outside_distance_points`)."""
+    polygon = [(float(x), float(y)) for x, y in np.asarray(hull_xy, dtype=float).reshape(-1, 2)]
+    distance, nearest = outside_distance_points((float(point_xy[0]), float(point_xy[1])), polygon)
+    return distance, np.array(nearest)
 
 
 def outside_distance_points(point: Point, polygon: list[Point]) -> tuple[float, Point]:

@@ -38,7 +38,7 @@ from stylesync.model.character import (
     batch_model_quat_from_canonical,
     canonical_quat_from_model,
 )
-from stylesync.model.sole import sole_corner_points, sole_outside_m, sole_points_xy, sole_within_m
+from stylesync.model.sole import sole_corner_points, sole_outside_m, sole_points_xy
 from stylesync.model.state import CharacterState, MassProperties
 from stylesync.motion.balance_strategy import stance_hip_blend, swing_hip_feedback
 from stylesync.motion.bounds import BoundsMonitor, step_length_bound_m
@@ -46,10 +46,10 @@ from stylesync.motion.capture_bound import bounded_com_target
 from stylesync.motion.leg_ik import solve_leg
 from stylesync.motion.operator_analysis import UPPER_JOINTS, OperatorAnalysis, analyse_operator, upper_local
 from stylesync.motion.recovery_step import (
-    ON_GROUND_GAP_M,
     RecoveryStepper,
     capture_point,
     operator_stands,
+    soles_on_ground,
     stands_on,
 )
 from stylesync.motion.reference import LipmMap, MotionReading, ReferencePose
@@ -450,10 +450,11 @@ class MotionOptimizer:
         return tick.com_h + tick.com_vel_h * np.sqrt(h_h / self.g)
 
     @staticmethod
-    def _operator_stands(tick: _Tick, xi_h: np.ndarray) -> bool:
-        """Whether the operator's capture point ``xi_h`` is within his soles (recovery_step.operator_stands)."""
-        yaw_h = {k: rot.twist_angle(tick.s.quat[f"ANKLE_{v}"], _UP) for k, v in _SIDE_UP.items()}
-        return operator_stands(xi_h, tick.a_h, yaw_h, tick.scale)
+    def _operator_stands(tick: _Tick, xi_h: np.ndarray, sides: tuple[str, ...] = ("left", "right")) -> bool:
+        """Whether the operator's capture point ``xi_h`` is within the soles of his feet ``sides``
+        (recovery_step.operator_stands)."""
+        yaw_h = {s: rot.twist_angle(tick.s.quat[f"ANKLE_{_SIDE_UP[s]}"], _UP) for s in sides}
+        return operator_stands(xi_h, {s: tick.a_h[s] for s in sides}, yaw_h, tick.scale)
 
     def _capture_bounded(self, tick: _Tick) -> bool:
         """Whether the COM target's capture point is bounded to the character's soles this tick (capture_bound.py):
@@ -462,24 +463,16 @@ class MotionOptimizer:
         still in the air)."""
         if tick.ch_state is Stance.DS:
             return True
-        sides = [s for s in _SIDE_UP if tick.op_state is Stance.DS or swing_side(tick.op_state) != s]
-        yaw_h = {s: rot.twist_angle(tick.s.quat[f"ANKLE_{_SIDE_UP[s]}"], _UP) for s in sides}
-        return operator_stands(self._operator_capture_point(tick), {s: tick.a_h[s] for s in sides}, yaw_h,
-                               tick.scale)
+        sides = tuple(s for s in _SIDE_UP if tick.op_state is Stance.DS or swing_side(tick.op_state) != s)
+        return self._operator_stands(tick, self._operator_capture_point(tick), sides)
 
     def _bounded_com_target(self, tick: _Tick, state: CharacterState, com_d: np.ndarray,
                             com_vel_d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The COM target with its capture point within the soles the character stands on (capture_bound.py)."""
         soles = [sole_points_xy(tick.a_c[s], state.link_quat_wxyz[_LINK[f"{s}_ankle"]], self._sole_bound)
-                 for s in self._soles_on_ground(tick, state) if tick.weights[s] > 0.0]
+                 for s in soles_on_ground(state) if tick.weights[s] > 0.0]
         _, omega = capture_point(tick.com_c, tick.com_vel_c, self.g)
         return bounded_com_target(com_d, com_vel_d, omega, soles)
-
-    @staticmethod
-    def _soles_on_ground(tick: _Tick, state: CharacterState) -> list[str]:
-        """The feet whose soles touch the ground, or are within ON_GROUND_GAP_M of it."""
-        return [s for s in _SIDE_UP if tick.contact[s]
-                or sole_within_m(tick.a_c[s], state.link_quat_wxyz[_LINK[f"{s}_ankle"]], ON_GROUND_GAP_M)]
 
     def _stopping_landing(self, tick: _Tick, state: CharacterState, side: str, xi_h: np.ndarray,
                           landing: np.ndarray) -> np.ndarray:
@@ -518,7 +511,7 @@ class MotionOptimizer:
             return  # a double stance shorter than this is a walk's: his next step is the character's
         quats = {s: state.link_quat_wxyz[_LINK[f"{s}_ankle"]] for s in _SIDE_UP}
         step = stepper.trigger(state.time_s, tick.com_c, tick.com_vel_c, tick.a_c, quats,
-                               self._soles_on_ground(tick, state), tick.R_root_d)
+                               soles_on_ground(state), tick.R_root_d)
         if step is not None:
             timeout_s = self.cfg.recovery_swing_s + self.cfg.late_contact_timeout_s
             tick.ch_state = self.char_fsm.begin_recovery_step(step.side, state.time_s, timeout_s)

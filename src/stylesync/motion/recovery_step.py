@@ -45,6 +45,7 @@ from stylesync.model.character import (
     FOOT_LENGTH_M,
     FOOT_WIDTH_M,
     HIP_HALF_WIDTH_M,
+    LINK_NAMES,
 )
 from stylesync.model.sole import (
     convex_hull_points,
@@ -55,7 +56,9 @@ from stylesync.model.sole import (
     sole_corners_world,
     sole_outside_m,
     sole_points_xy_yaw,
+    sole_within_m,
 )
+from stylesync.model.state import CharacterState
 from stylesync.processing.interpolation import smooth_step
 
 MAX_STEP_SHARE = 0.6  # the landing ankle is at most this share of the leg's length from the stance ankle
@@ -67,6 +70,7 @@ HORIZONTAL_SHARE = 0.8
 ON_GROUND_GAP_M = 0.01  # a sole whose lowest corner is this close to the ground counts in the support polygon [m]
 _SOLE_POINTS = sole_corner_points()  # the character's sole relative to its ankle [m]
 _OTHER = {"left": "right", "right": "left"}
+_ANKLE = {s: LINK_NAMES.index(f"{s}_ankle") for s in ("left", "right")}
 _OUT = {"left": 1.0, "right": -1.0}
 
 
@@ -75,6 +79,14 @@ def capture_point(com_world: np.ndarray, com_vel_world: np.ndarray, gravity_mps2
     h the COM height above the ground."""
     omega = float(np.sqrt(gravity_mps2 / max(float(com_world[2]), 0.1)))
     return np.asarray(com_world, dtype=float)[:2] + np.asarray(com_vel_world, dtype=float)[:2] / omega, omega
+
+
+def soles_on_ground(state: CharacterState) -> list[str]:
+    """The feet whose soles press the ground (``CharacterState.feet_pressing``) or whose lowest sole corner is within
+    ON_GROUND_GAP_M of it: the soles of the support polygon."""
+    pressing = state.feet_pressing()
+    return [s for s in ("left", "right") if pressing[s]
+            or sole_within_m(state.link_origin_world[_ANKLE[s]], state.link_quat_wxyz[_ANKLE[s]], ON_GROUND_GAP_M)]
 
 
 def operator_stands(xi_h_world: np.ndarray, ankles_h_world: dict[str, np.ndarray], foot_yaw_h_rad: dict[str, float],
