@@ -1,7 +1,7 @@
 """Per-tick balance trace of one run of the development suite: what the character stood on, where its capture
 point was, what the COM task asked for and what the body did (prints figures; a tool for explaining a fall).
 
-    python benchmarks/trace_run.py 05_01 --seed 0 [--from 4.5] [--to 7] [--every 6] [--duration 12]
+    python benchmarks/trace_run.py 05_01 --seed 0 [--from 4.5] [--to 7] [--every 6] [--duration 12] [--past-fall]
 
 The clip is a development-suite name (`stylesync bench --suite dev`: a humanoid3d clip or a file of ../shared/mocap)
 or a source spec (``bvh:PATH``, ``builtin:walk``), run as the suite runs it: the Kinect sensor model with the seed,
@@ -11,6 +11,7 @@ a recorded file started in its first pose and held for the rest after its end. C
     op/ch      the operator's and the character's stance (DS, LS, RS); ``+own`` a recovery step, ``+held`` a late
                contact holding the reference
     com, v     the COM and its velocity (horizontal) [m, m/s]
+    z, z tgt   the COM's height and the COM target's [m]
     xi out     the capture point's signed distance from the support polygon of the soles on the ground (> 0
                outside) [m]
     tgt, vtgt  the COM target and its velocity after the motion stage (capture bound included) [m, m/s]
@@ -59,6 +60,7 @@ def main() -> None:
                     help="last time printed; the run ends there [s]")
     ap.add_argument("--every", type=int, default=6, help="print every this many control ticks (and each change "
                                                           "of stance)")
+    ap.add_argument("--past-fall", action="store_true", help="run on after the first fall (to see what follows it)")
     args = ap.parse_args()
     logging.disable(logging.WARNING)
     spec = resolve(args.clip)
@@ -66,11 +68,12 @@ def main() -> None:
     cfg, clip_end = suite_config(spec, opened, args.seed, args.duration)
     length = cfg.duration_s
     session = Session(dataclasses.replace(cfg, duration_s=min(length, args.t1)), opened.source)
+    session.stop_on_fall = not args.past_fall
     mass_kg = session.mass.total_kg
     g = cfg.world.gravity_mps2
     last: dict = {"v": None, "t": None, "key": None, "n": 0}
     print(f"{spec}, seed {args.seed}: the clip ends at {clip_end:.2f} s, the run at {length:.2f} s")
-    print(f"{'t':>6} {'op':>3} {'ch':>8} {'com':>13} {'v':>13} {'xi out':>7} {'tgt':>13} {'vtgt':>13} "
+    print(f"{'t':>6} {'op':>3} {'ch':>8} {'com':>13} {'v':>13} {'z':>5} {'z tgt':>5} {'xi out':>7} {'tgt':>13} {'vtgt':>13} "
           f"{'F asked':>11} {'m a':>11} {'fL':>5} {'fR':>5}")
 
     def on_tick(state, ref) -> None:
@@ -95,7 +98,7 @@ def main() -> None:
         taken = mass_kg * accel
         fl, fr = (state.foot_contact_force_n[f"{s}_ankle"] for s in ("left", "right"))
         print(f"{state.time_s:6.2f} {key[0]:>3} {key[1] + flags:>8} ({com[0]:+5.2f},{com[1]:+5.2f}) "
-              f"({vel[0]:+5.2f},{vel[1]:+5.2f}) {out:+7.3f} ({ref.com_world[0]:+5.2f},{ref.com_world[1]:+5.2f}) "
+              f"({vel[0]:+5.2f},{vel[1]:+5.2f}) {com[2]:5.2f} {ref.com_world[2]:5.2f} {out:+7.3f} ({ref.com_world[0]:+5.2f},{ref.com_world[1]:+5.2f}) "
               f"({ref.com_vel_world[0]:+5.2f},{ref.com_vel_world[1]:+5.2f}) ({force[0]:+4.0f},{force[1]:+4.0f}) "
               f"({taken[0]:+4.0f},{taken[1]:+4.0f}) {fl:5.0f} {fr:5.0f}")
 
