@@ -182,6 +182,9 @@ class _Tick:
     targets: dict[str, np.ndarray] = field(default_factory=dict)  # ankle targets
     foot_yaw: dict[str, float] = field(default_factory=dict)
     step_exceeded: bool = False
+    # The operator's capture point and whether it is within the soles he stands on, computed once a tick
+    xi_h: np.ndarray | None = None
+    stands: dict[tuple[str, ...], bool] = field(default_factory=dict)
 
 
 class MotionOptimizer:
@@ -446,15 +449,19 @@ class MotionOptimizer:
     def _operator_capture_point(self, tick: _Tick) -> np.ndarray:
         """(3,) the operator's capture point, his COM height taken above his ankles plus the character's ankle
         height scaled to him [m]."""
-        h_h = max(tick.com_h[2] - tick.ankle_h_z + ANKLE_HEIGHT_M / tick.scale, 0.1)
-        return tick.com_h + tick.com_vel_h * np.sqrt(h_h / self.g)
+        if tick.xi_h is None:
+            h_h = max(tick.com_h[2] - tick.ankle_h_z + ANKLE_HEIGHT_M / tick.scale, 0.1)
+            tick.xi_h = tick.com_h + tick.com_vel_h * np.sqrt(h_h / self.g)
+        return tick.xi_h
 
-    @staticmethod
-    def _operator_stands(tick: _Tick, xi_h: np.ndarray, sides: tuple[str, ...] = ("left", "right")) -> bool:
-        """Whether the operator's capture point ``xi_h`` is within the soles of his feet ``sides``
-        (recovery_step.operator_stands)."""
-        yaw_h = {s: rot.twist_angle(tick.s.quat[f"ANKLE_{_SIDE_UP[s]}"], _UP) for s in sides}
-        return operator_stands(xi_h, {s: tick.a_h[s] for s in sides}, yaw_h, tick.scale)
+    def _operator_stands(self, tick: _Tick, sides: tuple[str, ...] = ("left", "right")) -> bool:
+        """Whether the operator's capture point is within the soles of his feet ``sides``
+        (recovery_step.operator_stands); once a tick per set of feet."""
+        if sides not in tick.stands:
+            yaw_h = {s: rot.twist_angle(tick.s.quat[f"ANKLE_{_SIDE_UP[s]}"], _UP) for s in sides}
+            tick.stands[sides] = operator_stands(self._operator_capture_point(tick), {s: tick.a_h[s] for s in sides},
+                                                 yaw_h, tick.scale)
+        return tick.stands[sides]
 
     def _capture_bounded(self, tick: _Tick) -> bool:
         """Whether the COM target's capture point is bounded to the character's soles this tick (capture_bound.py):
@@ -464,7 +471,7 @@ class MotionOptimizer:
         if tick.ch_state is Stance.DS:
             return True
         sides = tuple(s for s in _SIDE_UP if tick.op_state is Stance.DS or swing_side(tick.op_state) != s)
-        return self._operator_stands(tick, self._operator_capture_point(tick), sides)
+        return self._operator_stands(tick, sides)
 
     def _bounded_com_target(self, tick: _Tick, state: CharacterState, com_d: np.ndarray,
                             com_vel_d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -480,7 +487,7 @@ class MotionOptimizer:
         the swinging one where it is): if the character's capture point, when the foot lands, would be outside its
         stance sole and the planned landing, the landing of a recovery step (recovery_step.py) instead, so that
         the character can stop where he does."""
-        if not self._operator_stands(tick, xi_h):
+        if not self._operator_stands(tick):
             return landing
         other = _OTHER_SIDE[side]
         stance_q = state.link_quat_wxyz[_LINK[f"{other}_ankle"]]
@@ -502,7 +509,7 @@ class MotionOptimizer:
         if (stepper.step is not None or tick.ch_state is not Stance.DS or tick.op_state is not Stance.DS
                 or self.char_fsm.hold_reference):
             return
-        if not self._operator_stands(tick, self._operator_capture_point(tick)):
+        if not self._operator_stands(tick):
             self._operator_stands_since_s = None  # he moves over his feet (a walk's double stance)
             return
         if self._operator_stands_since_s is None:
