@@ -69,6 +69,9 @@ def clip_specs() -> list[tuple[str, str, str]]:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--baseline", default="9e63c3d", help="git ref of the earlier version ('none': this one only)")
+    ap.add_argument("--version", default="HEAD",
+                    help="git ref of this version ('worktree': the checkout's files as they are, uncommitted "
+                         "changes included)")
     ap.add_argument("--only", default="", help="comma-separated categories to run (default: all)")
     ap.add_argument("--seeds", type=int, default=3)
     ap.add_argument("--duration", type=float, default=12.0)
@@ -78,10 +81,11 @@ def main() -> None:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     clips = [c for c in clip_specs() if not args.only or c[2] in args.only.split(",")]
-    refs = {"this version": "HEAD"}
+    refs = {} if args.version == "worktree" else {"this version": args.version}
     if args.baseline != "none":
         refs[f"baseline {args.baseline}"] = args.baseline
-    with checkouts(refs) as trees:
+    with checkouts(refs) as checked_out:
+        trees = {"this version": REPO / "src", **checked_out} if args.version == "worktree" else checked_out
         jobs = [(spec, name, cat, seed, v) for spec, name, cat in clips for seed in range(args.seeds) for v in trees]
 
         def run(job):

@@ -73,8 +73,8 @@ def main() -> None:
     g = cfg.world.gravity_mps2
     last: dict = {"v": None, "t": None, "key": None, "n": 0}
     print(f"{spec}, seed {args.seed}: the clip ends at {clip_end:.2f} s, the run at {length:.2f} s")
-    print(f"{'t':>6} {'op':>3} {'ch':>8} {'com':>13} {'v':>13} {'z':>5} {'z tgt':>5} {'xi out':>7} {'tgt':>13} {'vtgt':>13} "
-          f"{'F asked':>11} {'m a':>11} {'fL':>5} {'fR':>5}")
+    print(f"{'t':>6} {'op':>3} {'ch':>8} {'com':>13} {'v':>13} {'z':>5} {'z tgt':>5} {'xi out':>7} {'tgt':>13} "
+          f"{'vtgt':>13} {'F asked':>11} {'m a':>11} {'fL':>5} {'fR':>5}")
 
     def on_tick(state, ref) -> None:
         com, vel = session.mass.com(state), session.mass.com_velocity(state)
@@ -98,7 +98,8 @@ def main() -> None:
         taken = mass_kg * accel
         fl, fr = (state.foot_contact_force_n[f"{s}_ankle"] for s in ("left", "right"))
         print(f"{state.time_s:6.2f} {key[0]:>3} {key[1] + flags:>8} ({com[0]:+5.2f},{com[1]:+5.2f}) "
-              f"({vel[0]:+5.2f},{vel[1]:+5.2f}) {com[2]:5.2f} {ref.com_world[2]:5.2f} {out:+7.3f} ({ref.com_world[0]:+5.2f},{ref.com_world[1]:+5.2f}) "
+              f"({vel[0]:+5.2f},{vel[1]:+5.2f}) {com[2]:5.2f} {ref.com_world[2]:5.2f} {out:+7.3f} "
+              f"({ref.com_world[0]:+5.2f},{ref.com_world[1]:+5.2f}) "
               f"({ref.com_vel_world[0]:+5.2f},{ref.com_vel_world[1]:+5.2f}) ({force[0]:+4.0f},{force[1]:+4.0f}) "
               f"({taken[0]:+4.0f},{taken[1]:+4.0f}) {fl:5.0f} {fr:5.0f}")
 

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from stylesync.config import MotionConfig, OperatorConfig, SessionConfig
+from stylesync.config import ControlConfig, MotionConfig, OperatorConfig, SessionConfig, WholeBodyConfig
 from stylesync.model.character import ANKLE_HEIGHT_M, FOOT_CENTER_AHEAD_OF_ANKLE_M, FOOT_LENGTH_M
 from stylesync.model.sole import convex_hull_xy, outside_distance_m, sole_corners_world
 from stylesync.motion.pose_optimization import CHAR_LEG_LENGTH_M
@@ -114,12 +114,20 @@ def test_the_fsm_keeps_a_recovery_step_until_its_foot_lands():
     assert fsm.update(Stance.DS, {"left": False, "right": True}, 1.31) is Stance.DS
 
 
-def _run(spec: str, seconds: float, motion: MotionConfig, seed: int = 0):
+# The controller the scenarios below were traced with: the supporting legs' posture at full weight (before
+# WholeBodyConfig.stance_leg_tracking_share). Each scenario is one clip and seed on which a feature decides a fall;
+# a change of the controller changes which runs fall, so the feature is tested where its effect was traced, and the
+# default controller where the test says "default".
+TRACED = ControlConfig(whole_body=WholeBodyConfig(stance_leg_tracking_share=1.0))
+
+
+def _run(spec: str, seconds: float, motion: MotionConfig, seed: int = 0, control: ControlConfig | None = None):
     from stylesync.session import Session
     from stylesync.sources.registry import open_source
 
     opened = open_source(spec, seed=seed, duration_s=seconds)
     cfg = SessionConfig(duration_s=seconds, seed=seed, operator=OperatorConfig(), motion=motion,
+                        control=control or ControlConfig(),
                         clocks=dataclasses.replace(SessionConfig().clocks, mocap_hz=opened.mocap_hz))
     session = Session(cfg, opened.source)
     result = session.run()
@@ -186,9 +194,10 @@ def test_a_late_contact_hold_keeps_the_walk_going():
     without the bound on the COM target's capture point (capture_bound.py), which also keeps the stopped targets from
     throwing this run; with everything on, it comes to rest too."""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '08_01.bvh'}"
-    on, _ = _run(spec, 5.27, MotionConfig(capture_bound_sole_share=0.0), seed=1)
+    on, _ = _run(spec, 5.27, MotionConfig(capture_bound_sole_share=0.0), seed=1, control=TRACED)
     assert not on.fell
-    off, _ = _run(spec, 5.27, MotionConfig(late_contact_keeps_momentum=False, capture_bound_sole_share=0.0), seed=1)
+    off, _ = _run(spec, 5.27, MotionConfig(late_contact_keeps_momentum=False, capture_bound_sole_share=0.0), seed=1,
+                  control=TRACED)
     assert off.fell
     default, _ = _run(spec, 5.27, MotionConfig(), seed=1)
     assert not default.fell
@@ -222,10 +231,11 @@ def test_a_recovery_step_lets_the_body_move_as_its_landing_assumes():
     ``recovery_landing_reach``) and the COM target unbounded (no ``capture_bound_sole_share``): with the body lowered
     for a landing as well, both come to rest."""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '07_01.bvh'}"
-    free, _ = _run(spec, 5.6, MotionConfig(recovery_landing_reach=False, capture_bound_sole_share=0.0))
+    free, _ = _run(spec, 5.6, MotionConfig(recovery_landing_reach=False, capture_bound_sole_share=0.0),
+                   control=TRACED)
     assert not free.fell
     pulled, _ = _run(spec, 5.6, MotionConfig(recovery_step_free_com=False, recovery_landing_reach=False,
-                                             capture_bound_sole_share=0.0))
+                                             capture_bound_sole_share=0.0), control=TRACED)
     assert pulled.fell and pulled.fall_time_s is not None and pulled.fall_time_s > 2.6
 
 
@@ -238,7 +248,8 @@ def test_targets_that_follow_the_operator_keep_the_walk_up_with_him():
     covered = {}
     for tau in (0.0, 0.5):
         opened = open_source("builtin:walk", seed=0, duration_s=7.0)
-        cfg = SessionConfig(duration_s=7.0, seed=0, motion=MotionConfig(reference_follows_operator_s=tau))
+        cfg = SessionConfig(duration_s=7.0, seed=0, motion=MotionConfig(reference_follows_operator_s=tau),
+                            control=TRACED)
         session = Session(cfg, opened.source)
         start = {}
 
@@ -287,8 +298,9 @@ def test_a_step_from_standing_waits_for_the_weight_to_shift():
     the operator's stance by his ankles alone (no rear-foot support), so that only the wait differs; with the whole
     balance layer (the default) it falls at 3.44 s."""
     spec = f"bvh:{MOCAP / 'cmu' / '131_01.bvh'}"
-    shifted, _ = _run(spec, 3.5, MotionConfig(rear_foot_support_margin_m=None))
-    at_once, _ = _run(spec, 3.5, MotionConfig(liftoff_weight_shift_s=0.0, rear_foot_support_margin_m=None))
+    shifted, _ = _run(spec, 3.5, MotionConfig(rear_foot_support_margin_m=None), control=TRACED)
+    at_once, _ = _run(spec, 3.5, MotionConfig(liftoff_weight_shift_s=0.0, rear_foot_support_margin_m=None),
+                      control=TRACED)
     default, _ = _run(spec, 3.5, MotionConfig())
     assert not default.fell or (default.fall_time_s is not None and default.fall_time_s > 3.0)
     assert at_once.fell and at_once.fall_time_s is not None and at_once.fall_time_s < 2.1
@@ -310,7 +322,7 @@ def test_a_rear_foot_on_its_toes_is_read_as_still_standing():
     for margin in (None, 0.02):
         opened = open_source(spec, seed=0, duration_s=5.0)
         cfg = SessionConfig(duration_s=5.0, seed=0, motion=MotionConfig(rear_foot_support_margin_m=margin),
-                            clocks=dataclasses.replace(SessionConfig().clocks, mocap_hz=opened.mocap_hz))
+                            control=TRACED, clocks=dataclasses.replace(SessionConfig().clocks, mocap_hz=opened.mocap_hz))
         session = Session(cfg, opened.source)
         stances: list[Stance] = []
 
@@ -336,7 +348,8 @@ def test_a_recovery_step_that_must_land_lowers_the_body_until_its_foot_reaches_t
     bound on the COM target's capture point (capture_bound.py), with which the character, braked in its double
     stances, comes to rest either way."""
     spec = f"bvh:{MOCAP / 'cmu' / '02_01.bvh'}"
-    reach, _ = _run(spec, 5.85, MotionConfig(capture_bound_sole_share=0.0), seed=2)
-    hover, _ = _run(spec, 5.85, MotionConfig(recovery_landing_reach=False, capture_bound_sole_share=0.0), seed=2)
+    reach, _ = _run(spec, 5.85, MotionConfig(capture_bound_sole_share=0.0), seed=2, control=TRACED)
+    hover, _ = _run(spec, 5.85, MotionConfig(recovery_landing_reach=False, capture_bound_sole_share=0.0), seed=2,
+                    control=TRACED)
     assert not reach.fell
     assert hover.fell and hover.fall_time_s is not None and hover.fall_time_s > 2.85  # in the rest

@@ -261,6 +261,12 @@ class WholeBodyConfig:
     hand_task_kp: float = 100.0
     hand_task_kd: float = 20.0
     hand_task_weight: float = 100.0
+    # The posture task's weight on the hip, knee and ankle of each supporting leg, as a share of its weight elsewhere.
+    # A supporting leg closes a chain through the ground: its joint angles are where the pelvis is over the foot,
+    # which the momentum task (the COM), the pelvis height and the pelvis orientation already ask for. At full weight
+    # the leg's posture (the operator's crouch or push-off, retargeted) drove the COM past the feet before jumps
+    # (docs/decisions.md, "The supporting legs' posture")
+    stance_leg_tracking_share: float = 0.1
 
     def __post_init__(self) -> None:
         for n in ("joint_tracking_omega_rad_s", "joint_tracking_damping_ratio", "momentum_moment_weight_per_m",
@@ -268,7 +274,7 @@ class WholeBodyConfig:
             _positive(f"WholeBodyConfig.{n}", getattr(self, n))
         for n in ("momentum_com_kp", "momentum_com_kd", "momentum_root_kp", "momentum_root_kd",
                   "contact_velocity_gain", "sole_contact_gap_m", "joint_tracking_weight", "hand_task_kp",
-                  "hand_task_kd", "hand_task_weight"):
+                  "hand_task_kd", "hand_task_weight", "stance_leg_tracking_share"):
             _non_negative(f"WholeBodyConfig.{n}", getattr(self, n))
 
 

@@ -36,7 +36,17 @@ from stylesync.control.pid import IS_BALL
 from stylesync.control.solver import DaqpSolver
 from stylesync.control.stable_pd import flatten_joint_values, unflatten_joint_values
 from stylesync.control.tasks import CentroidalMomentumTask, FrameOrientationTask, FramePositionTask, JointPostureTask
-from stylesync.model.character import ANKLE_HEIGHT_M, LINK_NAMES, Q_WORLD_MODEL, ROOT_DOFS, SIDES
+from stylesync.model.character import (
+    ANKLE_HEIGHT_M,
+    JOINT_DOF_COUNT,
+    JOINT_DOF_START,
+    JOINT_NAMES,
+    LINK_NAMES,
+    N_DOFS,
+    Q_WORLD_MODEL,
+    ROOT_DOFS,
+    SIDES,
+)
 from stylesync.model.character_model import HAND_FRAMES, CharacterModel
 from stylesync.model.state import CharacterState, JointFeedback, MassProperties, Torques
 from stylesync.motion import bounds as bnd
@@ -45,6 +55,10 @@ from stylesync.motion.stance_fsm import swing_side
 
 log = logging.getLogger("stylesync.control")
 _FOOT_LINK = {s: LINK_NAMES.index(f"{s}_ankle") for s in SIDES}
+# Each leg's hip, knee and ankle DOFs, in the joint-DOF layout of the posture task.
+_LEG_DOFS = {s: np.concatenate([np.arange(JOINT_DOF_START[k], JOINT_DOF_START[k] + JOINT_DOF_COUNT[k])
+                                for k, name in enumerate(JOINT_NAMES)
+                                if name in (f"{s}_hip", f"{s}_knee", f"{s}_ankle")]) for s in SIDES}
 # A stance foot not yet touching is aimed this far below the ground [m], with this weight against a joint's: with
 # 2 cm and 100 a landing foot bounced off and slid in double stance (docs/decisions.md, "Landing").
 GROUND_PRESS_M = 0.035
@@ -165,6 +179,12 @@ class WholeBodyController(ControllerBase):
                                          else state.root_lin_vel_world)
                 task.target_world = self._hand_target[s] = target
 
+        # The supporting legs' posture weighs stance_leg_tracking_share of the rest's (WholeBodyConfig): their joint
+        # angles are where the pelvis is over the feet, which the momentum and pelvis tasks already ask for.
+        share = np.ones(N_DOFS - ROOT_DOFS)
+        for s in support:
+            share[_LEG_DOFS[s]] = wb.stance_leg_tracking_share
+        self.posture.dof_scale = share
         contacts = []
         for s in support:
             c = self.contacts[s]

@@ -22,8 +22,11 @@ class JointPostureTask(Task):
         self.min_inertia_kgm2 = min_inertia_kgm2  # [kg·m²]
         self.desired_accel = np.zeros(N_DOFS - ROOT_DOFS)  # (n_joint_dofs,) [rad/s²], set per tick
         self._dofs = np.arange(ROOT_DOFS, N_DOFS)
+        self.dof_scale: np.ndarray | None = None  # (n_joint_dofs,) per-DOF factor on the weight, set per tick
 
     def rows(self, model: CharacterModel) -> TaskRows:
         inertia = model.mass_matrix.diagonal()[ROOT_DOFS:]
-        return TaskRows(None, self.desired_accel, self.weight * np.maximum(inertia, self.min_inertia_kgm2),
-                        dofs=self._dofs)
+        w = self.weight * np.maximum(inertia, self.min_inertia_kgm2)
+        if self.dof_scale is not None:
+            w = w * self.dof_scale
+        return TaskRows(None, self.desired_accel, w, dofs=self._dofs)
