@@ -322,7 +322,8 @@ def test_a_rear_foot_on_its_toes_is_read_as_still_standing():
     for margin in (None, 0.02):
         opened = open_source(spec, seed=0, duration_s=5.0)
         cfg = SessionConfig(duration_s=5.0, seed=0, motion=MotionConfig(rear_foot_support_margin_m=margin),
-                            control=TRACED, clocks=dataclasses.replace(SessionConfig().clocks, mocap_hz=opened.mocap_hz))
+                            control=TRACED,
+                            clocks=dataclasses.replace(SessionConfig().clocks, mocap_hz=opened.mocap_hz))
         session = Session(cfg, opened.source)
         stances: list[Stance] = []
 

@@ -258,6 +258,9 @@ class Session:
         self.backend.reset(root, init.root_quat_wxyz, init.joint_pos)
         if self.cfg.operator.start_with_clip_velocity:
             self.backend.set_velocities(init.root_lin_vel_world, init.root_ang_vel_world, init.joint_vel)
+            self.processing.prime_rates(f0, f1)
+            com_vel_h = (s1.com_world - s0.com_world) / (s1.time_s - s0.time_s)
+            self.motion.prime_rates(com_vel_h, init.root_lin_vel_world)
         return True
 
     def run(self, progress: Callable[[float, float], None] | None = None,

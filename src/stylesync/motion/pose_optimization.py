@@ -144,6 +144,10 @@ class _SmoothedRate:
         """The current estimate (3,)."""
         return self._rate
 
+    def prime(self, rate: np.ndarray) -> None:
+        """Start from this rate (3,) instead of rest (a recording started mid-motion)."""
+        self._rate = np.array(rate, dtype=float)
+
     def __call__(self, x: np.ndarray) -> np.ndarray:
         if self._prev is not None:
             self._rate += _VELOCITY_SMOOTHING * ((x - self._prev) / self.dt_s - self._rate)
@@ -219,6 +223,12 @@ class MotionOptimizer:
         self._operator_stands_since_s: float | None = None
         self._sole_bound = sole_corner_points(cfg.capture_bound_sole_share)  # shrunk for capture_bound.py [m]
         self.reading: MotionReading | None = None  # the last tick's reading of the operator, besides the targets
+
+    def prime_rates(self, com_vel_h_world: np.ndarray, com_vel_d_world: np.ndarray) -> None:
+        """Start the operator's COM velocity and the desired COM velocity (Eq. 19) from these [m/s] instead of
+        rest: a character started with a recording's velocities (OperatorConfig.start_with_clip_velocity)."""
+        self._com_h_rate.prime(com_vel_h_world)
+        self._com_d_rate.prime(com_vel_d_world)
 
     def update(self, sample: OperatorSample, state: CharacterState, mass: MassProperties,
                analysis: OperatorAnalysis | None = None) -> ReferencePose:

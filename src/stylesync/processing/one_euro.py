@@ -31,16 +31,22 @@ class OneEuroFilter:
         self.d_cutoff_hz = d_cutoff_hz
         self._x: np.ndarray | None = None
         self._dx: np.ndarray | None = None
+        self._dx0: np.ndarray | None = None
 
     def reset(self) -> None:
         self._x = None
         self._dx = None
 
+    def prime(self, rate_per_s: np.ndarray) -> None:
+        """The derivative the filter starts from at its first sample (default 0): a signal already moving at its
+        first sample is then filtered with its cut-off of Eq. 8 from the start, not from f_cmin."""
+        self._dx0 = np.asarray(rate_per_s, dtype=float).copy()
+
     def __call__(self, x: np.ndarray) -> np.ndarray:
         x = np.asarray(x, dtype=float)
         if self._x is None or self._dx is None:
             self._x = x.copy()
-            self._dx = np.zeros_like(x)
+            self._dx = self._dx0.copy() if self._dx0 is not None and self._dx0.shape == x.shape else np.zeros_like(x)
             return x.copy()
         dx = (x - self._x) / self.period_s
         a_d = _alpha(self.d_cutoff_hz, self.period_s)

@@ -78,6 +78,18 @@ class OperatorProcessing:
         self._pramp.push(np.vstack([p, com[None, :]]))
         self.mocap_time_s = frame.timestamp_s
 
+    def prime_rates(self, f0: OperatorFrame, f1: OperatorFrame) -> None:
+        """Start the 1€ filter (Eq. 8) with the rates from frame ``f0`` to the later ``f1``: an operator who is
+        already moving at the first frame (a recording that starts mid-motion) is filtered with the lag of his
+        speed from the start, not with the larger one of a filter that believes him at rest."""
+        dt = f1.timestamp_s - f0.timestamp_s
+        if not dt > 0:
+            return
+        q0, p0, _, _ = tracked_arrays(f0)
+        q1, p1, _, _ = tracked_arrays(f1)
+        q1 = rot.batch_align_sign(q1, q0)
+        self._filter.prime(np.concatenate([(q1 - q0).reshape(-1), (p1 - p0).reshape(-1)]) / dt)
+
     def step(self, time_s: float) -> OperatorSample:
         q = self._qramp.step()  # Eq. 7
         if self._q_prev_out is not None:
