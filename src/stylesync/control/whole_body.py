@@ -106,6 +106,7 @@ class WholeBodyController(ControllerBase):
         self._arm_length_m = model.rest_distance("left_shoulder", "left_elbow") + model.rest_distance(
             "left_elbow", "left_wrist")
         self._hand_target: dict[str, np.ndarray] = {}  # the last tick's hand targets [m]
+        self._leg_share: dict[tuple[str, ...], np.ndarray] = {}  # the posture task's per-DOF share, per support
         self.contacts = {s: SoleContact(s, friction, mass.total_kg * gravity_mps2) for s in SIDES}
         self.solver = DaqpSolver()
 
@@ -181,10 +182,13 @@ class WholeBodyController(ControllerBase):
 
         # The supporting legs' posture weighs stance_leg_tracking_share of the rest's (WholeBodyConfig): their joint
         # angles are where the pelvis is over the feet, which the momentum and pelvis tasks already ask for.
-        share = np.ones(N_DOFS - ROOT_DOFS)
-        for s in support:
-            share[_LEG_DOFS[s]] = wb.stance_leg_tracking_share
-        self.posture.dof_scale = share
+        key = tuple(support)
+        if key not in self._leg_share:
+            share = np.ones(N_DOFS - ROOT_DOFS)
+            for s in support:
+                share[_LEG_DOFS[s]] = wb.stance_leg_tracking_share
+            self._leg_share[key] = share
+        self.posture.dof_scale = self._leg_share[key]
         contacts = []
         for s in support:
             c = self.contacts[s]
