@@ -313,7 +313,9 @@ def test_a_rear_foot_on_its_toes_is_read_as_still_standing():
     """The stealthy walk's long, low stride (2.6-3.2 s): the rear ankle rises 6-10 cm above the front one while
     its toes stay down and the operator's capture point stays 0.1-0.2 m behind his front heel. Read by ankle heights
     alone he stands on his front foot, and the character lifts its rear foot with its COM behind the front one;
-    read with the rear foot bearing weight, both stay down, and the fall comes later."""
+    read with the rear foot bearing weight, both stay down, and the fall comes later. Traced before recovery steps
+    were allowed while the character waits with its step counted (``recovery_while_step_counted``): both runs
+    without them."""
     from stylesync.session import Session
     from stylesync.sources.registry import open_source
 
@@ -321,7 +323,8 @@ def test_a_rear_foot_on_its_toes_is_read_as_still_standing():
     out = {}
     for margin in (None, 0.02):
         opened = open_source(spec, seed=0, duration_s=5.0)
-        cfg = SessionConfig(duration_s=5.0, seed=0, motion=MotionConfig(rear_foot_support_margin_m=margin),
+        cfg = SessionConfig(duration_s=5.0, seed=0, motion=MotionConfig(rear_foot_support_margin_m=margin,
+                                                                         recovery_while_step_counted=False),
                             control=TRACED,
                             clocks=dataclasses.replace(SessionConfig().clocks, mocap_hz=opened.mocap_hz))
         session = Session(cfg, opened.source)
@@ -354,3 +357,49 @@ def test_a_recovery_step_that_must_land_lowers_the_body_until_its_foot_reaches_t
                     control=TRACED)
     assert not reach.fell
     assert hover.fell and hover.fall_time_s is not None and hover.fall_time_s > 2.85  # in the rest
+
+
+def test_a_step_counted_as_taken_leaves_the_character_waiting_in_double_stance():
+    fsm = CharacterStanceFsm(late_contact_timeout_s=0.4, min_swing_s=0.12)
+    both = {"left": True, "right": True}
+    fsm.update(Stance.DS, both, 0.0)
+    assert fsm.update(Stance.LS, both, 0.1) is Stance.LS and not fsm.step_counted
+    # The swing foot touches before the operator's lands (early contact): his step counts as taken.
+    assert fsm.update(Stance.LS, both, 0.3) is Stance.DS and fsm.step_counted
+    assert fsm.update(Stance.LS, both, 0.5) is Stance.DS and fsm.step_counted
+    assert fsm.update(Stance.DS, both, 0.6) is Stance.DS and not fsm.step_counted
+
+
+@pytest.mark.skipif(not (MOCAP / "cmu-dev" / "05_01.bvh").exists(),
+                    reason="../shared/mocap/cmu-dev/05_01.bvh is not available")
+def test_a_character_waiting_with_its_step_counted_may_still_step_on_its_own():
+    """CMU-dev 05_01, seed 2, in the rest after the clip (4.9 s): the operator's held last frame is on one foot,
+    lowering the other; the character, its step for his counted as taken, stood on both feet with its capture point
+    running 0.2 to 0.65 m out of its support for 0.4 s, and could not step until he stood on both (measured: a fall at
+    5.62 s). With recovery steps allowed while it waits, its first one begins while he is still on one foot."""
+    from stylesync.session import Session
+    from stylesync.sources.registry import open_source
+
+    spec = f"bvh:{MOCAP / 'cmu-dev' / '05_01.bvh'}"
+    began = {}
+    for allowed in (False, True):
+        opened = open_source(spec, seed=2, duration_s=5.4)
+        cfg = SessionConfig(duration_s=5.4, seed=2, motion=MotionConfig(recovery_while_step_counted=allowed),
+                            clocks=dataclasses.replace(SessionConfig().clocks, mocap_hz=opened.mocap_hz))
+        session = Session(cfg, opened.source)
+        steps: list[float] = []
+        count = [0]
+
+        def on_tick(state, ref, steps=steps, session=session, count=count):
+            motion = session.motion
+            if (motion.recovery.count > count[0] and state.time_s > 4.9
+                    and motion.reading.operator_stance is not Stance.DS):
+                steps.append(state.time_s)  # a recovery step began while he is on one foot
+            count[0] = motion.recovery.count
+
+        session.on_tick = on_tick
+        session.run()
+        opened.source.close()
+        began[allowed] = steps
+    assert not began[False]
+    assert began[True] and began[True][0] < 5.2

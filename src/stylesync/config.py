@@ -161,6 +161,9 @@ class MotionConfig:
     recovery_swing_s: float = 0.2
     recovery_step_height_m: float = 0.05
     recovery_min_stance_s: float = 0.1
+    # ... also while the operator is on one foot but the character, its step for his counted as taken (early
+    # contact), stands on both and waits for his next change
+    recovery_while_step_counted: bool = True
     # Step timing (motion/recovery_step.py): a swing of the operator's that has lasted this many times his usual
     # swing time, while the character's capture point is outside its stance sole by more than the margin, is
     # landed by the balance (a recovery step takes it over) [-]

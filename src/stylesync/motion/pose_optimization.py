@@ -514,10 +514,13 @@ class MotionOptimizer:
         stepper = self.recovery
         if stepper.step is not None and not self.char_fsm.recovery_step:
             stepper.end(state.time_s)
-        if tick.op_state is not Stance.DS:
+        # The operator stands on both feet, or on one while the character, its step for his counted as taken,
+        # stands on both and waits for his next change (the held last frame of a clip cut mid-swing): either way
+        # the character does not follow a step of his now.
+        waits = tick.op_state is Stance.DS or (self.cfg.recovery_while_step_counted and self.char_fsm.step_counted)
+        if not waits:
             self._operator_stands_since_s = None
-        if (stepper.step is not None or tick.ch_state is not Stance.DS or tick.op_state is not Stance.DS
-                or self.char_fsm.hold_reference):
+        if stepper.step is not None or tick.ch_state is not Stance.DS or not waits or self.char_fsm.hold_reference:
             return
         if not self._operator_stands(tick):
             self._operator_stands_since_s = None  # he moves over his feet (a walk's double stance)

@@ -77,6 +77,12 @@ class CharacterStanceFsm:
         self.waiting_to_lift = False  # the operator has lifted a foot; the character shifts its weight first
         self._lift_wait_from_s: float | None = None
 
+    @property
+    def step_counted(self) -> bool:
+        """In double stance while the operator is on one foot, his step counted as taken (an early contact, or a
+        recovery step that landed while he lifted the same foot): the character waits for his next change."""
+        return self.state is Stance.DS and self._early_latched_for is not None
+
     def begin_recovery_step(self, swing: str, time_s: float, timeout_s: float) -> Stance:
         """From double stance, lift ``swing`` on the character's own decision; the step ends at its contact, or
         after ``timeout_s``."""
