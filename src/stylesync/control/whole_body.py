@@ -31,6 +31,7 @@ from stylesync.control.contacts import SoleContact, feasible_horizontal_force, s
 from stylesync.control.controller import TORQUE_LIMIT, ControllerBase, ControlTelemetry, supporting_weights
 from stylesync.control.crvc import com_virtual_force, root_orientation_error, root_pd
 from stylesync.control.formulation import WholeBodyFormulation, hinge_limits
+from stylesync.control.gravity_compensation import LEG_JOINTS
 from stylesync.control.model_compensation import bounded_lipm_sync_force
 from stylesync.control.pid import IS_BALL
 from stylesync.control.solver import DaqpSolver
@@ -40,9 +41,8 @@ from stylesync.model.character import (
     ANKLE_HEIGHT_M,
     JOINT_DOF_COUNT,
     JOINT_DOF_START,
-    JOINT_NAMES,
     LINK_NAMES,
-    N_DOFS,
+    N_JOINT_DOFS,
     Q_WORLD_MODEL,
     ROOT_DOFS,
     SIDES,
@@ -56,9 +56,18 @@ from stylesync.motion.stance_fsm import swing_side
 log = logging.getLogger("stylesync.control")
 _FOOT_LINK = {s: LINK_NAMES.index(f"{s}_ankle") for s in SIDES}
 # Each leg's hip, knee and ankle DOFs, in the joint-DOF layout of the posture task.
-_LEG_DOFS = {s: np.concatenate([np.arange(JOINT_DOF_START[k], JOINT_DOF_START[k] + JOINT_DOF_COUNT[k])
-                                for k, name in enumerate(JOINT_NAMES)
-                                if name in (f"{s}_hip", f"{s}_knee", f"{s}_ankle")]) for s in SIDES}
+_LEG_DOFS = {s: np.concatenate([JOINT_DOF_START[k] + np.arange(JOINT_DOF_COUNT[k]) for k in LEG_JOINTS[s]])
+             for s in SIDES}
+
+
+def _leg_share(support: tuple[str, ...], share: float) -> np.ndarray:
+    """(n_joint_dofs,) the posture task's weight factor: ``share`` on the supporting legs' DOFs, 1 elsewhere."""
+    out = np.ones(N_JOINT_DOFS)
+    for s in support:
+        out[_LEG_DOFS[s]] = share
+    return out
+
+
 # A stance foot not yet touching is aimed this far below the ground [m], with this weight against a joint's: with
 # 2 cm and 100 a landing foot bounced off and slid in double stance (docs/decisions.md, "Landing").
 GROUND_PRESS_M = 0.035
@@ -106,7 +115,9 @@ class WholeBodyController(ControllerBase):
         self._arm_length_m = model.rest_distance("left_shoulder", "left_elbow") + model.rest_distance(
             "left_elbow", "left_wrist")
         self._hand_target: dict[str, np.ndarray] = {}  # the last tick's hand targets [m]
-        self._leg_share: dict[tuple[str, ...], np.ndarray] = {}  # the posture task's per-DOF share, per support
+        # The posture task's per-DOF weight share for each set of supporting feet (stance_leg_tracking_share)
+        self._leg_share: dict[tuple[str, ...], np.ndarray] = {support: _leg_share(support, wb.stance_leg_tracking_share)
+                           for support in ((), ("left",), ("right",), ("left", "right"))}
         self.contacts = {s: SoleContact(s, friction, mass.total_kg * gravity_mps2) for s in SIDES}
         self.solver = DaqpSolver()
 
@@ -182,13 +193,7 @@ class WholeBodyController(ControllerBase):
 
         # The supporting legs' posture weighs stance_leg_tracking_share of the rest's (WholeBodyConfig): their joint
         # angles are where the pelvis is over the feet, which the momentum and pelvis tasks already ask for.
-        key = tuple(support)
-        if key not in self._leg_share:
-            share = np.ones(N_DOFS - ROOT_DOFS)
-            for s in support:
-                share[_LEG_DOFS[s]] = wb.stance_leg_tracking_share
-            self._leg_share[key] = share
-        self.posture.dof_scale = self._leg_share[key]
+        self.posture.dof_scale = self._leg_share[tuple(support)]
         contacts = []
         for s in support:
             c = self.contacts[s]
