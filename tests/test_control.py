@@ -258,6 +258,8 @@ def test_eq26_is_checked_on_the_operators_motion_and_the_clamp_counted_apart():
     assert b.counts["lipm_force"] == 1
     line = b.summary(600.0)
     assert line is not None and "lipm_force" in line and "t=1.50 s" in line
+    demand = synchronised_tracking_force_n(lunge, m, g)
+    assert f"asks |f_cro| {demand:.0f} N > {limit:.0f} N (Eq. 26)" in line  # the detail, formatted when exceeded
 
 
 def test_the_built_in_walk_exceeds_no_movement_bound_and_logs_no_warning(caplog):

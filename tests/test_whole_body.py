@@ -11,7 +11,7 @@ import pytest
 from stylesync import rotations as rot
 from stylesync.config import ControlConfig, OperatorConfig, SessionConfig, WholeBodyConfig, WorldConfig
 from stylesync.control.contacts import FORCES_PER_SOLE, SoleContact
-from stylesync.control.formulation import WholeBodyFormulation
+from stylesync.control.formulation import WholeBodyFormulation, hinge_limits
 from stylesync.control.solver import DaqpSolver
 from stylesync.control.tasks import JointPostureTask, Task, TaskRows
 from stylesync.control.whole_body import _TORQUE_LIMIT_FLAT, HAND_REACH_SHARE
@@ -84,6 +84,27 @@ def test_solution_obeys_the_equations_of_motion_contacts_and_limits(standing):
         np.testing.assert_allclose(jac @ qdd, acc, atol=1e-6)
     normal = sum(float(c.normal_row @ lam[16 * i:16 * (i + 1)]) for i, c in enumerate(contacts))
     assert normal == pytest.approx(model.total_mass_kg * 9.8, rel=0.05)  # standing: the feet carry the body
+
+
+def test_hinge_limits_bound_the_accelerations_that_keep_them_over_the_horizon(standing):
+    """Each hinge's row is q̈ alone, bounded so that q + q̇ T + ½ q̈ T² stays within its limits (never tighter than 0)."""
+    _, model = standing
+    limits = hinge_limits(model.joint_limits_rad)
+    assert len(limits) == 4  # knees and elbows
+    t = 0.05
+    formulation = WholeBodyFormulation(_TORQUE_LIMIT_FLAT, limits, 10.0, t)
+    posture = formulation.add_task(JointPostureTask(10.0, 0.05))
+    posture.desired_accel = np.zeros(N_DOFS - ROOT_DOFS)
+    problem = formulation.build(model, [SoleContact("left", 0.9, 45.0 * 9.8)])
+    c_rows, lo, hi = problem.C[-len(limits):], problem.l[-len(limits):], problem.u[-len(limits):]
+    for k, lim in enumerate(limits):
+        assert np.flatnonzero(c_rows[k]).tolist() == [lim.dof] and c_rows[k, lim.dof] == 1.0
+        q, qd = model.joint_position(lim.dof), model.v[lim.dof]
+        assert lo[k] == pytest.approx(min(2.0 * (lim.lower_rad - q - qd * t) / t ** 2, 0.0))
+        assert hi[k] == pytest.approx(max(2.0 * (lim.upper_rad - q - qd * t) / t ** 2, 0.0))
+        assert lo[k] <= 0.0 <= hi[k]
+    np.testing.assert_array_equal(problem.b, problem.lower[:problem.n_eq])
+    np.testing.assert_array_equal(problem.upper[:problem.n_eq], problem.lower[:problem.n_eq])  # equalities
 
 
 def test_warm_start_reaches_the_cold_solution(standing):

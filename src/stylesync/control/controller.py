@@ -189,7 +189,7 @@ class BalanceController(ControllerBase):
             centre = 0.5 * (ref.ankle_world["left"] + ref.ankle_world["right"])
             d_c = float(np.linalg.norm((ref.com_world - centre)[:2]))
             self.bounds.report("ds_com", d_c > bnd.ds_com_bound_m(), state.time_s,
-                               f"COM {d_c:.3f} m from the support centre > {bnd.ds_com_bound_m():.3f} m (Eq. 24)")
+                               "COM %.3f m from the support centre > %.3f m (Eq. 24)", d_c, bnd.ds_com_bound_m())
         moment = np.zeros((len(JOINTS), 3))  # world moments of Eq. 17 and Eq. 20
         if np.any(force):
             moment += stance_force_moments(frames, state.link_com_world, self.mass.link_mass_kg, force, w)  # Eq. 17

@@ -31,16 +31,36 @@ T = TypeVar("T", bound=Task)
 
 @dataclass
 class QpProblem:
-    """``min ½ xᵀ H x + gᵀ x  s.t.  A x = b,  l <= C x <= u``."""
+    """``min ½ xᵀ H x + gᵀ x  s.t.  A x = b,  l <= C x <= u``, with the constraints stacked in one matrix as the
+    solver takes them: ``rows = [A; C]``, ``lower = [b; l]``, ``upper = [b; u]``."""
 
     H: np.ndarray
     g: np.ndarray
-    A: np.ndarray
-    b: np.ndarray
-    C: np.ndarray
-    l: np.ndarray
-    u: np.ndarray
+    rows: np.ndarray  # (n_eq + n_in, n): the equalities' rows, then the inequalities'
+    lower: np.ndarray  # (n_eq + n_in,)
+    upper: np.ndarray  # (n_eq + n_in,)
+    n_eq: int
     n_forces: int
+
+    @property
+    def A(self) -> np.ndarray:  # noqa: N802 (the QP's usual names)
+        return self.rows[:self.n_eq]
+
+    @property
+    def b(self) -> np.ndarray:
+        return self.lower[:self.n_eq]
+
+    @property
+    def C(self) -> np.ndarray:  # noqa: N802
+        return self.rows[self.n_eq:]
+
+    @property
+    def l(self) -> np.ndarray:  # noqa: E743
+        return self.lower[self.n_eq:]
+
+    @property
+    def u(self) -> np.ndarray:
+        return self.upper[self.n_eq:]
 
 
 @dataclass(frozen=True)
@@ -68,6 +88,9 @@ class WholeBodyFormulation:
         self.tasks: list[Task] = []
         self.torque_limit_nm = np.asarray(torque_limit_nm, dtype=float)  # (n_joint_dofs,)
         self.limits = limits
+        self._limit_dofs = np.array([lim.dof for lim in limits], dtype=int)
+        self._limit_lower = np.array([lim.lower_rad for lim in limits])  # [rad]
+        self._limit_upper = np.array([lim.upper_rad for lim in limits])  # [rad]
         self.contact_velocity_gain = contact_velocity_gain  # [1/s]
         self.limit_horizon_s = limit_horizon_s  # [s]
 
@@ -105,45 +128,45 @@ class WholeBodyFormulation:
             h_mat[sl, sl].flat[::FORCES_PER_SOLE + 1] = c.regularisation
             gen[:, sl.start - nv:sl.stop - nv] = c.generator
         m, h = model.mass_matrix, model.bias_forces
-        # Equalities: the root's equations of motion, then each sole's 6 acceleration rows.
-        a_eq = np.zeros((ROOT_DOFS + 6 * len(contacts), n))
-        b_eq = np.zeros(len(a_eq))
-        a_eq[:ROOT_DOFS, :nv] = m[:ROOT_DOFS]
-        a_eq[:ROOT_DOFS, nv:] = -gen[:ROOT_DOFS]
-        b_eq[:ROOT_DOFS] = -h[:ROOT_DOFS]
-        for i, c in enumerate(contacts):
-            jac, acc = c.constraint_rows(self.contact_velocity_gain)
-            a_eq[ROOT_DOFS + 6 * i:ROOT_DOFS + 6 * (i + 1), :nv] = jac
-            b_eq[ROOT_DOFS + 6 * i:ROOT_DOFS + 6 * (i + 1)] = acc
-        # Inequalities: joint torques, each sole's normal force, the pyramids' λ >= 0, the hinges' limits.
+        # Equalities: the root's equations of motion, then each sole's 6 acceleration rows. Then the inequalities:
+        # joint torques, each sole's normal force, the pyramids' λ >= 0, the hinges' limits.
+        n_eq = ROOT_DOFS + 6 * len(contacts)
         n_tau = nv - ROOT_DOFS
         n_in = n_tau + len(contacts) + n_f + len(self.limits)
-        c_in = np.zeros((n_in, n))
-        lower = np.empty(n_in)
-        upper = np.empty(n_in)
-        c_in[:n_tau, :nv] = m[ROOT_DOFS:]
-        c_in[:n_tau, nv:] = -gen[ROOT_DOFS:]
-        lower[:n_tau] = -self.torque_limit_nm - h[ROOT_DOFS:]
-        upper[:n_tau] = self.torque_limit_nm - h[ROOT_DOFS:]
-        row = n_tau
+        rows = np.zeros((n_eq + n_in, n))
+        lower = np.empty(n_eq + n_in)
+        upper = np.empty(n_eq + n_in)
+        rows[:ROOT_DOFS, :nv] = m[:ROOT_DOFS]
+        rows[:ROOT_DOFS, nv:] = -gen[:ROOT_DOFS]
+        lower[:ROOT_DOFS] = -h[:ROOT_DOFS]
         for i, c in enumerate(contacts):
-            c_in[row, nv + FORCES_PER_SOLE * i:nv + FORCES_PER_SOLE * (i + 1)] = c.normal_row
+            jac, acc = c.constraint_rows(self.contact_velocity_gain)
+            rows[ROOT_DOFS + 6 * i:ROOT_DOFS + 6 * (i + 1), :nv] = jac
+            lower[ROOT_DOFS + 6 * i:ROOT_DOFS + 6 * (i + 1)] = acc
+        upper[:n_eq] = lower[:n_eq]
+        row = n_eq
+        rows[row:row + n_tau, :nv] = m[ROOT_DOFS:]
+        rows[row:row + n_tau, nv:] = -gen[ROOT_DOFS:]
+        lower[row:row + n_tau] = -self.torque_limit_nm - h[ROOT_DOFS:]
+        upper[row:row + n_tau] = self.torque_limit_nm - h[ROOT_DOFS:]
+        row += n_tau
+        for i, c in enumerate(contacts):
+            rows[row, nv + FORCES_PER_SOLE * i:nv + FORCES_PER_SOLE * (i + 1)] = c.normal_row
             lower[row], upper[row] = 0.0, c.max_normal_force_n
             row += 1
-        c_in[row:row + n_f, nv:].flat[::n_f + 1] = 1.0
+        rows[row:row + n_f, nv:].flat[::n_f + 1] = 1.0
         lower[row:row + n_f], upper[row:row + n_f] = 0.0, INFINITY
         row += n_f
-        t = self.limit_horizon_s
-        for lim in self.limits:  # q + q̇ T + ½ q̈ T² within the limits
-            q, qd = model.joint_position(lim.dof), model.v[lim.dof]
-            c_in[row, lim.dof] = 1.0
-            lower[row] = min(2.0 * (lim.lower_rad - q - qd * t) / (t * t), 0.0)
-            upper[row] = max(2.0 * (lim.upper_rad - q - qd * t) / (t * t), 0.0)
-            row += 1
-        return QpProblem(h_mat, g, a_eq, b_eq, c_in, lower, upper, n_f)
+        if self.limits:  # q + q̇ T + ½ q̈ T² within the limits
+            t = self.limit_horizon_s
+            q, qd = model.joint_positions(self._limit_dofs), model.v[self._limit_dofs]
+            rows[row + np.arange(len(self.limits)), self._limit_dofs] = 1.0
+            lower[row:] = np.minimum(2.0 * (self._limit_lower - q - qd * t) / (t * t), 0.0)
+            upper[row:] = np.maximum(2.0 * (self._limit_upper - q - qd * t) / (t * t), 0.0)
+        return QpProblem(h_mat, g, rows, lower, upper, n_eq, n_f)
 
     @staticmethod
     def torques(model: CharacterModel, problem: QpProblem, x: np.ndarray) -> np.ndarray:
         """(n_joint_dofs,) joint torques of a solution: the joint rows of the equations of motion [N·m]."""
         nv = N_DOFS
-        return problem.C[:nv - ROOT_DOFS] @ x + model.bias_forces[ROOT_DOFS:]
+        return problem.rows[problem.n_eq:problem.n_eq + nv - ROOT_DOFS] @ x + model.bias_forces[ROOT_DOFS:]

@@ -70,9 +70,9 @@ def bounded_lipm_sync_force(lipm: LipmMap, mass_kg: float, gravity_mps2: float, 
     f = lipm_sync_force(lipm.d_a_human, lipm.h_human_m, lipm.d_a_char, lipm.h_char_m, mass_kg, gravity_mps2)
     limit = min(force_limit_n, lipm_force_bound_n(mass_kg, gravity_mps2, lipm.h_char_m))
     demand = synchronised_tracking_force_n(lipm, mass_kg, gravity_mps2)
-    bounds.report("lipm_force", demand > limit, time_s,
-                  f"his motion asks |f_cro| {demand:.0f} N > {limit:.0f} N (Eq. 26)")
+    bounds.report("lipm_force", demand > limit, time_s, "his motion asks |f_cro| %.0f N > %.0f N (Eq. 26)", demand,
+                  limit)
     mag = float(np.linalg.norm(f))
     exceeded = mag > limit and enforce
-    bounds.report("lipm_clamped", exceeded, time_s, f"|f_cro| {mag:.0f} N clamped to {limit:.0f} N")
+    bounds.report("lipm_clamped", exceeded, time_s, "|f_cro| %.0f N clamped to %.0f N", mag, limit)
     return f * (limit / mag) if exceeded else f

@@ -34,18 +34,18 @@ class DaqpSolver:
     def __init__(self, iter_limit: int = 1000):
         self.iter_limit = iter_limit
         self._duals: dict[tuple[int, int], np.ndarray] = {}  # the last multipliers per problem size
+        self._sense: dict[tuple[tuple[int, int], int], np.ndarray] = {}  # DAQP's row kinds per size and n_eq
 
     def solve(self, p: QpProblem) -> QpResult:
-        n_eq = len(p.A)
-        a = np.vstack([p.A, p.C])
-        upper = np.concatenate([p.b, p.u])
-        lower = np.concatenate([p.b, p.l])
-        sense = np.zeros(len(a), dtype=c_int)
-        sense[:n_eq] = EQUALITY
-        key = a.shape
+        key = p.rows.shape
+        sense = self._sense.get((key, p.n_eq))
+        if sense is None:
+            sense = self._sense[(key, p.n_eq)] = np.zeros(len(p.rows), dtype=c_int)
+            sense[:p.n_eq] = EQUALITY
         warm = self._duals.get(key)
         kwargs = {"dual_start": warm} if warm is not None else {}
-        x, _, exitflag, info = daqp.solve(p.H, p.g, a, upper, lower, sense, iter_limit=self.iter_limit, **kwargs)
+        x, _, exitflag, info = daqp.solve(p.H, p.g, p.rows, p.upper, p.lower, sense, iter_limit=self.iter_limit,
+                                          **kwargs)
         solved = exitflag in DAQP_OPTIMAL
         if solved:
             self._duals[key] = np.asarray(info["lam"], dtype=float)

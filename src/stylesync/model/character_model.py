@@ -159,7 +159,8 @@ class CharacterModel:
         self._q_idx, self._q_flat = np.array(q_idx), np.array(q_flat)
         self._v_idx, self._v_flat = np.array(v_idx), np.array(v_flat)
         self._perm = perm
-        self._perm_rows_cols = np.ix_(perm, perm)
+        self._hinge_q_of_dof = np.full(self.nv, -1)  # a hinge's index in q by its DOF (-1: not a hinge)
+        self._hinge_q_of_dof[list(self._hinge_q)] = list(self._hinge_q.values())
         self.q = pin.neutral(self.model)
         self.v = np.zeros(self.nv)
         self._zero_a = np.zeros(self.nv)
@@ -212,16 +213,16 @@ class CharacterModel:
     def update_qv(self, q: np.ndarray, v: np.ndarray) -> None:
         """:meth:`update` from Pinocchio's q and v. Results are in the character's DOF layout."""
         m, d, p = self.model, self.data, self._perm
-        self.q, self.v = q, v[p]
+        self.q, self.v = q, v.take(p)
         # Frame accelerations at q̈ = 0 are the drift terms J̇ q̇ of the tasks.
         pin.forwardKinematics(m, d, q, v, self._zero_a)
         pin.computeJointJacobians(m, d)  # from the placements just computed
         pin.updateFramePlacements(m, d)
         pin.crba(m, d, q, pin.Convention.WORLD)
-        self.mass_matrix = d.M[self._perm_rows_cols]  # (nv, nv); crba fills M whole
-        self.bias_forces = pin.nonLinearEffects(m, d, q, v)[p]  # (nv,) C(q, v) v + g(q) [N, N·m]
+        self.mass_matrix = d.M.take(p, 0).take(p, 1)  # (nv, nv); crba fills M whole
+        self.bias_forces = pin.nonLinearEffects(m, d, q, v).take(p)  # (nv,) C(q, v) v + g(q) [N, N·m]
         pin.computeCentroidalMapTimeVariation(m, d, q, v)  # also the COM and the centroidal momentum
-        self.centroidal_map = d.Ag[:, p]  # (6, nv): [linear; angular about the COM] momentum
+        self.centroidal_map = d.Ag.take(p, 1)  # (6, nv): [linear; angular about the COM] momentum
         self.centroidal_map_dot_v = d.dAg @ v  # (6,) Ȧ_g v
         self.com_world = d.com[0].copy()  # (3,) [m]
         self.com_vel_world = (d.Ag[:3] @ v) / self.total_mass_kg  # (3,) [m/s]
@@ -245,7 +246,7 @@ class CharacterModel:
 
     def frame_jacobian(self, frame: int) -> np.ndarray:
         """(6, nv) [linear; angular] Jacobian of the frame, LOCAL_WORLD_ALIGNED."""
-        return pin.getFrameJacobian(self.model, self.data, frame, _LWA)[:, self._perm]
+        return pin.getFrameJacobian(self.model, self.data, frame, _LWA).take(self._perm, 1)
 
     def frame_velocity(self, frame: int) -> np.ndarray:
         """(6,) [linear; angular] velocity of the frame's origin, world axes [m/s, rad/s]."""
@@ -274,3 +275,7 @@ class CharacterModel:
     def joint_position(self, dof: int) -> float:
         """A hinge's angle [rad] by its index in the character's DOF layout."""
         return float(self.q[self._hinge_q[dof]])
+
+    def joint_positions(self, dofs: np.ndarray) -> np.ndarray:
+        """Hinges' angles [rad] by their indices in the character's DOF layout."""
+        return self.q[self._hinge_q_of_dof[dofs]]

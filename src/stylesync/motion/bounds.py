@@ -55,10 +55,14 @@ class BoundsMonitor:
     first: dict[str, tuple[float, str]] = field(default_factory=dict)
     _last_log_s: dict[str, float] = field(default_factory=dict)
 
-    def report(self, kind: str, exceeded: bool, time_s: float, detail: str) -> None:
+    def report(self, kind: str, exceeded: bool, time_s: float, detail: str, *args: float) -> None:
+        """Whether the bound ``kind`` is exceeded at ``time_s``; ``detail % args`` says by how much (formatted only
+        when it is exceeded: this runs at every control tick)."""
         self.active[kind] = exceeded
         if not exceeded:
             return
+        if args:
+            detail = detail % args
         self.counts[kind] += 1
         self.first.setdefault(kind, (time_s, detail))
         if time_s - self._last_log_s.get(kind, -np.inf) >= _LOG_INTERVAL_S:

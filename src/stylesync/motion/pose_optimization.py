@@ -599,8 +599,8 @@ class MotionOptimizer:
         step = target[:2] - a_c[other][:2]
         dist = float(np.linalg.norm(step))
         tick.step_exceeded = dist > bound
-        self.bounds.report("step_length", tick.step_exceeded, state.time_s,
-                           f"step {dist:.2f} m > bound {bound:.2f} m (Eq. 28)")
+        self.bounds.report("step_length", tick.step_exceeded, state.time_s, "step %.2f m > bound %.2f m (Eq. 28)",
+                           dist, bound)
         if tick.step_exceeded:
             target[:2] = a_c[other][:2] + step * (bound / dist)
         # The swing starts where the foot lifts off: the difference to the first target is taken up over
