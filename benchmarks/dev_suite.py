@@ -74,6 +74,7 @@ def main() -> None:
                          "changes included)")
     ap.add_argument("--only", default="", help="comma-separated categories to run (default: all)")
     ap.add_argument("--seeds", type=int, default=3)
+    ap.add_argument("--first-seed", type=int, default=0, help="seeds run: first-seed .. first-seed + seeds - 1")
     ap.add_argument("--duration", type=float, default=12.0)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--out", default="out/dev_suite")
@@ -86,7 +87,8 @@ def main() -> None:
         refs[f"baseline {args.baseline}"] = args.baseline
     with checkouts(refs) as checked_out:
         trees = {"this version": REPO / "src", **checked_out} if args.version == "worktree" else checked_out
-        jobs = [(spec, name, cat, seed, v) for spec, name, cat in clips for seed in range(args.seeds) for v in trees]
+        seeds = range(args.first_seed, args.first_seed + args.seeds)
+        jobs = [(spec, name, cat, seed, v) for spec, name, cat in clips for seed in seeds for v in trees]
 
         def run(job):
             spec, name, cat, seed, v = job

@@ -149,6 +149,24 @@ def test_a_walk_cut_mid_stride_comes_to_rest_with_its_own_last_step():
     assert off.fell and off.fall_time_s is not None and off.fall_time_s > 2.27
 
 
+@pytest.mark.skipif(not (MOCAP / "cmu" / "02_01.bvh").exists(),
+                    reason="../shared/mocap/cmu/02_01.bvh is not available")
+def test_a_swing_he_stops_on_is_landed_at_once_where_the_capture_point_goes():
+    """CMU 02_01 ends (2.8 s) on a swing that the operator lowers as he comes to rest. The stopping landing moves the
+    character's foot to catch its capture point, and a recovery step lands it there at once: it stops with that one
+    step. Left to his slower lowering of the foot, the capture point runs on, eight recovery steps do not catch it,
+    and it falls in the rest (measured: 5.74 s, seed 0)."""
+    spec = f"bvh:{MOCAP / 'cmu' / '02_01.bvh'}"
+    result, session = _run(spec, 5.8, MotionConfig())
+    assert not result.fell
+    assert session.motion.recovery.count == 1
+    com_vel = session.mass.com_velocity(session.backend.read_state(result.sim_duration_s))
+    assert float(np.linalg.norm(com_vel[:2])) < 0.05  # at rest at the end
+    off, session_off = _run(spec, 5.8, MotionConfig(recovery_on_stopping_step=False))
+    assert off.fell and off.fall_time_s is not None and off.fall_time_s > 2.8
+    assert session_off.motion.recovery.count > 1
+
+
 def test_the_fsm_lets_the_balance_land_a_swing_it_takes_over():
     fsm = CharacterStanceFsm(late_contact_timeout_s=0.4, min_swing_s=0.12)
     both, up = {"left": True, "right": True}, {"left": True, "right": False}

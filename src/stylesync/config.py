@@ -168,6 +168,10 @@ class MotionConfig:
     # swing time, while the character's capture point is outside its stance sole by more than the margin, is
     # landed by the balance (a recovery step takes it over) [-]
     recovery_swing_overrun: float = 1.5
+    # ... and at once when the operator stops on this step (he stands over his soles) and the landing his step gives
+    # would not catch the character's capture point: the stopping landing (pose_optimization.py) is then reached in
+    # a recovery step's time, not in his slower lowering of the foot
+    recovery_on_stopping_step: bool = True
     # During a recovery step the COM task holds the character's own COM state (no pull towards the operator's
     # stance): the body moves as the landing's capture-point prediction assumes
     recovery_step_free_com: bool = True

@@ -221,6 +221,7 @@ class MotionOptimizer:
         self._op_last_ds_s = 0.0
         self.recovery = RecoveryStepper(cfg, CHAR_LEG_LENGTH_M, gravity_mps2)
         self._operator_stands_since_s: float | None = None
+        self._stopping_capture_side: str | None = None  # the swing whose landing _stopping_landing moved last tick
         self._sole_bound = sole_corner_points(cfg.capture_bound_sole_share)  # shrunk for capture_bound.py [m]
         self.reading: MotionReading | None = None  # the last tick's reading of the operator, besides the targets
 
@@ -506,6 +507,7 @@ class MotionOptimizer:
                                                          stance_q, tick.R_root_d, side)
         if stands_on(xi_land, tick.a_c[other], stance_q, landing, tick.R_root_d):
             return landing
+        self._stopping_capture_side = side  # landed by a recovery step next tick (_land_overrun_swing)
         return capture
 
     def _recovery_step(self, tick: _Tick, state: CharacterState) -> None:
@@ -541,10 +543,16 @@ class MotionOptimizer:
         """Step timing adapted to the balance: a swing that has lasted ``recovery_swing_overrun`` times the
         operator's usual swing time (he holds a foot up: a pose on one leg, the held last frame of a clip) while the
         character's capture point has left its stance sole by more than the margin (it cannot stand on one foot
-        as he does) becomes a recovery step, which lands the foot where the capture point will be."""
+        as he does) becomes a recovery step, which lands the foot where the capture point will be. With
+        ``recovery_on_stopping_step``, a swing whose landing the last tick's :meth:`_stopping_landing` moved to catch
+        the capture point (he stops on this step, the character cannot) becomes one at once: his foot, lowered as
+        he comes to rest, would land it 0.3-0.5 s later while the capture point runs on."""
         cfg = self.cfg
         sw = swing_side(tick.ch_state)
         overrun_s = cfg.recovery_swing_overrun * self._op_swing_s
+        stopping_side, self._stopping_capture_side = self._stopping_capture_side, None
+        if cfg.recovery_on_stopping_step and stopping_side is not None and stopping_side == sw:
+            overrun_s = 0.0
         if (not cfg.recovery_steps or sw is None or sw != self._swing or self.char_fsm.recovery_step
                 or self.char_fsm.hold_reference or state.time_s - self._swing_t0_s < overrun_s):
             return
