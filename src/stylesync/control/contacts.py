@@ -98,22 +98,33 @@ class SoleContact:
         self.drift = np.zeros(6)
         self.velocity = np.zeros(6)
         self.corners_world = np.zeros((4, 3))
+        self._updated_for: tuple[int, int] | None = None  # (model, revision) of the last update
         # Normal components of the 16 unit forces (the same at every corner): Σ_e n_e λ_e is the normal force.
         self.normal_row = np.tile(self.edges[:, 2], 4)
         self._forces = np.tile(self.edges.T, 4)  # (3, 16): the unit forces, corner by corner, edge by edge
-        # The rows (4 edges x 3, 3) that give every edge's moment r × β_e from a lever r.
-        self._lever_to_moments = np.concatenate([np.cross(np.eye(3), b).T for b in self.edges])
+        # The map (3 * 16, 4 corners x 3) from the four corners' levers r_c, stacked, to every unit force's moment
+        # r_c × β_e, (3, 16) flattened: corner by corner, edge by edge as in _forces.
+        lever_to_moments = np.zeros((3, FORCES_PER_SOLE, 4, 3))
+        for c in range(4):
+            for e, b in enumerate(self.edges):
+                lever_to_moments[:, 4 * c + e, c, :] = np.cross(np.eye(3), b).T  # K r = r × b
+        self._lever_to_moments = lever_to_moments.reshape(3 * FORCES_PER_SOLE, 12)
 
     def update(self, model: CharacterModel) -> None:
+        """The sole's Jacobian, drift, velocity, corners and generator at the model's current state (once per model
+        update: a second call for the same state does nothing)."""
+        if self._updated_for == (id(model), model.revision):
+            return
+        self._updated_for = (id(model), model.revision)
         f = model.frame_id(self.frame)
         self.jacobian = model.frame_jacobian(f)
         self.drift = model.frame_drift(f)
         self.velocity = model.frame_velocity(f)
-        r_world_sole = model.frame_rotation(f)
-        levers = SOLE_CORNERS_IN_SOLE @ r_world_sole.T  # (4, 3) corner - sole centre, world axes
-        self.corners_world = model.frame_position(f) + levers
+        placement = model.frame_placement(f)
+        levers = SOLE_CORNERS_IN_SOLE @ placement.rotation.T  # (4, 3) corner - sole centre, world axes
+        self.corners_world = placement.translation + levers
         # B = Σ_c J_cᵀ β_e = J_linᵀ β_e + J_angᵀ (r_c × β_e), corner by corner, edge by edge.
-        moments = (self._lever_to_moments @ levers.T).reshape(4, 3, 4).transpose(1, 2, 0).reshape(3, 16)
+        moments = (self._lever_to_moments @ levers.reshape(12)).reshape(3, FORCES_PER_SOLE)
         self.generator = self.jacobian[:3].T @ self._forces + self.jacobian[3:].T @ moments
 
     @property

@@ -115,7 +115,10 @@ class WholeBodyFormulation:
                 continue
             r = task.rows(model)
             if r.jacobian is None:  # rows on single DOFs: a diagonal
-                h_mat[r.dofs, r.dofs] += r.weight
+                if isinstance(r.dofs, slice):  # a range of DOFs: a strided view of the diagonal
+                    h_mat.ravel()[r.dofs.start * (n + 1):r.dofs.stop * (n + 1):n + 1] += r.weight
+                else:
+                    h_mat[r.dofs, r.dofs] += r.weight
                 g[r.dofs] -= r.weight * r.target
                 continue
             wj = r.weight[:, None] * r.jacobian
@@ -125,7 +128,7 @@ class WholeBodyFormulation:
         for i, c in enumerate(contacts):
             c.update(model)
             sl = slice(nv + FORCES_PER_SOLE * i, nv + FORCES_PER_SOLE * (i + 1))
-            h_mat[sl, sl].flat[::FORCES_PER_SOLE + 1] = c.regularisation
+            h_mat.ravel()[sl.start * (n + 1):sl.stop * (n + 1):n + 1] = c.regularisation
             gen[:, sl.start - nv:sl.stop - nv] = c.generator
         m, h = model.mass_matrix, model.bias_forces
         # Equalities: the root's equations of motion, then each sole's 6 acceleration rows. Then the inequalities:

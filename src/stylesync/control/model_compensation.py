@@ -12,6 +12,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from stylesync import rotations as rot
@@ -54,7 +56,7 @@ def synchronised_tracking_force_n(lipm: LipmMap, mass_kg: float, gravity_mps2: f
     """|f_cro| [N] that Eq. 23 asks of a character that tracks the operator exactly (d_aC = d_aH h_C / h_H):
     ``m_C g |d_aH| |h_C - h_H| / h_H²``. It depends on the operator's motion alone: the ankle torque it implies
     (Eq. 25) is what his motion asks of the character's foot, the counterpart of Eq. 28 for the COM."""
-    d = float(np.linalg.norm(np.asarray(lipm.d_a_human)[:2]))
+    d = math.hypot(float(lipm.d_a_human[0]), float(lipm.d_a_human[1]))
     return mass_kg * gravity_mps2 * d * abs(lipm.h_char_m - lipm.h_human_m) / lipm.h_human_m ** 2
 
 
@@ -72,7 +74,7 @@ def bounded_lipm_sync_force(lipm: LipmMap, mass_kg: float, gravity_mps2: float, 
     demand = synchronised_tracking_force_n(lipm, mass_kg, gravity_mps2)
     bounds.report("lipm_force", demand > limit, time_s, "his motion asks |f_cro| %.0f N > %.0f N (Eq. 26)", demand,
                   limit)
-    mag = float(np.linalg.norm(f))
+    mag = math.hypot(float(f[0]), float(f[1]))  # (f has no z component)
     exceeded = mag > limit and enforce
     bounds.report("lipm_clamped", exceeded, time_s, "|f_cro| %.0f N clamped to %.0f N", mag, limit)
     return f * (limit / mag) if exceeded else f

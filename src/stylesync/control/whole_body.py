@@ -27,7 +27,7 @@ import numpy as np
 
 from stylesync import rotations as rot
 from stylesync.config import ControlConfig
-from stylesync.control.contacts import SoleContact, feasible_horizontal_force, sole_corners_world, sole_touches
+from stylesync.control.contacts import SoleContact, feasible_horizontal_force, sole_touches
 from stylesync.control.controller import TORQUE_LIMIT, ControllerBase, ControlTelemetry, supporting_weights
 from stylesync.control.crvc import com_virtual_force, root_orientation_error, root_pd
 from stylesync.control.formulation import WholeBodyFormulation, hinge_limits
@@ -147,9 +147,9 @@ class WholeBodyController(ControllerBase):
             f_lipm = bounded_lipm_sync_force(ref.lipm, m, self.g, cfg.lipm_force_limit_n, cfg.enforce_bounds,
                                              self.bounds, state.time_s)
             force += f_lipm
-        corners = [sole_corners_world(state.link_origin_world[_FOOT_LINK[s]], state.link_quat_wxyz[_FOOT_LINK[s]])
-                   for s in support]
-        force = feasible_horizontal_force(force, com, corners, m, self.g)
+        for s in support:
+            self.contacts[s].update(model)
+        force = feasible_horizontal_force(force, com, [self.contacts[s].corners_world for s in support], m, self.g)
         e_root = root_orientation_error(ref.root_quat_wxyz, state.root_quat_wxyz)
         moment = root_pd(e_root, state.root_ang_vel_world, wb.momentum_root_kp, wb.momentum_root_kd,
                          cfg.root_yaw_gain_scale)
@@ -158,11 +158,11 @@ class WholeBodyController(ControllerBase):
         # Joint posture: Eq. 13 per unit inertia, saturated (a jump of the reference, a stance change or a landing,
         # would otherwise ask for accelerations whose torques exceed the joints' limits).
         e = self._error_and_reference_velocity(state.joint_pos, ref)
-        qdd_joint = self.kp * e + self.kd * (self._ref_vel - state.joint_vel)
+        qdd_joint = flatten_joint_values(self.kp * e + self.kd * (self._ref_vel - state.joint_vel))
         m_diag = model.mass_matrix.diagonal()
-        own = JOINT_ACCEL_TORQUE_SHARE * TORQUE_LIMIT / np.maximum(unflatten_joint_values(m_diag[ROOT_DOFS:]), 1e-6)
+        own = JOINT_ACCEL_TORQUE_SHARE * _TORQUE_LIMIT_FLAT / np.maximum(m_diag[ROOT_DOFS:], 1e-6)
         lim = np.maximum(wb.joint_acceleration_limit_rad_s2, own)
-        self.posture.desired_accel = flatten_joint_values(np.minimum(np.maximum(qdd_joint, -lim), lim))
+        self.posture.desired_accel = np.minimum(np.maximum(qdd_joint, -lim), lim)
 
         # Pelvis orientation, weighted by the pelvis's rotational inertia about world axes (as a joint's by M_ii).
         r_base = model.data.oMi[1].rotation

@@ -165,6 +165,7 @@ class CharacterModel:
         self.v = np.zeros(self.nv)
         self._zero_a = np.zeros(self.nv)
         self.mass_matrix = np.zeros((self.nv, self.nv))
+        self.revision = 0  # counts the updates: what was computed from the model can tell whether it is current
 
     # ---- indices -----------------------------------------------------------------------------------------
     def frame_id(self, name: str) -> int:
@@ -213,6 +214,7 @@ class CharacterModel:
     def update_qv(self, q: np.ndarray, v: np.ndarray) -> None:
         """:meth:`update` from Pinocchio's q and v. Results are in the character's DOF layout."""
         m, d, p = self.model, self.data, self._perm
+        self.revision += 1
         self.q, self.v = q, v.take(p)
         # Frame accelerations at q̈ = 0 are the drift terms J̇ q̇ of the tasks.
         pin.forwardKinematics(m, d, q, v, self._zero_a)
@@ -238,6 +240,10 @@ class CharacterModel:
         return pin.jacobianCenterOfMass(self.model, self.data, self.q, False)[:, self._perm]
 
     # ---- frames ------------------------------------------------------------------------------------------
+    def frame_placement(self, frame: int) -> pin.SE3:
+        """The frame's world placement at the last update (Pinocchio's own object: read it before the next)."""
+        return self.data.oMf[frame]
+
     def frame_position(self, frame: int) -> np.ndarray:
         return self.data.oMf[frame].translation.copy()
 

@@ -23,7 +23,7 @@ class TaskRows:
     jacobian: np.ndarray | None  # (k, nv), or None with dofs
     target: np.ndarray  # (k,)
     weight: np.ndarray  # (k,) per-row weight (>= 0)
-    dofs: np.ndarray | None = None  # (k,) DOF indices when jacobian is None
+    dofs: np.ndarray | slice | None = None  # (k,) DOF indices (or a range of them) when jacobian is None
 
 
 class Task(ABC):

@@ -30,7 +30,7 @@ class FramePositionTask(Task):
     def rows(self, model: CharacterModel) -> TaskRows:
         f = model.frame_id(self.frame)
         jac = model.frame_jacobian(f)[self.axes]
-        pos, vel = model.frame_position(f), model.frame_velocity(f)[:3]
+        pos, vel = model.frame_placement(f).translation, model.frame_velocity(f)[:3]
         accel = self.kp * (self.target_world - pos) + self.kd * (self.target_vel_world - vel)
         target = accel[self.axes] - model.frame_drift(f)[self.axes]
         return TaskRows(jac, target, np.full(len(self.axes), self.weight))
@@ -54,7 +54,7 @@ class FrameOrientationTask(Task):
 
     def rows(self, model: CharacterModel) -> TaskRows:
         f = model.frame_id(self.frame)
-        r = model.frame_rotation(f) @ self._r_frame_canonical
+        r = model.frame_placement(f).rotation @ self._r_frame_canonical
         self.error_rotvec = pin.log3(rot.matrix_from_quat(self.target_quat_wxyz) @ r.T)
         omega = model.frame_velocity(f)[3:]
         accel = self.gain_scale * (self.kp * self.error_rotvec - self.kd * omega)

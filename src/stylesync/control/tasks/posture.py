@@ -21,7 +21,7 @@ class JointPostureTask(Task):
         self.weight = weight
         self.min_inertia_kgm2 = min_inertia_kgm2  # [kg·m²]
         self.desired_accel = np.zeros(N_DOFS - ROOT_DOFS)  # (n_joint_dofs,) [rad/s²], set per tick
-        self._dofs = np.arange(ROOT_DOFS, N_DOFS)
+        self._dofs = slice(ROOT_DOFS, N_DOFS)
         self.dof_scale: np.ndarray | None = None  # (n_joint_dofs,) per-DOF factor on the weight, set per tick
 
     def rows(self, model: CharacterModel) -> TaskRows:
