@@ -161,6 +161,10 @@ class MotionConfig:
     recovery_swing_s: float = 0.2
     recovery_step_height_m: float = 0.05
     recovery_min_stance_s: float = 0.1
+    # A recovery step lands its ankle at most this share of the leg's length from the stance ankle (the pelvis lowered
+    # as the leg needs, recovery_landing_reach): at 0.6 the steps that stop a walk landed short of the capture point,
+    # and each left the body faster (docs/decisions.md, "Longer recovery steps") [-]
+    recovery_step_reach_share: float = 0.75
     # ... also while the operator is on one foot but the character, its step for his counted as taken (early
     # contact), stands on both and waits for his next change
     recovery_while_step_counted: bool = True
@@ -200,6 +204,7 @@ class MotionConfig:
         _positive("MotionConfig.recovery_swing_s", self.recovery_swing_s)
         _non_negative("MotionConfig.recovery_step_height_m", self.recovery_step_height_m)
         _non_negative("MotionConfig.recovery_min_stance_s", self.recovery_min_stance_s)
+        _positive("MotionConfig.recovery_step_reach_share", self.recovery_step_reach_share)
         _positive("MotionConfig.recovery_swing_overrun", self.recovery_swing_overrun)
         _non_negative("MotionConfig.reference_follows_operator_s", self.reference_follows_operator_s)
         for n in ("liftoff_weight_shift_s", "liftoff_after_stand_s", "liftoff_margin_m"):

@@ -20,7 +20,7 @@ own:
   stance sole's point nearest ξ, ``ξ(t + τ) = p + (ξ(t) - p) e^(ω τ)``, τ the swing time left; the sole is placed
   with its trailing edge there (trailing along ξ's direction of divergence from p), so that every centre of
   pressure on the new sole drives ξ back;
-* within the leg's reach (``MAX_STEP_SHARE`` of its length from the stance ankle) and never across the stance
+* within the leg's reach (``MotionConfig.recovery_step_reach_share`` of its length from the stance ankle) and never across the stance
   foot (at least ``MIN_FOOT_SEPARATION_M`` outwards of it, in the heading frame);
 * the foot rises ``recovery_step_height_m`` at mid-swing, follows a smooth step from its lift-off point to the
   landing, and after ``recovery_swing_s`` is lowered below the ground until it touches (the stance FSM ends the
@@ -61,7 +61,6 @@ from stylesync.model.sole import (
 from stylesync.model.state import CharacterState
 from stylesync.processing.interpolation import smooth_step
 
-MAX_STEP_SHARE = 0.6  # the landing ankle is at most this share of the leg's length from the stance ankle
 MIN_FOOT_SEPARATION_M = 1.2 * HIP_HALF_WIDTH_M  # the swing ankle lands at least this far outwards of the stance one
 LANDING_PRESS_M = 0.02  # after the nominal swing time the foot is aimed this far below the ground [m]
 # The foot reaches the landing point horizontally at this share of the nominal swing time (the remaining share
@@ -147,7 +146,7 @@ class RecoveryStepper:
     def __init__(self, cfg: MotionConfig, leg_length_m: float, gravity_mps2: float):
         self.cfg = cfg
         self.g = gravity_mps2
-        self.max_step_m = MAX_STEP_SHARE * leg_length_m
+        self.max_step_m = cfg.recovery_step_reach_share * leg_length_m
         self.step: RecoveryStep | None = None
         self.count = 0  # recovery steps taken
         self._last_end_s = -np.inf
