@@ -20,8 +20,8 @@ own:
   stance sole's point nearest ξ, ``ξ(t + τ) = p + (ξ(t) - p) e^(ω τ)``, τ the swing time left; the sole is placed
   with its trailing edge there (trailing along ξ's direction of divergence from p), so that every centre of
   pressure on the new sole drives ξ back;
-* within the leg's reach (``MotionConfig.recovery_step_reach_share`` of its length from the stance ankle) and never across the stance
-  foot (at least ``MIN_FOOT_SEPARATION_M`` outwards of it, in the heading frame);
+* within the leg's reach (``MotionConfig.recovery_step_reach_share`` of its length from the stance ankle) and
+  never across the stance foot (at least ``MIN_FOOT_SEPARATION_M`` outwards of it, in the heading frame);
 * the foot rises ``recovery_step_height_m`` at mid-swing, follows a smooth step from its lift-off point to the
   landing, and after ``recovery_swing_s`` is lowered below the ground until it touches (the stance FSM ends the
   step on its contact).
