@@ -89,6 +89,7 @@ class WholeBodyFormulation:
         self.torque_limit_nm = np.asarray(torque_limit_nm, dtype=float)  # (n_joint_dofs,)
         self.limits = limits
         self._limit_dofs = np.array([lim.dof for lim in limits], dtype=int)
+        self._limit_rows = np.arange(len(limits))
         self._limit_lower = np.array([lim.lower_rad for lim in limits])  # [rad]
         self._limit_upper = np.array([lim.upper_rad for lim in limits])  # [rad]
         self.contact_velocity_gain = contact_velocity_gain  # [1/s]
@@ -163,7 +164,7 @@ class WholeBodyFormulation:
         if self.limits:  # q + q̇ T + ½ q̈ T² within the limits
             t = self.limit_horizon_s
             q, qd = model.joint_positions(self._limit_dofs), model.v[self._limit_dofs]
-            rows[row + np.arange(len(self.limits)), self._limit_dofs] = 1.0
+            rows[row + self._limit_rows, self._limit_dofs] = 1.0
             lower[row:] = np.minimum(2.0 * (self._limit_lower - q - qd * t) / (t * t), 0.0)
             upper[row:] = np.maximum(2.0 * (self._limit_upper - q - qd * t) / (t * t), 0.0)
         return QpProblem(h_mat, g, rows, lower, upper, n_eq, n_f)
@@ -171,5 +172,4 @@ class WholeBodyFormulation:
     @staticmethod
     def torques(model: CharacterModel, problem: QpProblem, x: np.ndarray) -> np.ndarray:
         """(n_joint_dofs,) joint torques of a solution: the joint rows of the equations of motion [N·m]."""
-        nv = N_DOFS
-        return problem.rows[problem.n_eq:problem.n_eq + nv - ROOT_DOFS] @ x + model.bias_forces[ROOT_DOFS:]
+        return problem.C[:N_DOFS - ROOT_DOFS] @ x + model.bias_forces[ROOT_DOFS:]

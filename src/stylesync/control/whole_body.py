@@ -147,9 +147,11 @@ class WholeBodyController(ControllerBase):
             f_lipm = bounded_lipm_sync_force(ref.lipm, m, self.g, cfg.lipm_force_limit_n, cfg.enforce_bounds,
                                              self.bounds, state.time_s)
             force += f_lipm
-        for s in support:
-            self.contacts[s].update(model)
-        force = feasible_horizontal_force(force, com, [self.contacts[s].corners_world for s in support], m, self.g)
+        contacts = [self.contacts[s] for s in support]
+        for c in contacts:
+            c.stance_weight = w[c.side]
+            c.update(model)  # its corners bound the force here; the formulation reads the rest of it
+        force = feasible_horizontal_force(force, com, [c.corners_world for c in contacts], m, self.g)
         e_root = root_orientation_error(ref.root_quat_wxyz, state.root_quat_wxyz)
         moment = root_pd(e_root, state.root_ang_vel_world, wb.momentum_root_kp, wb.momentum_root_kd,
                          cfg.root_yaw_gain_scale)
@@ -194,11 +196,6 @@ class WholeBodyController(ControllerBase):
         # The supporting legs' posture weighs stance_leg_tracking_share of the rest's (WholeBodyConfig): their joint
         # angles are where the pelvis is over the feet, which the momentum and pelvis tasks already ask for.
         self.posture.dof_scale = self._leg_share[tuple(support)]
-        contacts = []
-        for s in support:
-            c = self.contacts[s]
-            c.stance_weight = w[s]
-            contacts.append(c)
         problem = self.formulation.build(model, contacts)
         result = self.solver.solve(problem)
         if not result.solved:

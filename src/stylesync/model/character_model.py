@@ -138,7 +138,7 @@ class CharacterModel:
         self.link_frame_ids = [self._frame_ids[n] for n in LINK_NAMES]
         # Index maps from the state's (n_joints, 4) / (n_joints, 3) arrays to q and v (wxyz -> xyzw for balls).
         q_idx, v_idx, q_flat, v_flat = [], [], [], []
-        self._hinge_q: dict[int, int] = {}  # a hinge's DOF in the character's layout -> its index in q
+        self._hinge_q_of_dof = np.full(self.nv, -1)  # a hinge's index in q by its DOF in the character's layout
         perm = np.arange(self.nv)  # perm[i]: Pinocchio's index of DOF i of the character's layout
         for k, spec in enumerate(JOINTS):
             jid = self.model.getJointId(spec.name)
@@ -151,7 +151,7 @@ class CharacterModel:
                 v_idx += [iv, iv + 1, iv + 2]
                 v_flat += [3 * k, 3 * k + 1, 3 * k + 2]
             else:
-                self._hinge_q[ROOT_DOFS + JOINT_DOF_START[k]] = iq
+                self._hinge_q_of_dof[ROOT_DOFS + JOINT_DOF_START[k]] = iq
                 q_idx.append(iq)
                 q_flat.append(4 * k)
                 v_idx.append(iv)
@@ -159,8 +159,6 @@ class CharacterModel:
         self._q_idx, self._q_flat = np.array(q_idx), np.array(q_flat)
         self._v_idx, self._v_flat = np.array(v_idx), np.array(v_flat)
         self._perm = perm
-        self._hinge_q_of_dof = np.full(self.nv, -1)  # a hinge's index in q by its DOF (-1: not a hinge)
-        self._hinge_q_of_dof[list(self._hinge_q)] = list(self._hinge_q.values())
         self.q = pin.neutral(self.model)
         self.v = np.zeros(self.nv)
         self._zero_a = np.zeros(self.nv)
@@ -280,7 +278,7 @@ class CharacterModel:
 
     def joint_position(self, dof: int) -> float:
         """A hinge's angle [rad] by its index in the character's DOF layout."""
-        return float(self.q[self._hinge_q[dof]])
+        return float(self.q[self._hinge_q_of_dof[dof]])
 
     def joint_positions(self, dofs: np.ndarray) -> np.ndarray:
         """Hinges' angles [rad] by their indices in the character's DOF layout."""
