@@ -63,6 +63,27 @@ def test_builtin_walk_starts_from_standing_and_reaches_the_clip_speed():
     assert speed(t_after) == pytest.approx(v_clip, rel=1e-6)
 
 
+def test_a_faster_operator_plays_the_clip_faster_after_the_lead_in():
+    """``OperatorConfig.playback_speed``: the same lead-in, then the clip's time runs that many times faster (the
+    sync experiment's speed sweep); a speed of zero or less is a clear configuration error."""
+    from stylesync.config import ClockConfig, OperatorConfig
+    from stylesync.errors import ConfigError
+    from stylesync.sources.builtin_operator import builtin_operator
+
+    op = OperatorConfig()
+    _, normal = builtin_operator(op, ClockConfig(), 1.0, 0)
+    _, fast = builtin_operator(OperatorConfig(playback_speed=1.5), ClockConfig(), 1.0, 0)
+    lead = op.standing_lead_in_s
+    for t in (0.3, lead):
+        assert np.array_equal(fast.frame_at(t).joint_pos_world, normal.frame_at(t).joint_pos_world)
+    for u in (0.4, 1.7, 3.2):  # clip time after the lead-in, within and past the start ramp
+        f, n = fast.frame_at(lead + u / 1.5), normal.frame_at(lead + u)
+        assert np.allclose(f.joint_pos_world, n.joint_pos_world, atol=1e-9)
+        assert f.timestamp_s == pytest.approx(lead + u / 1.5)
+    with pytest.raises(ConfigError, match="playback_speed"):
+        OperatorConfig(playback_speed=0.0)
+
+
 @pytest.mark.parametrize("value, says", [("1e300", "NaN or infinite"), ("1e308", "NaN or infinite"),
                                          ("1e7", "limit 1000 m"), ("nan", "NaN or infinite")])
 def test_bvh_positions_and_rotations_out_of_this_world_are_one_clear_error(tmp_path, value, says):

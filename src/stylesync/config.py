@@ -324,6 +324,8 @@ class OperatorConfig:
     timestamp_jitter_s: float = 0.004  # sample-time jitter (1 sigma) [s]
     standing_lead_in_s: float = 1.0  # operator stands in the first frame's pose before the clip plays [s]
     start_ramp_s: float = 1.5  # a looping clip's strides grow from standing to full over this time [s]
+    # The clip played this many times faster after the lead-in (the operator walks faster: cadence and speed) [-]
+    playback_speed: float = 1.0
     # A recorded file (BVH, k4a JSON) starts the character in its first frame's pose (motion/initial_state.py)
     # instead of the standing lead-in, and the operator holds the last frame for
     # rest_after_clip_s while the character comes to rest (part of the run).
@@ -345,6 +347,7 @@ class OperatorConfig:
         _non_negative("OperatorConfig.timestamp_jitter_s", self.timestamp_jitter_s)
         _non_negative("OperatorConfig.standing_lead_in_s", self.standing_lead_in_s)
         _non_negative("OperatorConfig.start_ramp_s", self.start_ramp_s)
+        _positive("OperatorConfig.playback_speed", self.playback_speed)
         _non_negative("OperatorConfig.rest_after_clip_s", self.rest_after_clip_s)
 
 

@@ -1,8 +1,11 @@
 """Experiment ``sync`` (Sec. 7.4.1, Fig. 11): stepping with and without the LIPM time-sync compensation
 (Eq. 21-23). Paper: state-transition delay at most 0.172 s with it; 0.798 s and a fall within 3 steps without.
 
-The claim checked: with compensation, no fall and a maximum delay <= 0.172 s; without, a larger maximum delay or a
-fall. Exit status 0 only when the claim holds.
+The claim checked: with compensation, the built-in walk (the run's seed) does not fall and its maximum delay is
+<= 0.172 s; without it, the walk falls, or, where it does not at the operator's own pace, there is an operator
+speed at which the term decides a fall. The speed sweep plays the walk ``SPEEDS`` times faster (cadence and speed,
+``OperatorConfig.playback_speed``) over ``SWEEP_SEEDS`` sensor seeds from the run's; the term decides a fall at a
+speed where no walk with it falls and most walks without it do. Exit status 0 only when the claim holds.
 """
 
 from __future__ import annotations
@@ -14,28 +17,77 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
 
 from stylesync.config import ControlConfig, OperatorConfig, SessionConfig  # noqa: E402
 from stylesync.experiments.common import run_session  # noqa: E402
 from stylesync.metrics.plots import save_figure, stance_axes  # noqa: E402
 from stylesync.metrics.summary import summarize  # noqa: E402
-from stylesync.session import Session  # noqa: E402
+from stylesync.session import Session, SessionResult  # noqa: E402
 from stylesync.sources.builtin_operator import builtin_operator  # noqa: E402
 
 PAPER = {"with_max_delay_s": 0.172, "without_max_delay_s": 0.798, "without_falls_within_steps": 3}
+SPEEDS = (1.0, 1.2, 1.4, 1.6, 1.8)  # operator speed, times the clip's [-]
+SWEEP_SEEDS = 4
+_LABELS = (("with", True), ("without", False))
+_KEYS = ("fell", "fall_time_s", "operator_steps", "character_steps", "state_transition_delay_s")
+
+
+def _walk(lipm: bool, speed: float, duration_s: float, seed: int) -> SessionResult:
+    """The built-in walk at ``speed`` times the clip's pace, with or without the LIPM term."""
+    cfg = SessionConfig(duration_s=duration_s, seed=seed, operator=OperatorConfig(clip="walk", playback_speed=speed),
+                        control=ControlConfig(lipm_time_sync=lipm))
+    source, _ = builtin_operator(cfg.operator, cfg.clocks, duration_s + 1.0, seed)
+    return run_session(Session(cfg, source))
+
+
+def speed_sweep(duration_s: float, seed: int, first: dict[str, dict] | None = None) -> list[dict]:
+    """Per speed of ``SPEEDS``: the runs with and without the term over ``SWEEP_SEEDS`` seeds from ``seed`` (fell,
+    fall time, maximum delay), and whether the term decides a fall there. ``first``: the summaries already run at
+    speed 1.0 and ``seed`` (label -> summary), reused."""
+    rows = []
+    for speed in SPEEDS:
+        row: dict = {"speed": speed}
+        for label, lipm in _LABELS:
+            runs = []
+            for k in range(SWEEP_SEEDS):
+                m = (first[label] if first is not None and speed == 1.0 and k == 0
+                     else summarize(_walk(lipm, speed, duration_s, seed + k)))
+                runs.append({"seed": seed + k, "fell": bool(m["fell"]), "fall_time_s": m["fall_time_s"],
+                             "max_delay_s": m["state_transition_delay_s"]["max"]})
+            row[label] = runs
+        falls_with = sum(r["fell"] for r in row["with"])
+        falls_without = sum(r["fell"] for r in row["without"])
+        row["term_decides_fall"] = falls_with == 0 and falls_without > SWEEP_SEEDS / 2
+        rows.append(row)
+    return rows
+
+
+def _plot_sweep(rows: list[dict], path: Path) -> None:
+    fig, (ax_f, ax_d) = plt.subplots(1, 2, figsize=(10, 3.8))
+    speeds = np.array([r["speed"] for r in rows])
+    for i, (label, _) in enumerate(_LABELS):
+        falls = [sum(x["fell"] for x in r[label]) for r in rows]
+        delays = [float(np.median([x["max_delay_s"] for x in r[label]])) for r in rows]
+        ax_f.bar(speeds + (i - 0.5) * 0.08, falls, width=0.08, label=f"{label} LIPM time sync")
+        ax_d.plot(speeds, delays, "o-", label=f"{label} LIPM time sync")
+    ax_f.set_xlabel("operator speed [x clip]")
+    ax_f.set_ylabel(f"runs that fall (of {SWEEP_SEEDS})")
+    ax_f.set_ylim(0, SWEEP_SEEDS)
+    ax_f.legend(loc="upper left")
+    ax_d.axhline(PAPER["with_max_delay_s"], color="k", lw=0.8, ls="--", label="paper, with (0.172 s)")
+    ax_d.set_xlabel("operator speed [x clip]")
+    ax_d.set_ylabel("median of the runs' max delay [s]")
+    ax_d.legend(loc="upper left")
+    save_figure(fig, path)
 
 
 def run(out: Path, duration_s: float = 12.0, seed: int = 0) -> tuple[bool, dict]:
     out.mkdir(parents=True, exist_ok=True)
-    results, metrics = {}, {}
-    for label, lipm in (("with", True), ("without", False)):
-        cfg = SessionConfig(duration_s=duration_s, seed=seed, operator=OperatorConfig(clip="walk"),
-                            control=ControlConfig(lipm_time_sync=lipm))
-        source, _ = builtin_operator(cfg.operator, cfg.clocks, duration_s + 1.0, seed)
-        results[label] = run_session(Session(cfg, source))
-        metrics[label] = summarize(results[label])
+    results = {label: _walk(lipm, 1.0, duration_s, seed) for label, lipm in _LABELS}
+    metrics = {label: summarize(r) for label, r in results.items()}
     fig, axes = plt.subplots(2, 1, figsize=(9, 5), sharex=True)
-    for ax, label in zip(axes, ("with", "without"), strict=True):
+    for ax, (label, _) in zip(axes, _LABELS, strict=True):
         stance_axes(ax, results[label].log)
         m = metrics[label]
         ax.set_title(f"{label} LIPM time sync: max delay {m['state_transition_delay_s']['max']:.3f} s, "
@@ -44,12 +96,15 @@ def run(out: Path, duration_s: float = 12.0, seed: int = 0) -> tuple[bool, dict]
     axes[-1].set_xlabel("t [s]")
     save_figure(fig, out / "fig11_states.png")
     w, wo = metrics["with"], metrics["without"]
-    holds = (not w["fell"] and w["state_transition_delay_s"]["max"] <= PAPER["with_max_delay_s"]
-             and (wo["fell"] or wo["state_transition_delay_s"]["max"] > w["state_transition_delay_s"]["max"]))
+    with_holds = not w["fell"] and w["state_transition_delay_s"]["max"] <= PAPER["with_max_delay_s"]
+    sweep = []
+    if with_holds and not wo["fell"]:
+        sweep = speed_sweep(duration_s, seed, metrics)
+        _plot_sweep(sweep, out / "speed_sweep.png")
+    deciding = [r["speed"] for r in sweep if r["term_decides_fall"]]
+    holds = with_holds and (wo["fell"] or bool(deciding))
     summary = {"experiment": "sync", "claim_holds": holds, "paper": PAPER,
-               "with": {k: w[k] for k in ("fell", "fall_time_s", "operator_steps", "character_steps",
-                                          "state_transition_delay_s")},
-               "without": {k: wo[k] for k in ("fell", "fall_time_s", "operator_steps", "character_steps",
-                                             "state_transition_delay_s")}}
+               "with": {k: w[k] for k in _KEYS}, "without": {k: wo[k] for k in _KEYS},
+               "speed_sweep": sweep, "speeds_where_the_term_decides_a_fall": deciding}
     (out / "metrics.json").write_text(json.dumps(summary, indent=2))
     return holds, summary

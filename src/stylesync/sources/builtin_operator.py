@@ -30,8 +30,9 @@ class ClipPerformer:
     """Noise-free operator frames of a human skeleton playing a clip."""
 
     def __init__(self, clip: DeepMimicClip | None, human: HumanModel, lead_in_s: float = 0.0,
-                 blend_s: float = 0.5, start_ramp_s: float = 0.0):
+                 blend_s: float = 0.5, start_ramp_s: float = 0.0, speed: float = 1.0):
         self.clip = clip
+        self.speed = speed  # the clip's time runs this many times faster than the run's after the lead-in [-]
         self.human = human
         self.lead_in_s = lead_in_s
         self.leg_ratio = (human.hip_height_m) / CLIP_CHARACTER_LEG_LENGTH_M
@@ -76,9 +77,10 @@ class ClipPerformer:
         stand_root, stand_quats = self._stand_root, self._stand_quats
         if self.clip is None or t_s < self.lead_in_s - self.blend_s:
             return self.human.frame_from_pose(t_s, stand_root, stand_quats)
+        u_s = self.speed * (t_s - self.lead_in_s)  # the clip's time [s]
         if self.start_ramp_s > 0:
-            return self.human.frame_from_pose(t_s, *self._ramped(t_s - self.lead_in_s))
-        pose = self.clip.pose_at(max(0.0, t_s - self.lead_in_s))
+            return self.human.frame_from_pose(t_s, *self._ramped(u_s))
+        pose = self.clip.pose_at(max(0.0, u_s))
         root = pose.root_pos_world * self.leg_ratio
         if t_s < self.lead_in_s:  # blend from standing into the clip's first pose
             a = 1.0 - (self.lead_in_s - t_s) / self.blend_s
@@ -100,6 +102,7 @@ def builtin_operator(
 ) -> tuple[RecordedSource, ClipPerformer]:
     clip = None if operator.clip == STAND_CLIP else DeepMimicClip.builtin(operator.clip)
     human = HumanModel(operator.height_m, operator.mass_kg)
-    performer = ClipPerformer(clip, human, operator.standing_lead_in_s, start_ramp_s=operator.start_ramp_s)
+    performer = ClipPerformer(clip, human, operator.standing_lead_in_s, start_ramp_s=operator.start_ramp_s,
+                              speed=operator.playback_speed)
     return sensed(performer.frame_at, operator, clocks, duration_s, seed, f"builtin:{operator.clip}"), performer
 
