@@ -1,7 +1,7 @@
 """Per-tick balance trace of one run of the development suite: what the character stood on, where its capture
 point was, what the COM task asked for and what the body did (prints figures; a tool for explaining a fall).
 
-    python benchmarks/trace_run.py 05_01 --seed 0 [--from 4.5] [--to 7] [--every 6] [--duration 12] [--past-fall]
+    python benchmarks/trace_run.py 05_01 --seed 0 [--from 4.5] [--to 7] [--every 6] [--duration 12] [--past-fall] [--feet]
 
 The clip is a development-suite name (`stylesync bench --suite dev`: a humanoid3d clip or a file of ../shared/mocap)
 or a source spec (``bvh:PATH``, ``builtin:walk``), run as the suite runs it: the Kinect sensor model with the seed,
@@ -60,6 +60,7 @@ def main() -> None:
                     help="last time printed; the run ends there [s]")
     ap.add_argument("--every", type=int, default=6, help="print every this many control ticks (and each change "
                                                           "of stance)")
+    ap.add_argument("--feet", action="store_true", help="also print the ankles' horizontal positions [m]")
     ap.add_argument("--past-fall", action="store_true", help="run on after the first fall (to see what follows it)")
     args = ap.parse_args()
     logging.disable(logging.WARNING)
@@ -101,7 +102,10 @@ def main() -> None:
               f"({vel[0]:+5.2f},{vel[1]:+5.2f}) {com[2]:5.2f} {ref.com_world[2]:5.2f} {out:+7.3f} "
               f"({ref.com_world[0]:+5.2f},{ref.com_world[1]:+5.2f}) "
               f"({ref.com_vel_world[0]:+5.2f},{ref.com_vel_world[1]:+5.2f}) ({force[0]:+4.0f},{force[1]:+4.0f}) "
-              f"({taken[0]:+4.0f},{taken[1]:+4.0f}) {fl:5.0f} {fr:5.0f}")
+              f"({taken[0]:+4.0f},{taken[1]:+4.0f}) {fl:5.0f} {fr:5.0f}"
+              + ("".join(f" {s[0]}({state.link_origin_world[_ANKLE[s]][0]:+5.2f},"
+                         f"{state.link_origin_world[_ANKLE[s]][1]:+5.2f})" for s in ("left", "right"))
+                 if args.feet else ""))
 
     session.on_tick = on_tick
     try:

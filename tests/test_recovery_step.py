@@ -121,7 +121,8 @@ def test_the_fsm_keeps_a_recovery_step_until_its_foot_lands():
 TRACED = ControlConfig(whole_body=WholeBodyConfig(stance_leg_tracking_share=1.0))
 # ... and the motion stage's balance layer as it was then: recovery steps of 0.6 leg lengths, and a swing the
 # operator stops on not yet landed at once (with either, several of the traced falls come later or not at all).
-TRACED_MOTION = {"recovery_step_reach_share": 0.6, "recovery_on_stopping_step": False}
+TRACED_MOTION = {"recovery_step_reach_share": 0.6, "recovery_on_stopping_step": False,
+                 "recovery_double_stance_overrun": 0.0}
 
 
 def _run(spec: str, seconds: float, motion: MotionConfig, seed: int = 0, control: ControlConfig | None = None):
@@ -180,6 +181,37 @@ def test_a_swing_he_stops_on_is_landed_at_once_where_the_capture_point_goes(monk
     taken.clear()
     off, _ = _run(spec, clip_end_s + 3.0, MotionConfig(recovery_on_stopping_step=False))
     assert taken and taken[0] > clip_end_s + 0.2
+    assert off.fell and off.fall_time_s is not None and off.fall_time_s > clip_end_s
+
+
+@pytest.mark.skipif(not (MOCAP / "cmu-dev" / "07_05.bvh").exists(),
+                    reason="../shared/mocap/cmu-dev/07_05.bvh is not available")
+def test_a_double_stance_whose_capture_point_has_run_out_ends_in_a_step_of_its_own(monkeypatch):
+    """CMU-dev 07_05, seed 0: the character lands a recovery step (3.63 s) while the operator is still on one foot,
+    its step for his counted as taken; he lands (4.0 s) and stands to the clip's end (4.27 s). Its capture point is
+    out of its support from the landing on, drifting sideways. Overdue (1.5 of his double stances), a recovery step
+    begins while he still walks and it comes to rest; waiting for his standing, the step begins after the clip's
+    end and it falls in the rest (measured: 4.08 s against 4.36 s, and a fall at 5.20 s)."""
+    from stylesync.motion.recovery_step import RecoveryStepper
+
+    began: list[float] = []
+    trigger = RecoveryStepper.trigger
+
+    def recorded(self, time_s, *args, **kwargs):
+        step = trigger(self, time_s, *args, **kwargs)
+        if step is not None:
+            began.append(time_s)
+        return step
+
+    monkeypatch.setattr(RecoveryStepper, "trigger", recorded)
+    spec = f"bvh:{MOCAP / 'cmu-dev' / '07_05.bvh'}"
+    clip_end_s = 4.27
+    result, _ = _run(spec, clip_end_s + 3.0, MotionConfig())
+    assert not result.fell
+    assert any(3.9 < t < clip_end_s for t in began)
+    began.clear()
+    off, _ = _run(spec, clip_end_s + 3.0, MotionConfig(recovery_double_stance_overrun=0.0))
+    assert not any(3.9 < t < clip_end_s for t in began) and any(t > clip_end_s for t in began)
     assert off.fell and off.fall_time_s is not None and off.fall_time_s > clip_end_s
 
 

@@ -176,6 +176,11 @@ class MotionConfig:
     # would not catch the character's capture point: the stopping landing (pose_optimization.py) is then reached in
     # a recovery step's time, not in his slower lowering of the foot
     recovery_on_stopping_step: bool = True
+    # ... and in the character's double stance, whatever the operator does: once its capture point has been outside
+    # the support polygon of its soles (by more than the margin) for this many times his usual double stance, a
+    # recovery step (he walks on, or stands on one foot, while the character waits for a lift-off of his that
+    # comes too late for it; 0: off) [-]
+    recovery_double_stance_overrun: float = 1.5
     # During a recovery step the COM task holds the character's own COM state (no pull towards the operator's
     # stance): the body moves as the landing's capture-point prediction assumes
     recovery_step_free_com: bool = True
@@ -206,6 +211,7 @@ class MotionConfig:
         _non_negative("MotionConfig.recovery_min_stance_s", self.recovery_min_stance_s)
         _positive("MotionConfig.recovery_step_reach_share", self.recovery_step_reach_share)
         _positive("MotionConfig.recovery_swing_overrun", self.recovery_swing_overrun)
+        _non_negative("MotionConfig.recovery_double_stance_overrun", self.recovery_double_stance_overrun)
         _non_negative("MotionConfig.reference_follows_operator_s", self.reference_follows_operator_s)
         for n in ("liftoff_weight_shift_s", "liftoff_after_stand_s", "liftoff_margin_m"):
             _non_negative(f"MotionConfig.{n}", getattr(self, n))

@@ -38,7 +38,13 @@ from stylesync.model.character import (
     batch_model_quat_from_canonical,
     canonical_quat_from_model,
 )
-from stylesync.model.sole import sole_corner_points, sole_outside_m, sole_points_xy
+from stylesync.model.sole import (
+    convex_hull_points,
+    outside_distance_points,
+    sole_corner_points,
+    sole_outside_m,
+    sole_points_xy,
+)
 from stylesync.model.state import CharacterState, MassProperties
 from stylesync.motion.balance_strategy import stance_hip_blend, swing_hip_feedback
 from stylesync.motion.bounds import BoundsMonitor, step_length_bound_m
@@ -70,6 +76,7 @@ _UP = np.array([0.0, 0.0, 1.0])
 LATE_CONTACT_PRESS_M = 0.02  # a swing foot held for a late contact is aimed this far below the ground [m]
 LANDING_REACH = 0.97  # hip-ankle distance, as a fraction of the leg's length, at which a landing foot is aimed
 OPERATOR_SWING_S = 0.4  # the operator's swing time before one has been seen [s]
+OPERATOR_DOUBLE_STANCE_S = 0.2  # the operator's double-stance time before one has been seen [s]
 SWING_BLEND_S = 0.1  # time constant over which a swing foot moves from its lift-off point onto its target [s]
 ANCHOR_BLEND_S = 0.15  # time constant over which a stance change's jump of the retargeting anchor is taken up
 _SCALE_SMOOTHING = 0.02  # per tick, exponential average of the operator's leg length
@@ -79,6 +86,7 @@ _VELOCITY_SMOOTHING = 0.2  # per tick, exponential average of the desired COM ve
 _SIDE_UP = {"left": "LEFT", "right": "RIGHT"}
 _OTHER_SIDE = {"left": "right", "right": "left"}
 _LINK = {n: i for i, n in enumerate(LINK_NAMES)}
+_SOLE_POINTS = sole_corner_points()  # the character's sole relative to its ankle, full size [m]
 CHAR_LEG_LENGTH_M = THIGH_LENGTH_M + SHANK_LENGTH_M
 OPERATOR_VELOCITY_SETTLE_S = 0.2  # the operator's filtered COM velocity is taken as settled from then on [s]
 HEEL_AHEAD_OF_ANKLE_M = FOOT_CENTER_AHEAD_OF_ANKLE_M - FOOT_LENGTH_M / 2  # < 0: the heel is behind the ankle [m]
@@ -221,6 +229,9 @@ class MotionOptimizer:
         self._op_last_ds_s = 0.0
         self.recovery = RecoveryStepper(cfg, CHAR_LEG_LENGTH_M, gravity_mps2)
         self._operator_stands_since_s: float | None = None
+        # the operator's double-stance time, averaged over his double stances (of a walk: each counted 0.05-1 s) [s]
+        self._op_ds_s = OPERATOR_DOUBLE_STANCE_S
+        self._outside_since_s: float | None = None  # the character's capture point left its double support then [s]
         self._stopping_capture_side: str | None = None  # the swing whose landing _stopping_landing moved last tick
         self._sole_bound = sole_corner_points(cfg.capture_bound_sole_share)  # shrunk for capture_bound.py [m]
         self.reading: MotionReading | None = None  # the last tick's reading of the operator, besides the targets
@@ -311,6 +322,7 @@ class MotionOptimizer:
         if op_state is not self._op_state:  # the operator's swing time, for the swing's progress
             if self._op_state is Stance.DS:
                 self._op_last_ds_s = state.time_s - self._op_state_t0_s
+                self._op_ds_s += 0.5 * (min(max(self._op_last_ds_s, 0.05), 1.0) - self._op_ds_s)
             if self._op_state in (Stance.LS, Stance.RS):
                 swing_s = min(max(state.time_s - self._op_state_t0_s, 0.2), 1.0)
                 self._op_swing_s += 0.5 * (swing_s - self._op_swing_s)
@@ -511,8 +523,9 @@ class MotionOptimizer:
         return capture
 
     def _recovery_step(self, tick: _Tick, state: CharacterState) -> None:
-        """Ends a recovery step the stance FSM has ended; begins one when the operator and the character both stand
-        and the character's capture point has left its support polygon (recovery_step.py)."""
+        """Ends a recovery step the stance FSM has ended; begins one when the character stands on both feet and its
+        capture point has left its support polygon (recovery_step.py), and either the operator stands too or the
+        character's double stance is overdue (:meth:`_double_stance_overdue`)."""
         stepper = self.recovery
         if stepper.step is not None and not self.char_fsm.recovery_step:
             stepper.end(state.time_s)
@@ -522,7 +535,12 @@ class MotionOptimizer:
         waits = tick.op_state is Stance.DS or (self.cfg.recovery_while_step_counted and self.char_fsm.step_counted)
         if not waits:
             self._operator_stands_since_s = None
-        if stepper.step is not None or tick.ch_state is not Stance.DS or not waits or self.char_fsm.hold_reference:
+        if stepper.step is not None or tick.ch_state is not Stance.DS or self.char_fsm.hold_reference:
+            self._outside_since_s = None
+            return
+        if self._double_stance_overdue(tick, state) and self._begin_recovery_step(tick, state):
+            return
+        if not waits:
             return
         if not self._operator_stands(tick):
             self._operator_stands_since_s = None  # he moves over his feet (a walk's double stance)
@@ -531,13 +549,43 @@ class MotionOptimizer:
             self._operator_stands_since_s = state.time_s
         if state.time_s - self._operator_stands_since_s < self.cfg.recovery_min_stance_s:
             return  # a double stance shorter than this is a walk's: his next step is the character's
+        self._begin_recovery_step(tick, state)
+
+    def _begin_recovery_step(self, tick: _Tick, state: CharacterState) -> bool:
+        """A recovery step from double stance, if the capture point is outside the support by more than the margin
+        (recovery_step.RecoveryStepper.trigger): whether one began."""
         quats = {s: state.link_quat_wxyz[_LINK[f"{s}_ankle"]] for s in _SIDE_UP}
-        step = stepper.trigger(state.time_s, tick.com_c, tick.com_vel_c, tick.a_c, quats,
-                               soles_on_ground(state), tick.R_root_d)
-        if step is not None:
-            timeout_s = self.cfg.recovery_swing_s + self.cfg.late_contact_timeout_s
-            tick.ch_state = self.char_fsm.begin_recovery_step(step.side, state.time_s, timeout_s)
-            self._swing_t0_s = state.time_s
+        step = self.recovery.trigger(state.time_s, tick.com_c, tick.com_vel_c, tick.a_c, quats,
+                                     soles_on_ground(state), tick.R_root_d)
+        if step is None:
+            return False
+        self._outside_since_s = None
+        timeout_s = self.cfg.recovery_swing_s + self.cfg.late_contact_timeout_s
+        tick.ch_state = self.char_fsm.begin_recovery_step(step.side, state.time_s, timeout_s)
+        self._swing_t0_s = state.time_s
+        return True
+
+    def _double_stance_overdue(self, tick: _Tick, state: CharacterState) -> bool:
+        """Step timing adapted to the balance in double stance: whether the character's capture point has been
+        outside the support polygon of its soles on the ground, by more than the recovery step's margin, for
+        ``recovery_double_stance_overrun`` times the operator's usual double stance. A character's double stance
+        ends with his next lift-off; where he walks on from a step the character has already landed, or holds a
+        foot up at a clip's end, that lift-off comes after the capture point has run out of reach."""
+        cfg = self.cfg
+        on_ground = soles_on_ground(state)
+        if cfg.recovery_double_stance_overrun <= 0.0 or not cfg.recovery_steps or not on_ground:
+            self._outside_since_s = None
+            return False
+        xi, _ = capture_point(tick.com_c, tick.com_vel_c, self.g)
+        corners = [p for s in on_ground
+                   for p in sole_points_xy(tick.a_c[s], state.link_quat_wxyz[_LINK[f"{s}_ankle"]], _SOLE_POINTS)]
+        if outside_distance_points((float(xi[0]), float(xi[1])), convex_hull_points(corners))[0] \
+                <= cfg.recovery_step_margin_m:
+            self._outside_since_s = None
+            return False
+        if self._outside_since_s is None:
+            self._outside_since_s = state.time_s
+        return state.time_s - self._outside_since_s >= cfg.recovery_double_stance_overrun * self._op_ds_s
 
     def _land_overrun_swing(self, tick: _Tick, state: CharacterState) -> None:
         """Step timing adapted to the balance: a swing that has lasted ``recovery_swing_overrun`` times the
