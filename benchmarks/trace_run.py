@@ -1,7 +1,8 @@
 """Per-tick balance trace of one run of the development suite: what the character stood on, where its capture
 point was, what the COM task asked for and what the body did (prints figures; a tool for explaining a fall).
 
-    python benchmarks/trace_run.py 05_01 --seed 0 [--from 4.5] [--to 7] [--every 6] [--duration 12] [--past-fall] [--feet]
+    python benchmarks/trace_run.py 05_01 --seed 0 [--from 4.5] [--to 7] [--every 6] [--duration 12] [--past-fall]
+                                         [--feet]
 
 The clip is a development-suite name (`stylesync bench --suite dev`: a humanoid3d clip or a file of ../shared/mocap)
 or a source spec (``bvh:PATH``, ``builtin:walk``), run as the suite runs it: the Kinect sensor model with the seed,
