@@ -38,13 +38,7 @@ from stylesync.model.character import (
     batch_model_quat_from_canonical,
     canonical_quat_from_model,
 )
-from stylesync.model.sole import (
-    convex_hull_points,
-    outside_distance_points,
-    sole_corner_points,
-    sole_outside_m,
-    sole_points_xy,
-)
+from stylesync.model.sole import sole_corner_points, sole_outside_m, sole_points_xy
 from stylesync.model.state import CharacterState, MassProperties
 from stylesync.motion.balance_strategy import stance_hip_blend, swing_hip_feedback
 from stylesync.motion.bounds import BoundsMonitor, step_length_bound_m
@@ -57,6 +51,7 @@ from stylesync.motion.recovery_step import (
     operator_stands,
     soles_on_ground,
     stands_on,
+    support_outside_m,
 )
 from stylesync.motion.reference import LipmMap, MotionReading, ReferencePose
 from stylesync.motion.stance_fsm import (
@@ -86,7 +81,6 @@ _VELOCITY_SMOOTHING = 0.2  # per tick, exponential average of the desired COM ve
 _SIDE_UP = {"left": "LEFT", "right": "RIGHT"}
 _OTHER_SIDE = {"left": "right", "right": "left"}
 _LINK = {n: i for i, n in enumerate(LINK_NAMES)}
-_SOLE_POINTS = sole_corner_points()  # the character's sole relative to its ankle, full size [m]
 CHAR_LEG_LENGTH_M = THIGH_LENGTH_M + SHANK_LENGTH_M
 OPERATOR_VELOCITY_SETTLE_S = 0.2  # the operator's filtered COM velocity is taken as settled from then on [s]
 HEEL_AHEAD_OF_ANKLE_M = FOOT_CENTER_AHEAD_OF_ANKLE_M - FOOT_LENGTH_M / 2  # < 0: the heel is behind the ankle [m]
@@ -577,10 +571,8 @@ class MotionOptimizer:
             self._outside_since_s = None
             return False
         xi, _ = capture_point(tick.com_c, tick.com_vel_c, self.g)
-        corners = [p for s in on_ground
-                   for p in sole_points_xy(tick.a_c[s], state.link_quat_wxyz[_LINK[f"{s}_ankle"]], _SOLE_POINTS)]
-        if outside_distance_points((float(xi[0]), float(xi[1])), convex_hull_points(corners))[0] \
-                <= cfg.recovery_step_margin_m:
+        quats = {s: state.link_quat_wxyz[_LINK[f"{s}_ankle"]] for s in on_ground}
+        if support_outside_m(xi, tick.a_c, quats, on_ground) <= cfg.recovery_step_margin_m:
             self._outside_since_s = None
             return False
         if self._outside_since_s is None:

@@ -55,6 +55,7 @@ from stylesync.model.sole import (
     sole_corner_points,
     sole_corners_world,
     sole_outside_m,
+    sole_points_xy,
     sole_points_xy_yaw,
     sole_within_m,
 )
@@ -86,6 +87,15 @@ def soles_on_ground(state: CharacterState) -> list[str]:
     pressing = state.feet_pressing()
     return [s for s in ("left", "right") if pressing[s]
             or sole_within_m(state.link_origin_world[_ANKLE[s]], state.link_quat_wxyz[_ANKLE[s]], ON_GROUND_GAP_M)]
+
+
+def support_outside_m(xi_world: np.ndarray, ankles_world: dict[str, np.ndarray],
+                      feet_quat_wxyz: dict[str, np.ndarray], on_ground: list[str]) -> float:
+    """Signed distance of a capture point (horizontal) from the support polygon of the soles ``on_ground`` (each at
+    its ankle, turned by its foot's orientation): > 0 outside [m]. On plain floats (model/sole.py's ``*_points``):
+    it runs on every double-stance tick."""
+    corners = [p for s in on_ground for p in sole_points_xy(ankles_world[s], feet_quat_wxyz[s], _SOLE_POINTS)]
+    return outside_distance_points((float(xi_world[0]), float(xi_world[1])), convex_hull_points(corners))[0]
 
 
 def operator_stands(xi_h_world: np.ndarray, ankles_h_world: dict[str, np.ndarray], foot_yaw_h_rad: dict[str, float],
@@ -163,9 +173,7 @@ class RecoveryStepper:
         if not cfg.recovery_steps or not on_ground or time_s - self._last_end_s < cfg.recovery_min_stance_s:
             return None
         xi, _ = capture_point(com_world, com_vel_world, self.g)
-        corners = {s: sole_corners_world(ankles_world[s], feet_quat_wxyz[s])[:, :2] for s in on_ground}
-        outside, _ = outside_distance_m(xi, convex_hull_xy(np.vstack(list(corners.values()))))
-        if outside <= cfg.recovery_step_margin_m:
+        if support_outside_m(xi, ankles_world, feet_quat_wxyz, on_ground) <= cfg.recovery_step_margin_m:
             return None
         dist = {s: sole_outside_m(xi, ankles_world[s], feet_quat_wxyz[s]) for s in on_ground}
         stance = min(dist, key=lambda s: dist[s])
