@@ -103,3 +103,17 @@ def test_unknown_experiment_and_missing_shared_clips_fail_with_one_line(capsys, 
     assert e.value.code == 2
     with pytest.raises(StylesyncError, match="needs .*humanoid3d_stealthy_walk.txt"):
         styles.run(tmp_path / "out", shared=tmp_path / "no-shared")
+
+
+def test_transition_delays_count_a_missed_change_and_leave_out_one_the_log_ends_on():
+    from stylesync.metrics.summary import transition_delays
+
+    t = np.arange(400) * 0.01  # 4 s
+    op = np.ones(400, dtype=int)
+    ch = np.ones(400, dtype=int)
+    op[50:150] = 0  # the operator lifts a foot at 0.5 s ...
+    ch[58:150] = 0  # ... the character 80 ms later
+    op[200:] = 2  # at 2.0 s he lifts the other; the character never does (its 1 s window ends before the log)
+    op[390:] = 0  # 3.9 s: the log ends 90 ms later, the character not yet following: unknown, left out
+    delays = transition_delays(t, op, ch)
+    assert delays == pytest.approx([0.08, 0.0, 1.0])

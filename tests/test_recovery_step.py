@@ -16,6 +16,7 @@ from stylesync.motion.pose_optimization import CHAR_LEG_LENGTH_M
 from stylesync.motion.recovery_step import (
     MIN_FOOT_SEPARATION_M,
     RecoveryStepper,
+    beyond_sole_towards_m,
     capture_point,
     operator_stands,
     stands_on,
@@ -38,6 +39,19 @@ def test_support_polygon_distance_is_signed_and_finds_the_nearest_point():
     assert d == pytest.approx(1.0) and np.allclose(p, [1.0, 0.5])
     d, p = outside_distance_m(np.array([2.0, 2.0]), square)
     assert d == pytest.approx(np.sqrt(2.0)) and np.allclose(p, [1.0, 1.0])
+
+
+def test_a_capture_point_counts_as_behind_a_sole_only_outside_it_on_the_other_foots_side():
+    front, rear = np.array([0.3, 0.1, ANKLE_HEIGHT_M]), np.array([0.0, -0.1, ANKLE_HEIGHT_M])
+    heel_x = front[0] + FOOT_CENTER_AHEAD_OF_ANKLE_M - FOOT_LENGTH_M / 2
+    # 6 cm behind the front heel, in line with it: outside towards the rear foot.
+    assert beyond_sole_towards_m(np.array([heel_x - 0.06, 0.1]), front, IDENTITY, rear) == pytest.approx(0.06)
+    # Over the front sole, or outside it beyond its toe (away from the rear foot): not behind.
+    assert beyond_sole_towards_m(np.array([front[0], 0.1]), front, IDENTITY, rear) == 0.0
+    assert beyond_sole_towards_m(np.array([front[0] + 0.3, 0.1]), front, IDENTITY, rear) == 0.0
+    # Seen from the rear foot, the same point ahead of it is on the front foot's side.
+    toe_x = rear[0] + FOOT_CENTER_AHEAD_OF_ANKLE_M + FOOT_LENGTH_M / 2
+    assert beyond_sole_towards_m(np.array([toe_x + 0.05, -0.1]), rear, IDENTITY, front) == pytest.approx(0.05)
 
 
 def test_sole_corners_span_the_foot_ahead_of_the_ankle():
@@ -122,7 +136,7 @@ TRACED = ControlConfig(whole_body=WholeBodyConfig(stance_leg_tracking_share=1.0)
 # ... and the motion stage's balance layer as it was then: recovery steps of 0.6 leg lengths, and a swing the
 # operator stops on not yet landed at once (with either, several of the traced falls come later or not at all).
 TRACED_MOTION = {"recovery_step_reach_share": 0.6, "recovery_on_stopping_step": False,
-                 "recovery_double_stance_overrun": 0.0}
+                 "recovery_double_stance_overrun": 0.0, "liftoff_capture_behind_m": None}
 
 
 def _run(spec: str, seconds: float, motion: MotionConfig, seed: int = 0, control: ControlConfig | None = None):
@@ -470,3 +484,18 @@ def test_a_character_waiting_with_its_step_counted_may_still_step_on_its_own():
         began[allowed] = steps
     assert not began[False]
     assert began[True] and began[True][0] < 5.2
+
+
+@pytest.mark.skipif(not (MOCAP / "cmu-dev" / "07_11.bvh").exists(),
+                    reason="../shared/mocap/cmu-dev/07_11.bvh is not available")
+def test_a_rear_foot_stays_down_while_the_capture_point_is_behind_the_front_heel():
+    """CMU-dev 07_11, seed 4: the walker sets off from rest with his feet apart. The character, still at rest, lifted
+    its rear foot with him while its capture point was behind its front heel: on the front foot alone it could
+    only fall back (it fell in the clip on every seed). With the rear foot kept down (at most
+    ``liftoff_weight_shift_s``) until the capture point is over the front sole, it walks the clip (2.58 s)."""
+    spec = f"bvh:{MOCAP / 'cmu-dev' / '07_11.bvh'}"
+    clip_end_s = 2.58
+    kept, _ = _run(spec, clip_end_s, MotionConfig(), seed=4)
+    lifted, _ = _run(spec, clip_end_s, MotionConfig(liftoff_capture_behind_m=None), seed=4)
+    assert not kept.fell
+    assert lifted.fell and lifted.fall_time_s is not None and lifted.fall_time_s < clip_end_s

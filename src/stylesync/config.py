@@ -130,6 +130,10 @@ class MotionConfig:
     liftoff_weight_shift_s: float = 0.25
     liftoff_after_stand_s: float = 0.3
     liftoff_margin_m: float = 0.02
+    # Any lift-off, from standing or in a walk (pose_optimization._can_lift): a foot that bears weight waits, as
+    # above, while the character's capture point is further than this outside its other sole towards the lifting
+    # foot. Standing on that sole alone, the body could only fall back onto the foot it lifts [m] (None: off).
+    liftoff_capture_behind_m: float | None = 0.05
     # A raised rear foot that still bears weight (on its toes, pose_optimization._rear_foot_bears_weight): while the
     # operator's capture point is more than this behind his stance sole's heel (the character's sole scaled to him,
     # in the heading frame) and his raised foot is behind it, his single stance is read as a double stance.
@@ -215,6 +219,8 @@ class MotionConfig:
         _non_negative("MotionConfig.reference_follows_operator_s", self.reference_follows_operator_s)
         for n in ("liftoff_weight_shift_s", "liftoff_after_stand_s", "liftoff_margin_m"):
             _non_negative(f"MotionConfig.{n}", getattr(self, n))
+        if self.liftoff_capture_behind_m is not None:
+            _non_negative("MotionConfig.liftoff_capture_behind_m", self.liftoff_capture_behind_m)
         _non_negative("MotionConfig.stance_hysteresis_m", self.stance_hysteresis_m)
         _positive("MotionConfig.late_contact_timeout_s", self.late_contact_timeout_s)
         _non_negative("MotionConfig.min_swing_s", self.min_swing_s)

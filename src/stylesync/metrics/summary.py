@@ -22,7 +22,9 @@ def transition_delays(t: np.ndarray, op: np.ndarray, ch: np.ndarray, window_s: f
     """For each operator state change, the time until the character first enters the same state [s].
 
     A character already in that state (early contact) counts as 0; one that never gets there within
-    ``window_s`` counts as ``window_s``.
+    ``window_s`` counts as ``window_s``. A change the character has not followed by the end of the log, less than
+    ``window_s`` before it, is left out: its delay is not known (a run that ends 40 ms after the operator's last
+    lift-off would otherwise count a delay of ``window_s``).
     """
     delays = []
     for i in np.where(op[1:] != op[:-1])[0] + 1:
@@ -31,7 +33,10 @@ def transition_delays(t: np.ndarray, op: np.ndarray, ch: np.ndarray, window_s: f
             delays.append(0.0)
             continue
         later = np.where((ch[i:] == target) & (t[i:] <= t[i] + window_s))[0]
-        delays.append(float(t[i + later[0]] - t[i]) if len(later) else window_s)
+        if len(later):
+            delays.append(float(t[i + later[0]] - t[i]))
+        elif t[-1] >= t[i] + window_s:
+            delays.append(window_s)
     return delays
 
 

@@ -47,6 +47,7 @@ from stylesync.motion.leg_ik import solve_leg
 from stylesync.motion.operator_analysis import UPPER_JOINTS, OperatorAnalysis, analyse_operator, upper_local
 from stylesync.motion.recovery_step import (
     RecoveryStepper,
+    beyond_sole_towards_m,
     capture_point,
     operator_stands,
     soles_on_ground,
@@ -252,23 +253,40 @@ class MotionOptimizer:
     # ---- 1. stance tracking (Sec. 5.1) ---------------------------------------------------------------------
     def _can_lift(self, sample: OperatorSample, state: CharacterState, mass: MassProperties
                   ) -> dict[str, bool] | None:
-        """Weight shift before a lift-off: per foot, whether the character may lift it now. A foot may not when the
-        operator lifts it after standing (a double stance of at least ``liftoff_after_stand_s``: a step or a kick
-        from standing, not a walk's double stance) with his capture point over his other sole, sideways (within
-        ``liftoff_margin_m`` of its inner edge, his sole the character's scaled to him), while the character's
-        capture point is further than that inwards of its own other sole. None: no such lift-off now."""
+        """Weight shift before a lift-off: per foot, whether the character may lift it now. None: no such test now.
+
+        * Any lift-off (``liftoff_capture_behind_m``): a foot that bears weight may not while the character's
+          capture point is further than that outside its other sole towards it
+          (recovery_step.beyond_sole_towards_m). On the other foot alone, the body would fall back onto the lifted
+          one: a start at rest mid-stride, or a character that lags its operator, lifts the rear foot while its
+          capture point is still behind the front heel.
+        * A lift-off after standing: a foot may not when the operator lifts it after a double stance of at least
+          ``liftoff_after_stand_s`` (a step or a kick from standing, not a walk's double stance) with his capture
+          point over his other sole, sideways (within ``liftoff_margin_m`` of its inner edge, his sole the
+          character's scaled to him), while the character's capture point is further than that inwards of its own
+          other sole."""
         cfg = self.cfg
         if cfg.liftoff_weight_shift_s <= 0.0:
             return None
+        xi, _ = capture_point(mass.com(state), mass.com_velocity(state), self.g)
+        can: dict[str, bool] | None = None
+        if cfg.liftoff_capture_behind_m is not None:
+            pressing = state.feet_pressing()
+            can = {}
+            for side in ("left", "right"):
+                stance = _OTHER_SIDE[side]
+                behind_m = beyond_sole_towards_m(xi, state.link_origin_world[_LINK[f"{stance}_ankle"]],
+                                                 state.link_quat_wxyz[_LINK[f"{stance}_ankle"]],
+                                                 state.link_origin_world[_LINK[f"{side}_ankle"]])
+                can[side] = not (pressing[side] and behind_m > cfg.liftoff_capture_behind_m)
         stood_s = (state.time_s - self._op_state_t0_s) if self._op_state is Stance.DS else self._op_last_ds_s
         if stood_s < cfg.liftoff_after_stand_s:
-            return None
-        xi, _ = capture_point(mass.com(state), mass.com_velocity(state), self.g)
+            return can
         scale = CHAR_LEG_LENGTH_M / self._op_leg_m if self._op_leg_m else 1.0
         h_h = max(sample.com_world[2] - min(sample.pos["ANKLE_LEFT"][2], sample.pos["ANKLE_RIGHT"][2]), 0.1)
         xi_h = sample.com_world + self._com_h_rate.rate * np.sqrt(h_h / self.g)
         edge = FOOT_WIDTH_M / 2 + cfg.liftoff_margin_m
-        can = {}
+        shifted = {}
         for side in ("left", "right"):
             stance = _OTHER_SIDE[side]
             ankle = state.link_origin_world[_LINK[f"{stance}_ankle"]]
@@ -276,8 +294,9 @@ class MotionOptimizer:
             ankle_h = sample.pos[f"ANKLE_{_SIDE_UP[stance]}"]
             yaw_h = rot.twist_angle(sample.quat[f"ANKLE_{_SIDE_UP[stance]}"], _UP)
             he_stands_on_it = scale * _inward_m(xi_h, ankle_h, yaw_h, stance) <= edge
-            can[side] = not he_stands_on_it or _inward_m(xi, ankle, yaw, stance) <= edge
-        return can
+            shifted[side] = ((not he_stands_on_it or _inward_m(xi, ankle, yaw, stance) <= edge)
+                             and (can is None or can[side]))
+        return shifted
 
     def _rear_foot_bears_weight(self, sample: OperatorSample, analysis: OperatorAnalysis, op_state: Stance) -> bool:
         """Whether the operator's raised foot still carries weight: it is behind his stance foot, and his capture

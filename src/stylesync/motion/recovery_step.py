@@ -98,6 +98,19 @@ def support_outside_m(xi_world: np.ndarray, ankles_world: dict[str, np.ndarray],
     return outside_distance_points((float(xi_world[0]), float(xi_world[1])), convex_hull_points(corners))[0]
 
 
+def beyond_sole_towards_m(xi_world: np.ndarray, stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray,
+                          other_ankle_world: np.ndarray) -> float:
+    """How far a capture point (horizontal) lies outside the stance sole on the side of the other foot [m]: its
+    distance from the sole where the direction from the sole's nearest point to it points towards the other ankle,
+    0 otherwise. Standing on that sole alone, the body then falls back onto the other foot. On plain floats."""
+    polygon = convex_hull_points(sole_points_xy(stance_ankle_world, stance_foot_quat_wxyz, _SOLE_POINTS))
+    x, y = float(xi_world[0]), float(xi_world[1])
+    distance, (nx, ny) = outside_distance_points((x, y), polygon)
+    towards = ((x - nx) * (float(other_ankle_world[0]) - float(stance_ankle_world[0]))
+               + (y - ny) * (float(other_ankle_world[1]) - float(stance_ankle_world[1])))
+    return distance if distance > 0.0 and towards > 0.0 else 0.0
+
+
 def operator_stands(xi_h_world: np.ndarray, ankles_h_world: dict[str, np.ndarray], foot_yaw_h_rad: dict[str, float],
                     scale: float) -> bool:
     """Whether the operator's capture point (horizontal) is within the support polygon of his soles, each the
