@@ -128,11 +128,11 @@ def test_the_fsm_keeps_a_recovery_step_until_its_foot_lands():
     assert fsm.update(Stance.DS, {"left": False, "right": True}, 1.31) is Stance.DS
 
 
-# The controller the scenarios below were traced with: the supporting legs' posture at full weight (before
-# WholeBodyConfig.stance_leg_tracking_share). Each scenario is one clip and seed on which a feature decides a fall;
-# a change of the controller changes which runs fall, so the feature is tested where its effect was traced, and the
-# default controller where the test says "default".
-TRACED = ControlConfig(whole_body=WholeBodyConfig(stance_leg_tracking_share=1.0))
+# The controller the scenarios below were traced with: the supporting legs' posture and the pelvis at full weight
+# (before WholeBodyConfig.stance_leg_tracking_share and single_stance_pelvis_share). Each scenario is one clip and
+# seed on which a feature decides a fall; a change of the controller changes which runs fall, so the feature is
+# tested where its effect was traced, and the default controller where the test says "default".
+TRACED = ControlConfig(whole_body=WholeBodyConfig(stance_leg_tracking_share=1.0, single_stance_pelvis_share=1.0))
 # ... and the motion stage's balance layer as it was then: recovery steps of 0.6 leg lengths, and a swing the
 # operator stops on not yet landed at once (with either, several of the traced falls come later or not at all).
 TRACED_MOTION = {"recovery_step_reach_share": 0.6, "recovery_on_stopping_step": False,
@@ -499,3 +499,18 @@ def test_a_rear_foot_stays_down_while_the_capture_point_is_behind_the_front_heel
     lifted, _ = _run(spec, clip_end_s, MotionConfig(liftoff_capture_behind_m=None), seed=4)
     assert not kept.fell
     assert lifted.fell and lifted.fall_time_s is not None and lifted.fall_time_s < clip_end_s
+
+
+@pytest.mark.skipif(not (MOCAP / "cmu-dev" / "02_03.bvh").exists(),
+                    reason="../shared/mocap/cmu-dev/02_03.bvh is not available")
+def test_a_lighter_pelvis_on_one_foot_lets_a_running_stride_swing_forward():
+    """CMU-dev 02_03 (a run), seed 0: with the pelvis orientation at full weight in single stance, the first swing
+    on the left foot (0.42-0.73 s) goes backwards while the operator's goes forward, lands beside the stance foot,
+    and the body sinks and falls in the clip (0.98 s). At ``single_stance_pelvis_share`` 0.3 the swing lands 0.73 m
+    ahead of the stance ankle and the run completes, the 3 s rest after the clip included (4.41 s)."""
+    spec = f"bvh:{MOCAP / 'cmu-dev' / '02_03.bvh'}"
+    light, _ = _run(spec, 4.41, MotionConfig())
+    level, _ = _run(spec, 4.41, MotionConfig(),
+                    control=ControlConfig(whole_body=WholeBodyConfig(single_stance_pelvis_share=1.0)))
+    assert not light.fell
+    assert level.fell and level.fall_time_s is not None and level.fall_time_s < 1.41

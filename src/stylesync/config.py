@@ -291,6 +291,11 @@ class WholeBodyConfig:
     # the leg's posture (the operator's crouch or push-off, retargeted) drove the COM past the feet before jumps
     # (docs/decisions.md, "The supporting legs' posture")
     stance_leg_tracking_share: float = 0.1
+    # The pelvis orientation task's weight in single stance, as a share of its weight on two feet. A swing leg driven
+    # forward and up (a running stride) turns the pelvis the other way; a pelvis held level at full weight took that
+    # acceleration from the swing leg, whose foot then went back instead of forward (docs/decisions.md, "The pelvis
+    # in single stance")
+    single_stance_pelvis_share: float = 0.3
 
     def __post_init__(self) -> None:
         for n in ("joint_tracking_omega_rad_s", "joint_tracking_damping_ratio", "momentum_moment_weight_per_m",
@@ -298,7 +303,7 @@ class WholeBodyConfig:
             _positive(f"WholeBodyConfig.{n}", getattr(self, n))
         for n in ("momentum_com_kp", "momentum_com_kd", "momentum_root_kp", "momentum_root_kd",
                   "contact_velocity_gain", "sole_contact_gap_m", "joint_tracking_weight", "hand_task_kp",
-                  "hand_task_kd", "hand_task_weight", "stance_leg_tracking_share"):
+                  "hand_task_kd", "hand_task_weight", "stance_leg_tracking_share", "single_stance_pelvis_share"):
             _non_negative(f"WholeBodyConfig.{n}", getattr(self, n))
 
 

@@ -166,10 +166,14 @@ class WholeBodyController(ControllerBase):
         lim = np.maximum(wb.joint_acceleration_limit_rad_s2, own)
         self.posture.desired_accel = np.minimum(np.maximum(qdd_joint, -lim), lim)
 
-        # Pelvis orientation, weighted by the pelvis's rotational inertia about world axes (as a joint's by M_ii).
+        # Pelvis orientation, weighted by the pelvis's rotational inertia about world axes (as a joint's by M_ii); on
+        # one foot by single_stance_pelvis_share of that, so that the swing leg's turn of the pelvis does not hold
+        # the swing back (WholeBodyConfig).
         r_base = model.data.oMi[1].rotation
         m_rot_world = r_base @ model.mass_matrix[3:6, 3:6] @ r_base.T
         self.pelvis.weight = wb.joint_tracking_weight * np.maximum(m_rot_world.diagonal(), MIN_TRACKING_INERTIA_KGM2)
+        if len(support) == 1:
+            self.pelvis.weight = self.pelvis.weight * wb.single_stance_pelvis_share
         self.pelvis.target_quat_wxyz = ref.root_quat_wxyz
 
         # A stance foot that does not touch yet is lowered onto the ground (a foot no force is planned for would
