@@ -133,6 +133,9 @@ def test_the_fsm_keeps_a_recovery_step_until_its_foot_lands():
 # seed on which a feature decides a fall; a change of the controller changes which runs fall, so the feature is
 # tested where its effect was traced, and the default controller where the test says "default".
 TRACED = ControlConfig(whole_body=WholeBodyConfig(stance_leg_tracking_share=1.0, single_stance_pelvis_share=1.0))
+# The default controller before WholeBodyConfig.single_stance_pelvis_share, which the scenarios of the stopping
+# step and the overdue double stance were traced with.
+PELVIS_LEVEL = ControlConfig(whole_body=WholeBodyConfig(single_stance_pelvis_share=1.0))
 # ... and the motion stage's balance layer as it was then: recovery steps of 0.6 leg lengths, and a swing the
 # operator stops on not yet landed at once (with either, several of the traced falls come later or not at all).
 TRACED_MOTION = {"recovery_step_reach_share": 0.6, "recovery_on_stopping_step": False,
@@ -187,13 +190,13 @@ def test_a_swing_he_stops_on_is_landed_at_once_where_the_capture_point_goes(monk
     monkeypatch.setattr(RecoveryStepper, "take_over", recorded)
     spec = f"bvh:{MOCAP / 'cmu-dev' / '08_04.bvh'}"
     clip_end_s = 3.99
-    result, session = _run(spec, clip_end_s + 3.0, MotionConfig())
+    result, session = _run(spec, clip_end_s + 3.0, MotionConfig(), control=PELVIS_LEVEL)
     assert not result.fell
     assert taken and clip_end_s < taken[0] < clip_end_s + 0.15
     com_vel = session.mass.com_velocity(session.backend.read_state(result.sim_duration_s))
     assert float(np.linalg.norm(com_vel[:2])) < 0.05  # at rest at the end
     taken.clear()
-    off, _ = _run(spec, clip_end_s + 3.0, MotionConfig(recovery_on_stopping_step=False))
+    off, _ = _run(spec, clip_end_s + 3.0, MotionConfig(recovery_on_stopping_step=False), control=PELVIS_LEVEL)
     assert taken and taken[0] > clip_end_s + 0.2
     assert off.fell and off.fall_time_s is not None and off.fall_time_s > clip_end_s
 
@@ -220,11 +223,11 @@ def test_a_double_stance_whose_capture_point_has_run_out_ends_in_a_step_of_its_o
     monkeypatch.setattr(RecoveryStepper, "trigger", recorded)
     spec = f"bvh:{MOCAP / 'cmu-dev' / '07_05.bvh'}"
     clip_end_s = 4.27
-    result, _ = _run(spec, clip_end_s + 3.0, MotionConfig())
+    result, _ = _run(spec, clip_end_s + 3.0, MotionConfig(), control=PELVIS_LEVEL)
     assert not result.fell
     assert any(3.9 < t < clip_end_s for t in began)
     began.clear()
-    off, _ = _run(spec, clip_end_s + 3.0, MotionConfig(recovery_double_stance_overrun=0.0))
+    off, _ = _run(spec, clip_end_s + 3.0, MotionConfig(recovery_double_stance_overrun=0.0), control=PELVIS_LEVEL)
     assert not any(3.9 < t < clip_end_s for t in began) and any(t > clip_end_s for t in began)
     assert off.fell and off.fall_time_s is not None and off.fall_time_s > clip_end_s
 
