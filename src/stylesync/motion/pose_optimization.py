@@ -268,35 +268,33 @@ class MotionOptimizer:
         cfg = self.cfg
         if cfg.liftoff_weight_shift_s <= 0.0:
             return None
-        xi, _ = capture_point(mass.com(state), mass.com_velocity(state), self.g)
-        can: dict[str, bool] | None = None
-        if cfg.liftoff_capture_behind_m is not None:
-            pressing = state.feet_pressing()
-            can = {}
-            for side in ("left", "right"):
-                stance = _OTHER_SIDE[side]
-                behind_m = beyond_sole_towards_m(xi, state.link_origin_world[_LINK[f"{stance}_ankle"]],
-                                                 state.link_quat_wxyz[_LINK[f"{stance}_ankle"]],
-                                                 state.link_origin_world[_LINK[f"{side}_ankle"]])
-                can[side] = not (pressing[side] and behind_m > cfg.liftoff_capture_behind_m)
         stood_s = (state.time_s - self._op_state_t0_s) if self._op_state is Stance.DS else self._op_last_ds_s
-        if stood_s < cfg.liftoff_after_stand_s:
-            return can
-        scale = CHAR_LEG_LENGTH_M / self._op_leg_m if self._op_leg_m else 1.0
-        h_h = max(sample.com_world[2] - min(sample.pos["ANKLE_LEFT"][2], sample.pos["ANKLE_RIGHT"][2]), 0.1)
-        xi_h = sample.com_world + self._com_h_rate.rate * np.sqrt(h_h / self.g)
-        edge = FOOT_WIDTH_M / 2 + cfg.liftoff_margin_m
-        shifted = {}
+        after_stand = stood_s >= cfg.liftoff_after_stand_s
+        behind_limit_m = cfg.liftoff_capture_behind_m
+        if behind_limit_m is None and not after_stand:
+            return None
+        xi, _ = capture_point(mass.com(state), mass.com_velocity(state), self.g)
+        pressing = state.feet_pressing()
+        if after_stand:
+            scale = CHAR_LEG_LENGTH_M / self._op_leg_m if self._op_leg_m else 1.0
+            h_h = max(sample.com_world[2] - min(sample.pos["ANKLE_LEFT"][2], sample.pos["ANKLE_RIGHT"][2]), 0.1)
+            xi_h = sample.com_world + self._com_h_rate.rate * np.sqrt(h_h / self.g)
+            edge = FOOT_WIDTH_M / 2 + cfg.liftoff_margin_m
+        can = {}
         for side in ("left", "right"):
             stance = _OTHER_SIDE[side]
             ankle = state.link_origin_world[_LINK[f"{stance}_ankle"]]
-            yaw = rot.twist_angle(state.link_quat_wxyz[_LINK[f"{stance}_ankle"]], _UP)
-            ankle_h = sample.pos[f"ANKLE_{_SIDE_UP[stance]}"]
-            yaw_h = rot.twist_angle(sample.quat[f"ANKLE_{_SIDE_UP[stance]}"], _UP)
-            he_stands_on_it = scale * _inward_m(xi_h, ankle_h, yaw_h, stance) <= edge
-            shifted[side] = ((not he_stands_on_it or _inward_m(xi, ankle, yaw, stance) <= edge)
-                             and (can is None or can[side]))
-        return shifted
+            foot_q = state.link_quat_wxyz[_LINK[f"{stance}_ankle"]]
+            may = not (behind_limit_m is not None and pressing[side] and beyond_sole_towards_m(
+                xi, ankle, foot_q, state.link_origin_world[_LINK[f"{side}_ankle"]]) > behind_limit_m)
+            if after_stand:
+                ankle_h = sample.pos[f"ANKLE_{_SIDE_UP[stance]}"]
+                yaw_h = rot.twist_angle(sample.quat[f"ANKLE_{_SIDE_UP[stance]}"], _UP)
+                he_stands_on_it = scale * _inward_m(xi_h, ankle_h, yaw_h, stance) <= edge
+                may = may and (not he_stands_on_it or _inward_m(xi, ankle, rot.twist_angle(foot_q, _UP), stance)
+                               <= edge)
+            can[side] = may
+        return can
 
     def _rear_foot_bears_weight(self, sample: OperatorSample, analysis: OperatorAnalysis, op_state: Stance) -> bool:
         """Whether the operator's raised foot still carries weight: it is behind his stance foot, and his capture
