@@ -139,7 +139,9 @@ PELVIS_LEVEL = ControlConfig(whole_body=WholeBodyConfig(single_stance_pelvis_sha
 # ... and the motion stage's balance layer as it was then: recovery steps of 0.6 leg lengths, and a swing the
 # operator stops on not yet landed at once (with either, several of the traced falls come later or not at all).
 TRACED_MOTION = {"recovery_step_reach_share": 0.6, "recovery_on_stopping_step": False,
-                 "recovery_double_stance_overrun": 0.0, "liftoff_capture_behind_m": None}
+                 "recovery_double_stance_overrun": 0.0, "liftoff_capture_behind_m": None, "foot_yaw_control": False}
+# The scenarios traced before MotionConfig.foot_yaw_control run with the feet's twist left where it was.
+TWIST_FREE = {"foot_yaw_control": False}
 
 
 def _run(spec: str, seconds: float, motion: MotionConfig, seed: int = 0, control: ControlConfig | None = None):
@@ -162,10 +164,13 @@ def test_a_walk_cut_mid_stride_comes_to_rest_with_its_own_last_step():
     """CMU 08_01 ends mid-stride (2.27 s); its operator then holds his last pose. Without the stopping landing and
     recovery steps the character keeps its momentum and falls in the rest (measured: 3.3 s, seed 0)."""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '08_01.bvh'}"
-    result, session = _run(spec, 5.27, MotionConfig())
+    # Traced with the feet's twist left where it is; with the feet's yaw controlled it does not fall either, but
+    # still sways in its last double stance at 0.1-0.17 m/s (measured).
+    result, session = _run(spec, 5.27, MotionConfig(foot_yaw_control=False))
     assert not result.fell
     com_vel = session.mass.com_velocity(session.backend.read_state(result.sim_duration_s))
     assert float(np.linalg.norm(com_vel[:2])) < 0.05  # at rest at the end
+    assert not _run(spec, 5.27, MotionConfig())[0].fell
     off, _ = _run(spec, 5.27, MotionConfig(recovery_steps=False))
     assert off.fell and off.fall_time_s is not None and off.fall_time_s > 2.27
 
@@ -190,13 +195,14 @@ def test_a_swing_he_stops_on_is_landed_at_once_where_the_capture_point_goes(monk
     monkeypatch.setattr(RecoveryStepper, "take_over", recorded)
     spec = f"bvh:{MOCAP / 'cmu-dev' / '08_04.bvh'}"
     clip_end_s = 3.99
-    result, session = _run(spec, clip_end_s + 3.0, MotionConfig(), control=PELVIS_LEVEL)
+    result, session = _run(spec, clip_end_s + 3.0, MotionConfig(**TWIST_FREE), control=PELVIS_LEVEL)
     assert not result.fell
     assert taken and clip_end_s < taken[0] < clip_end_s + 0.15
     com_vel = session.mass.com_velocity(session.backend.read_state(result.sim_duration_s))
     assert float(np.linalg.norm(com_vel[:2])) < 0.05  # at rest at the end
     taken.clear()
-    off, _ = _run(spec, clip_end_s + 3.0, MotionConfig(recovery_on_stopping_step=False), control=PELVIS_LEVEL)
+    off, _ = _run(spec, clip_end_s + 3.0, MotionConfig(**TWIST_FREE, recovery_on_stopping_step=False),
+                  control=PELVIS_LEVEL)
     assert taken and taken[0] > clip_end_s + 0.2
     assert off.fell and off.fall_time_s is not None and off.fall_time_s > clip_end_s
 
@@ -223,11 +229,12 @@ def test_a_double_stance_whose_capture_point_has_run_out_ends_in_a_step_of_its_o
     monkeypatch.setattr(RecoveryStepper, "trigger", recorded)
     spec = f"bvh:{MOCAP / 'cmu-dev' / '07_05.bvh'}"
     clip_end_s = 4.27
-    result, _ = _run(spec, clip_end_s + 3.0, MotionConfig(), control=PELVIS_LEVEL)
+    result, _ = _run(spec, clip_end_s + 3.0, MotionConfig(**TWIST_FREE), control=PELVIS_LEVEL)
     assert not result.fell
     assert any(3.9 < t < clip_end_s for t in began)
     began.clear()
-    off, _ = _run(spec, clip_end_s + 3.0, MotionConfig(recovery_double_stance_overrun=0.0), control=PELVIS_LEVEL)
+    off, _ = _run(spec, clip_end_s + 3.0, MotionConfig(**TWIST_FREE, recovery_double_stance_overrun=0.0),
+                  control=PELVIS_LEVEL)
     assert not any(3.9 < t < clip_end_s for t in began) and any(t > clip_end_s for t in began)
     assert off.fell and off.fall_time_s is not None and off.fall_time_s > clip_end_s
 
@@ -277,10 +284,10 @@ def test_a_late_contact_hold_keeps_the_walk_going():
     without the bound on the COM target's capture point (capture_bound.py), which also keeps the stopped targets from
     throwing this run; with everything on, it comes to rest too."""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '08_01.bvh'}"
-    on, _ = _run(spec, 5.27, MotionConfig(capture_bound_sole_share=0.0), seed=1, control=TRACED)
+    on, _ = _run(spec, 5.27, MotionConfig(**TWIST_FREE, capture_bound_sole_share=0.0), seed=1, control=TRACED)
     assert not on.fell
-    off, _ = _run(spec, 5.27, MotionConfig(late_contact_keeps_momentum=False, capture_bound_sole_share=0.0), seed=1,
-                  control=TRACED)
+    off, _ = _run(spec, 5.27, MotionConfig(**TWIST_FREE, late_contact_keeps_momentum=False,
+                                           capture_bound_sole_share=0.0), seed=1, control=TRACED)
     assert off.fell
     default, _ = _run(spec, 5.27, MotionConfig(), seed=1)
     assert not default.fell
@@ -314,10 +321,10 @@ def test_a_recovery_step_lets_the_body_move_as_its_landing_assumes():
     ``recovery_landing_reach``) and the COM target unbounded (no ``capture_bound_sole_share``): with the body lowered
     for a landing as well, both come to rest."""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '07_01.bvh'}"
-    free, _ = _run(spec, 5.6, MotionConfig(recovery_landing_reach=False, capture_bound_sole_share=0.0),
+    free, _ = _run(spec, 5.6, MotionConfig(**TWIST_FREE, recovery_landing_reach=False, capture_bound_sole_share=0.0),
                    control=TRACED)
     assert not free.fell
-    pulled, _ = _run(spec, 5.6, MotionConfig(recovery_step_free_com=False, recovery_landing_reach=False,
+    pulled, _ = _run(spec, 5.6, MotionConfig(**TWIST_FREE, recovery_step_free_com=False, recovery_landing_reach=False,
                                              capture_bound_sole_share=0.0), control=TRACED)
     assert pulled.fell and pulled.fall_time_s is not None and pulled.fall_time_s > 2.6
 
@@ -331,7 +338,7 @@ def test_targets_that_follow_the_operator_keep_the_walk_up_with_him():
     covered = {}
     for tau in (0.0, 0.5):
         opened = open_source("builtin:walk", seed=0, duration_s=7.0)
-        cfg = SessionConfig(duration_s=7.0, seed=0, motion=MotionConfig(reference_follows_operator_s=tau),
+        cfg = SessionConfig(duration_s=7.0, seed=0, motion=MotionConfig(**TWIST_FREE, reference_follows_operator_s=tau),
                             control=TRACED)
         session = Session(cfg, opened.source)
         start = {}
@@ -468,7 +475,8 @@ def test_a_character_waiting_with_its_step_counted_may_still_step_on_its_own():
     began = {}
     for allowed in (False, True):
         opened = open_source(spec, seed=2, duration_s=5.4)
-        cfg = SessionConfig(duration_s=5.4, seed=2, motion=MotionConfig(recovery_while_step_counted=allowed),
+        cfg = SessionConfig(duration_s=5.4, seed=2,
+                            motion=MotionConfig(**TWIST_FREE, recovery_while_step_counted=allowed),
                             clocks=dataclasses.replace(SessionConfig().clocks, mocap_hz=opened.mocap_hz))
         session = Session(cfg, opened.source)
         steps: list[float] = []
@@ -512,8 +520,8 @@ def test_a_lighter_pelvis_on_one_foot_lets_a_running_stride_swing_forward():
     and the body sinks and falls in the clip (0.98 s). At ``single_stance_pelvis_share`` 0.3 the swing lands 0.73 m
     ahead of the stance ankle and the run completes, the 3 s rest after the clip included (4.41 s)."""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '02_03.bvh'}"
-    light, _ = _run(spec, 4.41, MotionConfig())
-    level, _ = _run(spec, 4.41, MotionConfig(),
+    light, _ = _run(spec, 4.41, MotionConfig(**TWIST_FREE))
+    level, _ = _run(spec, 4.41, MotionConfig(**TWIST_FREE),
                     control=ControlConfig(whole_body=WholeBodyConfig(single_stance_pelvis_share=1.0)))
     assert not light.fell
     assert level.fell and level.fall_time_s is not None and level.fall_time_s < 1.41

@@ -145,6 +145,11 @@ class MotionConfig:
     swing_hip_cd: float = 0.0  # Eq. 12, Sec. 7.2 sets c_d = 0
     swing_hip_cv: float = 0.0  # Eq. 12, Sec. 7.2 sets c_v = 0
     max_swing_foot_lift_m: float = 0.25  # clamp of the scaled swing-ankle height above the ground [m]
+    # The feet's yaw about the shank (the ankle is a ball joint; pose_optimization.py): a swing foot turns to its
+    # target yaw (the operator's foot's; a recovery step's, the heading), and an unloaded planted foot keeps the yaw
+    # it had when it last pressed the ground. Off: the twist is left where it is, and the feet drifted to 90-180°
+    # from the body (docs/decisions.md, "The feet's yaw").
+    foot_yaw_control: bool = True
     # Where the swing foot goes, horizontally (pose_optimization.py): the operator's foot relative to his capture
     # point, scaled, from the character's capture point ("capture_point"), or relative to his pelvis from the
     # character's pelvis ("pelvis", no balance feedback, as Sec. 7.2's c_d = c_v = 0).

@@ -218,6 +218,7 @@ class MotionOptimizer:
         self._swing: str | None = None
         self._swing_offset = np.zeros(2)  # lift-off foot position minus the first swing target, decaying [m]
         self._swing_t0_s = 0.0  # when the character's current swing began [s]
+        self._planted_yaw: dict[str, float] = {}  # each planted foot's yaw when it last pressed the ground [rad]
         self._op_swing_s = OPERATOR_SWING_S  # the operator's swing time, averaged over his swings [s]
         self._op_state: Stance | None = None
         self._op_state_t0_s = 0.0
@@ -450,7 +451,9 @@ class MotionOptimizer:
                 tick.targets[side] = self.recovery.swing_target(
                     state.time_s, tick.com_c, tick.com_vel_c, tick.a_c[other],
                     state.link_quat_wxyz[_LINK[f"{other}_ankle"]], tick.R_root_d)
-                tick.foot_yaw[side] = rot.twist_angle(state.link_quat_wxyz[_LINK[f"{side}_ankle"]], _UP)
+                tick.foot_yaw[side] = (float(np.arctan2(tick.R_root_d[1, 0], tick.R_root_d[0, 0]))
+                                       if self.cfg.foot_yaw_control  # along the heading, as its landing is planned
+                                       else rot.twist_angle(state.link_quat_wxyz[_LINK[f"{side}_ankle"]], _UP))
             elif side == sw:
                 tick.targets[side] = self._swing_target(tick, state, side)
                 tick.foot_yaw[side] = rot.twist_angle(tick.s.quat[f"ANKLE_{_SIDE_UP[side]}"], _UP)
@@ -459,7 +462,15 @@ class MotionOptimizer:
                 # one, which rises when a foot rolls and would feed back into the pelvis height of Eq. 9.
                 a = tick.a_c[side]
                 tick.targets[side] = np.array([a[0], a[1], ANKLE_HEIGHT_M])
-                tick.foot_yaw[side] = rot.twist_angle(state.link_quat_wxyz[_LINK[f"{side}_ankle"]], _UP)
+                yaw = rot.twist_angle(state.link_quat_wxyz[_LINK[f"{side}_ankle"]], _UP)
+                if self.cfg.foot_yaw_control:
+                    # Where it presses the ground its sole's friction holds it; unloaded, it keeps the yaw it had.
+                    if tick.contact[side] or side not in self._planted_yaw:
+                        self._planted_yaw[side] = yaw
+                    yaw = self._planted_yaw[side]
+                tick.foot_yaw[side] = yaw
+            if side == sw:
+                self._planted_yaw.pop(side, None)
         self._swing = sw
         # A foot that has to reach the ground and does not touch it yet (a stance foot, or the swing foot held
         # for a late contact) must be within the leg's reach of its hip: the pelvis is lowered as far as that
@@ -711,14 +722,23 @@ class MotionOptimizer:
             q_foot = rot.quat_from_yaw(tick.foot_yaw[side])
             # Feet flat (Sec. 5.3). A planted foot on the IK's shank, which keeps the ankles' stiffness against
             # leaning; the swing foot on the actual shank, so that it is flat in the world whatever the swing leg's
-            # tracking error, and lands on its sole rather than an edge it would roll over. The twist about the
-            # shank's long axis is left where it is: a difference between the IK's and the actual shank twist
-            # would otherwise twist a planted foot against its sole's friction and spin it.
+            # tracking error, and lands on its sole rather than an edge it would roll over.
             shank = state.link_quat_wxyz[_LINK[f"{side}_knee"]] if side == sw else ik.shank_quat_wxyz
             q_ankle_ik = rot.multiply(rot.conjugate(shank), q_foot)
-            swing_ik, _ = rot.swing_twist(q_ankle_ik, _UP)
-            _, twist_now = rot.swing_twist(canonical_quat_from_model(q_cur[JOINT_NAMES.index(f"{side}_ankle")]), _UP)
-            local[f"{side}_ankle"] = rot.multiply(swing_ik, twist_now)
+            if not cfg.foot_yaw_control:
+                # The twist about the shank's long axis left where it is.
+                swing_ik, _ = rot.swing_twist(q_ankle_ik, _UP)
+                _, twist = rot.swing_twist(canonical_quat_from_model(q_cur[JOINT_NAMES.index(f"{side}_ankle")]), _UP)
+                local[f"{side}_ankle"] = rot.multiply(swing_ik, twist)
+            elif side == sw:
+                local[f"{side}_ankle"] = q_ankle_ik  # the swing foot turns to its yaw about the actual shank
+            else:
+                # A planted foot's twist is the one that gives its yaw about the actual shank: about the IK's, the
+                # difference between the two shanks' twists would turn the foot against its sole's friction.
+                swing_ik, _ = rot.swing_twist(q_ankle_ik, _UP)
+                on_shank = rot.multiply(rot.conjugate(state.link_quat_wxyz[_LINK[f"{side}_knee"]]), q_foot)
+                _, twist = rot.swing_twist(on_shank, _UP)
+                local[f"{side}_ankle"] = rot.multiply(swing_ik, twist)
         return local, knee_angle
 
     # ---- 5. upper body (joint map) -----------------------------------------------------------------------------
