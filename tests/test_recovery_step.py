@@ -20,6 +20,7 @@ from stylesync.motion.recovery_step import (
     capture_point,
     operator_stands,
     stands_on,
+    support_outside_along,
 )
 from stylesync.motion.stance_fsm import CharacterStanceFsm, Stance
 
@@ -525,3 +526,28 @@ def test_a_lighter_pelvis_on_one_foot_lets_a_running_stride_swing_forward():
                     control=ControlConfig(whole_body=WholeBodyConfig(single_stance_pelvis_share=1.0)))
     assert not light.fell
     assert level.fell and level.fall_time_s is not None and level.fall_time_s < 1.41
+
+
+def test_the_outward_direction_of_a_capture_point_tells_behind_from_ahead():
+    feet = {"left": ANKLES["left"], "right": ANKLES["right"]}
+    forward = np.array([1.0, 0.0])
+    out, along = support_outside_along(np.array([-0.3, 0.0]), feet, QUATS, ["left", "right"], forward)
+    assert out > 0.2 and along == pytest.approx(-1.0)
+    out, along = support_outside_along(np.array([0.5, 0.0]), feet, QUATS, ["left", "right"], forward)
+    assert out > 0.2 and along == pytest.approx(1.0)
+    out, along = support_outside_along(np.array([0.03, 0.0]), feet, QUATS, ["left", "right"], forward)
+    assert out < 0.0 and along == 0.0
+
+
+@pytest.mark.skipif(not (MOCAP / "cmu-dev" / "10_04.bvh").exists(),
+                    reason="../shared/mocap/cmu-dev/10_04.bvh is not available")
+def test_a_capture_point_behind_both_feet_steps_back_at_once():
+    """CMU-dev 10_04, seed 0: a stopping step landed the character's feet side by side with its COM 9 cm behind them
+    (1.57 s); the operator walks on forwards. Its capture point ran out behind both feet while it waited for his
+    next lift-off and then for the double stance to be overdue (the step back began at 2.08 s, 0.38 m out), and it fell
+    backwards in the clip (2.72 s). Stepping back as soon as the capture point is behind, it walks on."""
+    spec = f"bvh:{MOCAP / 'cmu-dev' / '10_04.bvh'}"
+    at_once, session = _run(spec, 4.0, MotionConfig())
+    assert not at_once.fell
+    waiting, _ = _run(spec, 4.0, MotionConfig(recovery_step_behind_cos=None))
+    assert waiting.fell and waiting.fall_time_s is not None and waiting.fall_time_s < 3.0

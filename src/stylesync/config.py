@@ -190,6 +190,10 @@ class MotionConfig:
     # recovery step (he walks on, or stands on one foot, while the character waits for a lift-off of his that
     # comes too late for it; 0: off) [-]
     recovery_double_stance_overrun: float = 1.5
+    # ... at once where the capture point has left that polygon behind: the outward direction from the polygon's
+    # nearest point to the capture point has a share below minus this of the heading's forward axis (a step of an
+    # operator walking forwards can never catch it; docs/decisions.md, "A capture point behind both feet"; None: off)
+    recovery_step_behind_cos: float | None = 0.7
     # During a recovery step the COM task holds the character's own COM state (no pull towards the operator's
     # stance): the body moves as the landing's capture-point prediction assumes
     recovery_step_free_com: bool = True
@@ -221,6 +225,9 @@ class MotionConfig:
         _positive("MotionConfig.recovery_step_reach_share", self.recovery_step_reach_share)
         _positive("MotionConfig.recovery_swing_overrun", self.recovery_swing_overrun)
         _non_negative("MotionConfig.recovery_double_stance_overrun", self.recovery_double_stance_overrun)
+        if self.recovery_step_behind_cos is not None and not -1.0 <= self.recovery_step_behind_cos <= 1.0:
+            raise ConfigError("MotionConfig.recovery_step_behind_cos must be within [-1, 1] or None, "
+                              f"got {self.recovery_step_behind_cos}")
         _non_negative("MotionConfig.reference_follows_operator_s", self.reference_follows_operator_s)
         for n in ("liftoff_weight_shift_s", "liftoff_after_stand_s", "liftoff_margin_m"):
             _non_negative(f"MotionConfig.{n}", getattr(self, n))

@@ -52,7 +52,7 @@ from stylesync.motion.recovery_step import (
     operator_stands,
     soles_on_ground,
     stands_on,
-    support_outside_m,
+    support_outside_along,
 )
 from stylesync.motion.reference import LipmMap, MotionReading, ReferencePose
 from stylesync.motion.stance_fsm import (
@@ -590,9 +590,10 @@ class MotionOptimizer:
     def _double_stance_overdue(self, tick: _Tick, state: CharacterState) -> bool:
         """Step timing adapted to the balance in double stance: whether the character's capture point has been
         outside the support polygon of its soles on the ground, by more than the recovery step's margin, for
-        ``recovery_double_stance_overrun`` times the operator's usual double stance. A character's double stance
-        ends with his next lift-off; where he walks on from a step the character has already landed, or holds a
-        foot up at a clip's end, that lift-off comes after the capture point has run out of reach."""
+        ``recovery_double_stance_overrun`` times the operator's usual double stance, or at all behind the feet
+        (``recovery_step_behind_cos``). A character's double stance ends with his next lift-off; where he walks on
+        from a step the character has already landed, or holds a foot up at a clip's end, that lift-off comes after
+        the capture point has run out of reach; and his next step forwards never reaches one behind the feet."""
         cfg = self.cfg
         on_ground = soles_on_ground(state)
         if cfg.recovery_double_stance_overrun <= 0.0 or not cfg.recovery_steps or not on_ground:
@@ -600,9 +601,12 @@ class MotionOptimizer:
             return False
         xi, _ = capture_point(tick.com_c, tick.com_vel_c, self.g)
         quats = {s: state.link_quat_wxyz[_LINK[f"{s}_ankle"]] for s in on_ground}
-        if support_outside_m(xi, tick.a_c, quats, on_ground) <= cfg.recovery_step_margin_m:
+        outside, along = support_outside_along(xi, tick.a_c, quats, on_ground, tick.R_root_d[:2, 0])
+        if outside <= cfg.recovery_step_margin_m:
             self._outside_since_s = None
             return False
+        if cfg.recovery_step_behind_cos is not None and along < -cfg.recovery_step_behind_cos:
+            return True  # behind both feet: no step of his forwards catches it (his steps back, it steps first)
         if self._outside_since_s is None:
             self._outside_since_s = state.time_s
         return state.time_s - self._outside_since_s >= cfg.recovery_double_stance_overrun * self._op_ds_s

@@ -94,8 +94,20 @@ def support_outside_m(xi_world: np.ndarray, ankles_world: dict[str, np.ndarray],
     """Signed distance of a capture point (horizontal) from the support polygon of the soles ``on_ground`` (each at
     its ankle, turned by its foot's orientation): > 0 outside [m]. On plain floats (model/sole.py's ``*_points``):
     it runs on every double-stance tick."""
+    return support_outside_along(xi_world, ankles_world, feet_quat_wxyz, on_ground, (1.0, 0.0))[0]
+
+
+def support_outside_along(xi_world: np.ndarray, ankles_world: dict[str, np.ndarray],
+                          feet_quat_wxyz: dict[str, np.ndarray], on_ground: list[str],
+                          direction_world: tuple[float, float] | np.ndarray) -> tuple[float, float]:
+    """:func:`support_outside_m`, and the cosine between the outward direction (from the polygon's nearest point to
+    the capture point) and a horizontal direction (``direction_world``, (2,), unit) [m, -]; the cosine is 0 inside."""
     corners = [p for s in on_ground for p in sole_points_xy(ankles_world[s], feet_quat_wxyz[s], _SOLE_POINTS)]
-    return outside_distance_points((float(xi_world[0]), float(xi_world[1])), convex_hull_points(corners))[0]
+    x, y = float(xi_world[0]), float(xi_world[1])
+    distance, (nx, ny) = outside_distance_points((x, y), convex_hull_points(corners))
+    if distance <= 0.0:
+        return distance, 0.0
+    return distance, ((x - nx) * float(direction_world[0]) + (y - ny) * float(direction_world[1])) / distance
 
 
 def beyond_sole_towards_m(xi_world: np.ndarray, stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray,
