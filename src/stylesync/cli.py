@@ -461,8 +461,12 @@ def main(argv: list[str] | None = None) -> int:
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     if threading.current_thread() is threading.main_thread():
         # A termination request (kill, a supervisor stopping the run) ends the run as Ctrl-C does: the session
-        # stops, the session file is closed and the viewer process shut down.
+        # stops, the session file is closed and the viewer process shut down. Ctrl-C (SIGINT) ends it whatever the
+        # parent process left: a parent that ignores or blocks SIGINT passes that on to the processes it starts,
+        # and Python then leaves it ignored (a run started so went on pacing its 60 s after a SIGINT).
         signal.signal(signal.SIGTERM, _interrupt)
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT, signal.SIGTERM})
     # Exit codes: 2 for input the parser or a source refuses (options, files, streams, settings); 1 for a failure
     # while running (the simulation, the system refusing a file); 130 when interrupted. --debug keeps tracebacks.
     try:
