@@ -461,9 +461,10 @@ def main(argv: list[str] | None = None) -> int:
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     if threading.current_thread() is threading.main_thread():
         # A termination request (kill, a supervisor stopping the run) ends the run as Ctrl-C does: the session
-        # stops, the session file is closed and the viewer process shut down. Ctrl-C (SIGINT) ends it whatever the
-        # parent process left: a parent that ignores or blocks SIGINT passes that on to the processes it starts,
-        # and Python then leaves it ignored (a run started so went on pacing its 60 s after a SIGINT).
+        # stops, the session file is closed and the viewer process shut down. SIGINT (Ctrl-C) ends it too whatever
+        # its parent left: a shell without job control starts a background command with SIGINT ignored, every
+        # process below it inherits that, and Python then leaves it ignored (a realtime demo started under such a
+        # command went on pacing its 60 s after a SIGINT).
         signal.signal(signal.SIGTERM, _interrupt)
         signal.signal(signal.SIGINT, signal.default_int_handler)
         signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT, signal.SIGTERM})
