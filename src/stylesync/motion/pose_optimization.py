@@ -729,20 +729,19 @@ class MotionOptimizer:
             # tracking error, and lands on its sole rather than an edge it would roll over.
             shank = state.link_quat_wxyz[_LINK[f"{side}_knee"]] if side == sw else ik.shank_quat_wxyz
             q_ankle_ik = rot.multiply(rot.conjugate(shank), q_foot)
-            if not cfg.foot_yaw_control:
-                # The twist about the shank's long axis left where it is.
-                swing_ik, _ = rot.swing_twist(q_ankle_ik, _UP)
-                _, twist = rot.swing_twist(canonical_quat_from_model(q_cur[JOINT_NAMES.index(f"{side}_ankle")]), _UP)
-                local[f"{side}_ankle"] = rot.multiply(swing_ik, twist)
-            elif side == sw:
+            if cfg.foot_yaw_control and side == sw:
                 local[f"{side}_ankle"] = q_ankle_ik  # the swing foot turns to its yaw about the actual shank
+                continue
+            # A planted foot's twist about the shank's long axis is the one that gives its yaw about the actual
+            # shank (about the IK's, the difference between the two shanks' twists would turn it against its sole's
+            # friction); without foot_yaw_control every foot's twist is left where it is.
+            if cfg.foot_yaw_control:
+                twist_of = rot.multiply(rot.conjugate(state.link_quat_wxyz[_LINK[f"{side}_knee"]]), q_foot)
             else:
-                # A planted foot's twist is the one that gives its yaw about the actual shank: about the IK's, the
-                # difference between the two shanks' twists would turn the foot against its sole's friction.
-                swing_ik, _ = rot.swing_twist(q_ankle_ik, _UP)
-                on_shank = rot.multiply(rot.conjugate(state.link_quat_wxyz[_LINK[f"{side}_knee"]]), q_foot)
-                _, twist = rot.swing_twist(on_shank, _UP)
-                local[f"{side}_ankle"] = rot.multiply(swing_ik, twist)
+                twist_of = canonical_quat_from_model(q_cur[JOINT_NAMES.index(f"{side}_ankle")])
+            swing_ik, _ = rot.swing_twist(q_ankle_ik, _UP)
+            _, twist = rot.swing_twist(twist_of, _UP)
+            local[f"{side}_ankle"] = rot.multiply(swing_ik, twist)
         return local, knee_angle
 
     # ---- 5. upper body (joint map) -----------------------------------------------------------------------------
