@@ -140,9 +140,11 @@ PELVIS_LEVEL = ControlConfig(whole_body=WholeBodyConfig(single_stance_pelvis_sha
 # ... and the motion stage's balance layer as it was then: recovery steps of 0.6 leg lengths, and a swing the
 # operator stops on not yet landed at once (with either, several of the traced falls come later or not at all).
 TRACED_MOTION = {"recovery_step_reach_share": 0.6, "recovery_on_stopping_step": False,
-                 "recovery_double_stance_overrun": 0.0, "liftoff_capture_behind_m": None, "foot_yaw_control": False}
-# The scenarios traced before MotionConfig.foot_yaw_control run with the feet's twist left where it was.
-TWIST_FREE = {"foot_yaw_control": False}
+                 "recovery_double_stance_overrun": 0.0, "liftoff_capture_behind_m": None, "foot_yaw_control": False,
+                 "liftoff_shift_tolerance_m": None}
+# The scenarios traced before MotionConfig.foot_yaw_control run with the feet's twist left where it was (and the
+# weight shift from standing as it was then).
+TWIST_FREE = {"foot_yaw_control": False, "liftoff_shift_tolerance_m": None}
 
 
 def _run(spec: str, seconds: float, motion: MotionConfig, seed: int = 0, control: ControlConfig | None = None):
@@ -396,6 +398,19 @@ def test_a_step_from_standing_waits_for_the_weight_to_shift():
     assert not default.fell or (default.fall_time_s is not None and default.fall_time_s > 3.0)
     assert at_once.fell and at_once.fall_time_s is not None and at_once.fall_time_s < 2.1
     assert not shifted.fell or (shifted.fall_time_s is not None and shifted.fall_time_s > 2.5)
+
+
+def test_a_kick_waits_until_the_weight_is_as_far_over_the_stance_foot_as_the_operators():
+    """The built-in kick in place, seed 0: the operator stands, shifts his weight over his left foot and kicks with
+    his right. Lifting the foot once its capture point was within 2 cm of the inner edge of its left sole (its COM
+    still 9 cm inwards of the ankle), the character fell towards the kicking side at 2.4 s. Waiting (at most
+    ``liftoff_weight_shift_s``) until its capture point is as far over the stance foot as his, scaled, it kicks and
+    stands through 5 s."""
+    spec = "deepmimic:kick"
+    matched, _ = _run(spec, 5.0, MotionConfig())
+    edge_only, _ = _run(spec, 5.0, MotionConfig(liftoff_shift_tolerance_m=None))
+    assert not matched.fell
+    assert edge_only.fell and edge_only.fall_time_s is not None and edge_only.fall_time_s < 3.0
 
 
 @pytest.mark.skipif(not (MOCAP / "deepmimic" / "humanoid3d_stealthy_walk.txt").exists(),

@@ -124,12 +124,16 @@ class MotionConfig:
     # over the ground (about twice the distance on the walk set) but falls more often (docs/decisions.md).
     reference_follows_operator_s: float = 0.0
     # Weight shift before a lift-off from standing (pose_optimization._can_lift): the operator lifts a foot after a
-    # double stance of at least liftoff_after_stand_s [s] with his capture point over his other sole; while the
-    # character's is further than liftoff_margin_m [m] inwards of its own other sole, the foot stays down, at most
-    # liftoff_weight_shift_s [s] (0: off), and the COM target on his stance foot moves the weight over.
+    # double stance of at least liftoff_after_stand_s [s] with his capture point over his other sole (within
+    # liftoff_margin_m [m] of its inner edge, sideways); while the character's is further inwards of its own other
+    # sole than his is of his (scaled, Eq. 9; never further out than the ankle) by more than
+    # liftoff_shift_tolerance_m [m], the foot stays down, at most liftoff_weight_shift_s [s] (0: off), and the COM
+    # target on his stance foot moves the weight over. liftoff_shift_tolerance_m None: the character's capture point
+    # need only be within liftoff_margin_m of its sole's inner edge, whatever his weight shift.
     liftoff_weight_shift_s: float = 0.25
     liftoff_after_stand_s: float = 0.3
     liftoff_margin_m: float = 0.02
+    liftoff_shift_tolerance_m: float | None = 0.01
     # Any lift-off, from standing or in a walk (pose_optimization._can_lift): a foot that bears weight waits, as
     # above, while the character's capture point is further than this outside its other sole towards the lifting
     # foot. Standing on that sole alone, the body could only fall back onto the foot it lifts [m] (None: off).
@@ -231,6 +235,8 @@ class MotionConfig:
         _non_negative("MotionConfig.reference_follows_operator_s", self.reference_follows_operator_s)
         for n in ("liftoff_weight_shift_s", "liftoff_after_stand_s", "liftoff_margin_m"):
             _non_negative(f"MotionConfig.{n}", getattr(self, n))
+        if self.liftoff_shift_tolerance_m is not None:
+            _non_negative("MotionConfig.liftoff_shift_tolerance_m", self.liftoff_shift_tolerance_m)
         if self.liftoff_capture_behind_m is not None:
             _non_negative("MotionConfig.liftoff_capture_behind_m", self.liftoff_capture_behind_m)
         _non_negative("MotionConfig.stance_hysteresis_m", self.stance_hysteresis_m)
