@@ -400,12 +400,12 @@ def test_a_step_from_standing_waits_for_the_weight_to_shift():
     assert not shifted.fell or (shifted.fall_time_s is not None and shifted.fall_time_s > 2.5)
 
 
-def test_a_kick_waits_until_the_weight_is_as_far_over_the_stance_foot_as_the_operators():
-    """The built-in kick in place, seed 0: the operator stands, shifts his weight over his left foot and kicks with
-    his right. Lifting the foot once its capture point was within 2 cm of the inner edge of its left sole (its COM
-    still 9 cm inwards of the ankle), the character fell towards the kicking side at 2.4 s. Waiting (at most
-    ``liftoff_weight_shift_s``) until its capture point is as far over the stance foot as his, scaled, it kicks and
-    stands through 5 s."""
+def test_a_kick_waits_until_the_weight_is_over_the_stance_ankle_as_the_operators():
+    """The built-in kick in place, seed 0: the operator stands, shifts his weight over his left foot (his capture
+    point over his ankle) and kicks with his right. Lifting the foot once its capture point was within 2 cm of the
+    inner edge of its left sole (its COM still 9 cm inwards of the ankle), the character fell towards the kicking
+    side at 2.4 s. Waiting (at most ``liftoff_weight_shift_s``) until its capture point is within 1 cm of its stance
+    ankle, it kicks and stands through 5 s."""
     spec = "deepmimic:kick"
     matched, _ = _run(spec, 5.0, MotionConfig())
     edge_only, _ = _run(spec, 5.0, MotionConfig(liftoff_shift_tolerance_m=None))

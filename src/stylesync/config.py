@@ -125,11 +125,11 @@ class MotionConfig:
     reference_follows_operator_s: float = 0.0
     # Weight shift before a lift-off from standing (pose_optimization._can_lift): the operator lifts a foot after a
     # double stance of at least liftoff_after_stand_s [s] with his capture point over his other sole (within
-    # liftoff_margin_m [m] of its inner edge, sideways); while the character's is further inwards of its own other
-    # sole than his is of his (scaled, Eq. 9; never further out than the ankle) by more than
-    # liftoff_shift_tolerance_m [m], the foot stays down, at most liftoff_weight_shift_s [s] (0: off), and the COM
-    # target on his stance foot moves the weight over. liftoff_shift_tolerance_m None: the character's capture point
-    # need only be within liftoff_margin_m of its sole's inner edge, whatever his weight shift.
+    # liftoff_margin_m [m] of its inner edge, sideways); while the character's is further than that inwards of its
+    # own other sole, or, where his is over or beyond his stance ankle (all his weight on it: a kick, a pose on one
+    # leg), further than liftoff_shift_tolerance_m [m] inwards of its stance ankle, the foot stays down, at most
+    # liftoff_weight_shift_s [s] (0: off), and the COM target on his stance foot moves the weight over.
+    # liftoff_shift_tolerance_m None: the sole's inner edge whatever his weight shift.
     liftoff_weight_shift_s: float = 0.25
     liftoff_after_stand_s: float = 0.3
     liftoff_margin_m: float = 0.02

@@ -264,9 +264,9 @@ class MotionOptimizer:
         * A lift-off after standing: a foot may not when the operator lifts it after a double stance of at least
           ``liftoff_after_stand_s`` (a step or a kick from standing, not a walk's double stance) with his capture
           point over his other sole, sideways (within ``liftoff_margin_m`` of its inner edge, his sole the
-          character's scaled to him), while the character's capture point is further inwards of its own other
-          sole than his of his, scaled, by more than ``liftoff_shift_tolerance_m`` (never asked beyond the ankle):
-          as far over the stance foot as he is before a kick, which his capture point leaves as he kicks."""
+          character's scaled to him), while the character's capture point is further than that inwards of its own
+          other sole; where his is over or beyond his stance ankle (his weight on that foot: a kick, a pose on one
+          leg), while the character's is further inwards of its stance ankle than ``liftoff_shift_tolerance_m``."""
         cfg = self.cfg
         if cfg.liftoff_weight_shift_s <= 0.0:
             return None
@@ -294,9 +294,10 @@ class MotionOptimizer:
                 yaw_h = rot.twist_angle(sample.quat[f"ANKLE_{_SIDE_UP[stance]}"], _UP)
                 inward_h = scale * _inward_m(xi_h, ankle_h, yaw_h, stance)
                 he_stands_on_it = inward_h <= edge
-                # As far over the stance foot as he is, or within the margin of the inner edge
-                shifted = (edge if cfg.liftoff_shift_tolerance_m is None
-                           else max(inward_h, 0.0) + cfg.liftoff_shift_tolerance_m)
+                # Over the stance ankle where he has his weight over his (a kick, a pose on one leg); otherwise
+                # within the margin of the sole's inner edge
+                shifted = (edge if cfg.liftoff_shift_tolerance_m is None or inward_h > 0.0
+                           else cfg.liftoff_shift_tolerance_m)
                 may = may and (not he_stands_on_it or _inward_m(xi, ankle, rot.twist_angle(foot_q, _UP), stance)
                                <= shifted)
             can[side] = may
