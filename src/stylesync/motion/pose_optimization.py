@@ -293,13 +293,12 @@ class MotionOptimizer:
                 ankle_h = sample.pos[f"ANKLE_{_SIDE_UP[stance]}"]
                 yaw_h = rot.twist_angle(sample.quat[f"ANKLE_{_SIDE_UP[stance]}"], _UP)
                 inward_h = scale * _inward_m(xi_h, ankle_h, yaw_h, stance)
-                he_stands_on_it = inward_h <= edge
-                # Over the stance ankle where he has his weight over his (a kick, a pose on one leg); otherwise
-                # within the margin of the sole's inner edge
-                shifted = (edge if cfg.liftoff_shift_tolerance_m is None or inward_h > 0.0
-                           else cfg.liftoff_shift_tolerance_m)
-                may = may and (not he_stands_on_it or _inward_m(xi, ankle, rot.twist_angle(foot_q, _UP), stance)
-                               <= shifted)
+                if inward_h <= edge:  # he stands on that foot
+                    # Over the stance ankle where his weight is over his (a kick, a pose on one leg); otherwise
+                    # within the margin of the sole's inner edge
+                    limit = (edge if cfg.liftoff_shift_tolerance_m is None or inward_h > 0.0
+                             else cfg.liftoff_shift_tolerance_m)
+                    may = may and _inward_m(xi, ankle, rot.twist_angle(foot_q, _UP), stance) <= limit
             can[side] = may
         return can
 
