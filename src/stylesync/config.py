@@ -205,6 +205,11 @@ class MotionConfig:
     # landing from where the hip is (a landing at the leg's full reach otherwise hovers above the ground while the
     # body runs on)
     recovery_landing_reach: bool = True
+    # A recovery step's landing is planned on the capture point of the body with the swing leg carried along by the
+    # pelvis (MassProperties.com_velocity_carried): the leg's own swing moves the whole body's capture point with
+    # the foot, and the ground stops that motion when the foot lands. Planned on the whole body's, the landing
+    # chased the capture point its own swing moved outwards (docs/decisions.md, "Recovery steps that land")
+    recovery_landing_without_swing: bool = True
     # The COM target asks for no capture point outside the soles the character stands on, each shrunk to this share
     # of its length and width about its centre, in double stance, and in single stance while the operator balances
     # over his stance sole (motion/capture_bound.py; 0: off) [-]
@@ -303,6 +308,13 @@ class WholeBodyConfig:
     hand_task_kp: float = 100.0
     hand_task_kd: float = 20.0
     hand_task_weight: float = 100.0
+    # The swing ankle of a step the character takes on its own (motion/recovery_step.py) follows its target in world
+    # space (a task, ReferencePose.recovery_ankle_world): through the joint posture alone it trailed its target by
+    # 0.2-0.3 m at mid-swing and landed 0.1 s late, short of the capture point (docs/decisions.md, "Recovery steps
+    # that land"; weight 0: off) [1/s², 1/s, -]
+    recovery_foot_task_kp: float = 400.0
+    recovery_foot_task_kd: float = 40.0
+    recovery_foot_task_weight: float = 100.0
     # The posture task's weight on the hip, knee and ankle of each supporting leg, as a share of its weight elsewhere.
     # A supporting leg closes a chain through the ground: its joint angles are where the pelvis is over the foot,
     # which the momentum task (the COM), the pelvis height and the pelvis orientation already ask for. At full weight
@@ -321,7 +333,8 @@ class WholeBodyConfig:
             _positive(f"WholeBodyConfig.{n}", getattr(self, n))
         for n in ("momentum_com_kp", "momentum_com_kd", "momentum_root_kp", "momentum_root_kd",
                   "contact_velocity_gain", "sole_contact_gap_m", "joint_tracking_weight", "hand_task_kp",
-                  "hand_task_kd", "hand_task_weight", "stance_leg_tracking_share", "single_stance_pelvis_share"):
+                  "hand_task_kd", "hand_task_weight", "stance_leg_tracking_share", "single_stance_pelvis_share",
+                  "recovery_foot_task_kp", "recovery_foot_task_kd", "recovery_foot_task_weight"):
             _non_negative(f"WholeBodyConfig.{n}", getattr(self, n))
 
 

@@ -9,7 +9,8 @@ The same parts as the paper's controller (controller.py), composed as tasks of o
   tracking law, ControlConfig.momentum_com_kp/kd, docs/decisions.md), the pelvis height of Eq. 9 vertically, the
   LIPM time-sync force (Eq. 21-23, bounded by Eq. 26), and the root virtual torque (Eq. 16, second line);
 * a stance foot that has not touched down yet (or a swing foot held for a late contact, Sec. 5.1) pressed onto the
-  ground; optionally the hands following the operator's hands (ControlConfig.hand_tasks);
+  ground; the swing ankle of a recovery step (motion/recovery_step.py) following its target in world space;
+  optionally the hands following the operator's hands (ControlConfig.hand_tasks);
 * sole contacts (contacts.py): the ground forces the soles can pass, found with the accelerations, replace the
   Jacobian-transpose mapping of Eq. 17-18 and the IPM ankle torque of Eq. 20 (a centre of pressure is placed,
   not implied); gravity compensation (Eq. 14-15) is in the equations of motion, with the feet's reactions.
@@ -112,6 +113,12 @@ class WholeBodyController(ControllerBase):
         self.hands = ({s: f.add_task(FramePositionTask(f"{s}_hand", HAND_FRAMES[s], wb.hand_task_kp,
                                                        wb.hand_task_kd, wb.hand_task_weight)) for s in SIDES}
                       if wb.hand_tasks else {})
+        # The swing ankle of the character's own step follows its target (weight 0: no task)
+        self.recovery_feet = ({s: f.add_task(FramePositionTask(f"{s}_recovery_foot", f"{s}_ankle",
+                                                               wb.recovery_foot_task_kp, wb.recovery_foot_task_kd,
+                                                               wb.recovery_foot_task_weight)) for s in SIDES}
+                              if wb.recovery_foot_task_weight > 0 else {})
+        self._recovery_target: dict[str, np.ndarray] = {}  # the last tick's recovery-step ankle targets [m]
         self._arm_length_m = model.rest_distance("left_shoulder", "left_elbow") + model.rest_distance(
             "left_elbow", "left_wrist")
         self._hand_target: dict[str, np.ndarray] = {}  # the last tick's hand targets [m]
@@ -182,6 +189,16 @@ class WholeBodyController(ControllerBase):
         for s, task in self.foot_press.items():
             ws = ref.stance_weight[s]
             task.active = (ws > 0 and w[s] <= 0) or (ref.press_swing_foot and s == swing)
+        for s, task in self.recovery_feet.items():
+            target = None if ref.recovery_ankle_world is None else ref.recovery_ankle_world.get(s)
+            task.active = target is not None
+            if target is None:
+                self._recovery_target.pop(s, None)
+                continue
+            previous = self._recovery_target.get(s)
+            # The target's velocity from successive ticks (none on the step's first tick)
+            task.target_vel_world = (target - previous) / self.control_dt_s if previous is not None else np.zeros(3)
+            task.target_world = self._recovery_target[s] = target
         for s, task in self.hands.items():
             task.active = ref.hand_world is not None
             if ref.hand_world is not None:

@@ -64,6 +64,12 @@ class MassProperties:
     def com_velocity(self, state: CharacterState) -> np.ndarray:
         return self._weights @ state.link_com_vel_world
 
+    def com_velocity_carried(self, state: CharacterState, links: tuple[int, ...], carrier: int) -> np.ndarray:
+        """Whole-body COM velocity [m/s] (world) with the ``links`` (indices into LINK_NAMES) moving as the link
+        ``carrier`` does: their own motion relative to it left out."""
+        vel = state.link_com_vel_world
+        return self._weights @ vel + self._weights[list(links)] @ (vel[carrier] - vel[list(links)])
+
 
 @dataclass
 class JointFeedback:

@@ -82,6 +82,8 @@ _VELOCITY_SMOOTHING = 0.2  # per tick, exponential average of the desired COM ve
 _SIDE_UP = {"left": "LEFT", "right": "RIGHT"}
 _OTHER_SIDE = {"left": "right", "right": "left"}
 _LINK = {n: i for i, n in enumerate(LINK_NAMES)}
+_ROOT_LINK = _LINK["root"]
+_LEG_LINKS = {s: tuple(_LINK[f"{s}_{j}"] for j in ("hip", "knee", "ankle")) for s in ("left", "right")}
 CHAR_LEG_LENGTH_M = THIGH_LENGTH_M + SHANK_LENGTH_M
 OPERATOR_VELOCITY_SETTLE_S = 0.2  # the operator's filtered COM velocity is taken as settled from then on [s]
 HEEL_AHEAD_OF_ANKLE_M = FOOT_CENTER_AHEAD_OF_ANKLE_M - FOOT_LENGTH_M / 2  # < 0: the heel is behind the ankle [m]
@@ -246,7 +248,7 @@ class MotionOptimizer:
             analysis = analyse_operator(sample)
         tick = self._track_stance(sample, state, analysis, mass)
         self._retarget_lower_body(tick, state, mass)
-        self._plan_feet(tick, state)
+        self._plan_feet(tick, state, mass)
         local, hinge = self._solve_legs(tick, state)
         self._map_upper_body(tick, local, hinge)
         return self._reference(tick, state, local, hinge)
@@ -443,7 +445,7 @@ class MotionOptimizer:
         tick.com_vel_h = self._com_h_rate(com_h)
 
     # ---- 3. foot targets: planted feet, swing-foot planning (Eq. 28) -----------------------------------------
-    def _plan_feet(self, tick: _Tick, state: CharacterState) -> None:
+    def _plan_feet(self, tick: _Tick, state: CharacterState, mass: MassProperties) -> None:
         """A planted foot where it is, the swing foot where the operator's is (or where a recovery step lands); the
         pelvis lowered as far as a foot that must land needs."""
         self._recovery_step(tick, state)
@@ -453,8 +455,10 @@ class MotionOptimizer:
         for side in ("left", "right"):
             if side == sw and self.char_fsm.recovery_step:
                 other = _OTHER_SIDE[side]
+                com_vel = (mass.com_velocity_carried(state, _LEG_LINKS[side], _ROOT_LINK)
+                           if self.cfg.recovery_landing_without_swing else tick.com_vel_c)
                 tick.targets[side] = self.recovery.swing_target(
-                    state.time_s, tick.com_c, tick.com_vel_c, tick.a_c[other],
+                    state.time_s, tick.com_c, com_vel, tick.a_c[other],
                     state.link_quat_wxyz[_LINK[f"{other}_ankle"]], tick.R_root_d)
                 tick.foot_yaw[side] = (float(np.arctan2(tick.R_root_d[1, 0], tick.R_root_d[0, 0]))
                                        if self.cfg.foot_yaw_control  # along the heading, as its landing is planned
@@ -786,6 +790,8 @@ class MotionOptimizer:
             time_s=state.time_s, joint_pos=joint_pos, root_quat_wxyz=tick.q_root_d, pelvis_world=tick.pelvis_d,
             com_world=com_d, com_vel_world=com_vel_d, character_stance=tick.ch_state, stance_weight=tick.weights,
             ankle_world=tick.a_c, lipm=lipm, press_swing_foot=self.char_fsm.hold_reference, hand_world=hands,
+            recovery_ankle_world=({tick.swing: tick.targets[tick.swing].copy()}
+                                  if tick.swing is not None and self.char_fsm.recovery_step else None),
         )
 
     @staticmethod
