@@ -19,12 +19,15 @@ own:
 * the landing is planned each tick where ξ will be when the foot lands: with the centre of pressure held at the
   stance sole's point nearest ξ, ``ξ(t + τ) = p + (ξ(t) - p) e^(ω τ)``, τ the swing time left; the sole is placed
   with its trailing edge there (trailing along ξ's direction of divergence from p), so that every centre of
-  pressure on the new sole drives ξ back;
+  pressure on the new sole drives ξ back; ξ is the body's with the swing leg carried by the pelvis
+  (``MotionConfig.recovery_landing_without_swing``): the leg's own swing, which the ground stops at the landing,
+  would otherwise move the landing with the foot;
 * within the leg's reach (``MotionConfig.recovery_step_reach_share`` of its length from the stance ankle) and
   never across the stance foot (at least ``MIN_FOOT_SEPARATION_M`` outwards of it, in the heading frame);
 * the foot rises ``recovery_step_height_m`` at mid-swing, follows a smooth step from its lift-off point to the
   landing, and after ``recovery_swing_s`` is lowered below the ground until it touches (the stance FSM ends the
-  step on its contact).
+  step on its contact); the whole-body controller tracks that target with a task of its own
+  (``ReferencePose.recovery_ankle_world``).
 
 The step's timing is the nominal swing time; its position is what adapts, each tick, to the capture point. A
 swing of the operator's that he holds up too long while the character cannot stand on one foot is taken over by
