@@ -133,18 +133,21 @@ def test_the_fsm_keeps_a_recovery_step_until_its_foot_lands():
 # (before WholeBodyConfig.stance_leg_tracking_share and single_stance_pelvis_share). Each scenario is one clip and
 # seed on which a feature decides a fall; a change of the controller changes which runs fall, so the feature is
 # tested where its effect was traced, and the default controller where the test says "default".
-TRACED = ControlConfig(whole_body=WholeBodyConfig(stance_leg_tracking_share=1.0, single_stance_pelvis_share=1.0))
-# The default controller before WholeBodyConfig.single_stance_pelvis_share, which the scenarios of the stopping
-# step and the overdue double stance were traced with.
-PELVIS_LEVEL = ControlConfig(whole_body=WholeBodyConfig(single_stance_pelvis_share=1.0))
+TRACED = ControlConfig(whole_body=WholeBodyConfig(stance_leg_tracking_share=1.0, single_stance_pelvis_share=1.0,
+                                                   recovery_foot_task_weight=0.0))
+# The default controller before WholeBodyConfig.single_stance_pelvis_share (and the recovery foot task), which
+# the scenarios of the stopping step and the overdue double stance were traced with.
+PELVIS_LEVEL = ControlConfig(whole_body=WholeBodyConfig(single_stance_pelvis_share=1.0, recovery_foot_task_weight=0.0))
 # ... and the motion stage's balance layer as it was then: recovery steps of 0.6 leg lengths, and a swing the
 # operator stops on not yet landed at once (with either, several of the traced falls come later or not at all).
 TRACED_MOTION = {"recovery_step_reach_share": 0.6, "recovery_on_stopping_step": False,
                  "recovery_double_stance_overrun": 0.0, "liftoff_capture_behind_m": None, "foot_yaw_control": False,
-                 "liftoff_shift_tolerance_m": None}
+                 "liftoff_shift_tolerance_m": None, "recovery_landing_without_swing": False}
 # The scenarios traced before MotionConfig.foot_yaw_control run with the feet's twist left where it was (and the
-# weight shift from standing as it was then).
-TWIST_FREE = {"foot_yaw_control": False, "liftoff_shift_tolerance_m": None}
+# weight shift from standing and the recovery steps' landing as they were then; with the controller, the recovery
+# foot task off: NO_FOOT_TASK).
+NO_FOOT_TASK = ControlConfig(whole_body=WholeBodyConfig(recovery_foot_task_weight=0.0))
+TWIST_FREE = {"foot_yaw_control": False, "liftoff_shift_tolerance_m": None, "recovery_landing_without_swing": False}
 
 
 def _run(spec: str, seconds: float, motion: MotionConfig, seed: int = 0, control: ControlConfig | None = None):
@@ -405,12 +408,16 @@ def test_a_kick_waits_until_the_weight_is_over_the_stance_ankle_as_the_operators
     point over his ankle) and kicks with his right. Lifting the foot once its capture point was within 2 cm of the
     inner edge of its left sole (its COM still 9 cm inwards of the ankle), the character fell towards the kicking
     side at 2.4 s. Waiting (at most ``liftoff_weight_shift_s``) until its capture point is within 1 cm of its stance
-    ankle, it kicks and stands through 5 s."""
+    ankle, it kicks and stands through 5 s. (With the recovery steps that land, the early lift-off's fall comes later,
+    at 3.8 s, against 2.4 s before.)"""
     spec = "deepmimic:kick"
     matched, _ = _run(spec, 5.0, MotionConfig())
     edge_only, _ = _run(spec, 5.0, MotionConfig(liftoff_shift_tolerance_m=None))
     assert not matched.fell
-    assert edge_only.fell and edge_only.fall_time_s is not None and edge_only.fall_time_s < 3.0
+    assert edge_only.fell
+    early, _ = _run(spec, 5.0, MotionConfig(liftoff_shift_tolerance_m=None, recovery_landing_without_swing=False),
+                    control=NO_FOOT_TASK)
+    assert early.fell and early.fall_time_s is not None and early.fall_time_s < 3.0
 
 
 @pytest.mark.skipif(not (MOCAP / "deepmimic" / "humanoid3d_stealthy_walk.txt").exists(),
@@ -493,6 +500,7 @@ def test_a_character_waiting_with_its_step_counted_may_still_step_on_its_own():
         opened = open_source(spec, seed=2, duration_s=5.4)
         cfg = SessionConfig(duration_s=5.4, seed=2,
                             motion=MotionConfig(**TWIST_FREE, recovery_while_step_counted=allowed),
+                            control=NO_FOOT_TASK,
                             clocks=dataclasses.replace(SessionConfig().clocks, mocap_hz=opened.mocap_hz))
         session = Session(cfg, opened.source)
         steps: list[float] = []
@@ -560,11 +568,14 @@ def test_a_capture_point_behind_both_feet_steps_back_at_once():
     """CMU-dev 10_04, seed 0: a stopping step landed the character's feet side by side with its COM 9 cm behind them
     (1.57 s); the operator walks on forwards. Its capture point ran out behind both feet while it waited for his
     next lift-off and then for the double stance to be overdue (the step back began at 2.08 s, 0.38 m out), and it fell
-    backwards in the clip (2.72 s). Stepping back as soon as the capture point is behind, it walks on."""
+    backwards in the clip (2.72 s). Stepping back as soon as the capture point is behind, it walks on. (Traced with
+    the recovery steps' landing and swing foot as they were then: with the recovery foot task and the carried capture
+    point, the waiting character does not fall either.)"""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '10_04.bvh'}"
-    at_once, session = _run(spec, 4.0, MotionConfig())
+    then = {"recovery_landing_without_swing": False}
+    at_once, session = _run(spec, 4.0, MotionConfig(**then), control=NO_FOOT_TASK)
     assert not at_once.fell
-    waiting, _ = _run(spec, 4.0, MotionConfig(recovery_step_behind_cos=None))
+    waiting, _ = _run(spec, 4.0, MotionConfig(**then, recovery_step_behind_cos=None), control=NO_FOOT_TASK)
     assert waiting.fell and waiting.fall_time_s is not None and waiting.fall_time_s < 3.0
 
 
@@ -606,8 +617,6 @@ def _suite_run(spec: str, seed: int, motion: MotionConfig, control: ControlConfi
     return result
 
 
-_NO_FOOT_TASK = ControlConfig(whole_body=WholeBodyConfig(recovery_foot_task_weight=0.0))
-
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "09_06.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/09_06.bvh is not available")
@@ -634,7 +643,7 @@ def test_the_swing_foot_of_a_recovery_step_follows_its_target():
         assert len(gaps) > 10
         return float(np.mean(gaps))
 
-    with_task, without = lag(ControlConfig()), lag(_NO_FOOT_TASK)
+    with_task, without = lag(ControlConfig()), lag(NO_FOOT_TASK)
     assert without > 0.1
     assert with_task < 0.7 * without  # measured: 0.08 m against 0.13 m (mean), 0.15 against 0.26 (max)
 
@@ -650,5 +659,5 @@ def test_recovery_steps_that_land_where_the_body_will_be_keep_a_walk_on_rough_gr
     joint posture alone and its landing planned on the capture point its own swing moved (measured)."""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '03_02.bvh'}"
     assert not _suite_run(spec, 1, MotionConfig(), ControlConfig()).fell
-    old = _suite_run(spec, 1, MotionConfig(recovery_landing_without_swing=False), _NO_FOOT_TASK)
+    old = _suite_run(spec, 1, MotionConfig(recovery_landing_without_swing=False), NO_FOOT_TASK)
     assert old.fell
