@@ -25,6 +25,7 @@ from stylesync.errors import SourceError
 from stylesync.model.character import (
     ANKLE_HEIGHT_M,
     CHARACTER_LINKS,
+    LEG_LINKS,
     LINK_NAMES,
     OPERATOR_JOINTS,
     STANDING_ROOT_HEIGHT_M,
@@ -61,7 +62,7 @@ def _all_tracked(frame: OperatorFrame) -> bool:
     return bool(np.all(cq > 0) and np.all(cp > 0))
 _LINK = {n: i for i, n in enumerate(LINK_NAMES)}
 # Hip, knee and ankle links of the left and the right leg, (2, 3).
-_LEG_LINKS = np.array([[_LINK[f"{s}_{j}"] for j in ("hip", "knee", "ankle")] for s in ("left", "right")])
+_LEG_LINKS = np.array([LEG_LINKS[s] for s in ("left", "right")])
 STANCE_CODE = {Stance.LS: 0, Stance.DS: 1, Stance.RS: 2}
 
 

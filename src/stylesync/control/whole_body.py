@@ -195,10 +195,7 @@ class WholeBodyController(ControllerBase):
             if target is None:
                 self._recovery_target.pop(s, None)
                 continue
-            previous = self._recovery_target.get(s)
-            # The target's velocity from successive ticks (none on the step's first tick)
-            task.target_vel_world = (target - previous) / self.control_dt_s if previous is not None else np.zeros(3)
-            task.target_world = self._recovery_target[s] = target
+            self._move_target(task, self._recovery_target, s, target, np.zeros(3))  # at rest on the step's first tick
         for s, task in self.hands.items():
             task.active = ref.hand_world is not None
             if ref.hand_world is not None:
@@ -209,10 +206,7 @@ class WholeBodyController(ControllerBase):
                 dist = float(np.linalg.norm(offset))
                 reach = HAND_REACH_SHARE * self._arm_length_m
                 target = shoulder + offset * min(1.0, reach / max(dist, 1e-9))
-                previous = self._hand_target.get(s)
-                task.target_vel_world = ((target - previous) / self.control_dt_s if previous is not None
-                                         else state.root_lin_vel_world)
-                task.target_world = self._hand_target[s] = target
+                self._move_target(task, self._hand_target, s, target, state.root_lin_vel_world)
 
         # The supporting legs' posture weighs stance_leg_tracking_share of the rest's (WholeBodyConfig): their joint
         # angles are where the pelvis is over the feet, which the momentum and pelvis tasks already ask for.
@@ -226,6 +220,14 @@ class WholeBodyController(ControllerBase):
         tau[~IS_BALL, 1:] = 0.0
         self._tau = Torques(np.minimum(np.maximum(tau, -TORQUE_LIMIT), TORQUE_LIMIT))
         self.telemetry = ControlTelemetry(force, f_lipm, moment)
+
+    def _move_target(self, task: FramePositionTask, last: dict[str, np.ndarray], side: str, target: np.ndarray,
+                     first_vel_world: np.ndarray) -> None:
+        """Set a frame task's target [m] and its velocity from the last tick's (``last[side]``, then updated) [m/s];
+        ``first_vel_world`` when there is none."""
+        previous = last.get(side)
+        task.target_vel_world = (target - previous) / self.control_dt_s if previous is not None else first_vel_world
+        task.target_world = last[side] = target
 
     def torques(self, fb: JointFeedback | None) -> Torques:
         return self._tau

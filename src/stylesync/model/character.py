@@ -72,6 +72,9 @@ LINK_NAMES: tuple[str, ...] = (
     "root", "chest", "neck", "right_hip", "right_knee", "right_ankle", "right_shoulder", "right_elbow",
     "right_wrist", "left_hip", "left_knee", "left_ankle", "left_shoulder", "left_elbow", "left_wrist",
 )
+# Each leg's hip, knee and ankle links (indices into LINK_NAMES)
+LEG_LINKS: dict[str, tuple[int, int, int]] = {s: (LINK_NAMES.index(f"{s}_hip"), LINK_NAMES.index(f"{s}_knee"),
+                                                  LINK_NAMES.index(f"{s}_ankle")) for s in ("left", "right")}
 LINK_PARENT: dict[str, str | None] = {
     "root": None, "chest": "root", "neck": "chest", "right_hip": "root", "right_knee": "right_hip",
     "right_ankle": "right_knee", "right_shoulder": "chest", "right_elbow": "right_shoulder",

@@ -31,6 +31,7 @@ from stylesync.model.character import (
     HIP_HALF_WIDTH_M,
     JOINT_NAMES,
     JOINTS,
+    LEG_LINKS,
     LINK_NAMES,
     SHANK_LENGTH_M,
     THIGH_LENGTH_M,
@@ -83,7 +84,6 @@ _SIDE_UP = {"left": "LEFT", "right": "RIGHT"}
 _OTHER_SIDE = {"left": "right", "right": "left"}
 _LINK = {n: i for i, n in enumerate(LINK_NAMES)}
 _ROOT_LINK = _LINK["root"]
-_LEG_LINKS = {s: tuple(_LINK[f"{s}_{j}"] for j in ("hip", "knee", "ankle")) for s in ("left", "right")}
 CHAR_LEG_LENGTH_M = THIGH_LENGTH_M + SHANK_LENGTH_M
 OPERATOR_VELOCITY_SETTLE_S = 0.2  # the operator's filtered COM velocity is taken as settled from then on [s]
 HEEL_AHEAD_OF_ANKLE_M = FOOT_CENTER_AHEAD_OF_ANKLE_M - FOOT_LENGTH_M / 2  # < 0: the heel is behind the ankle [m]
@@ -455,7 +455,7 @@ class MotionOptimizer:
         for side in ("left", "right"):
             if side == sw and self.char_fsm.recovery_step:
                 other = _OTHER_SIDE[side]
-                com_vel = (mass.com_velocity_carried(state, _LEG_LINKS[side], _ROOT_LINK)
+                com_vel = (mass.com_velocity_carried(state, LEG_LINKS[side], _ROOT_LINK)
                            if self.cfg.recovery_landing_without_swing else tick.com_vel_c)
                 tick.targets[side] = self.recovery.swing_target(
                     state.time_s, tick.com_c, com_vel, tick.a_c[other],
