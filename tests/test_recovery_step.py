@@ -661,3 +661,67 @@ def test_recovery_steps_that_land_where_the_body_will_be_keep_a_walk_on_rough_gr
     assert not _suite_run(spec, 1, MotionConfig(), ControlConfig()).fell
     old = _suite_run(spec, 1, MotionConfig(recovery_landing_without_swing=False), NO_FOOT_TASK)
     assert old.fell
+
+
+def test_a_landing_foot_out_of_reach_does_not_put_the_pelvis_target_on_the_ground():
+    """The kick in place, seed 1 (the development suite's run): from 2.2 s the kicking foot is held for its late
+    contact while the operator's pelvis target is 0.45 m to the side of the body. Measured from there, the foot is
+    beyond the leg's reach, and the pelvis target went down to the foot's own height; the character fell at 4.9 s.
+    The pelvis is now lowered no further than ``landing_pelvis_floor_share`` of the reach above the foot."""
+
+    def lowest_pelvis_target(motion: MotionConfig) -> tuple[float, bool]:
+        heights: list[float] = []
+
+        def on_tick(state, ref):
+            if 2.1 <= state.time_s <= 2.45:
+                heights.append(float(ref.pelvis_world[2]))
+
+        result = _suite_run("deepmimic:kick", 1, motion, ControlConfig(), on_tick)
+        assert len(heights) > 20
+        return min(heights), result.fell
+
+    low, fell = lowest_pelvis_target(MotionConfig())
+    low_old, fell_old = lowest_pelvis_target(MotionConfig(landing_pelvis_floor_share=0.0))
+    assert low_old < 0.3
+    assert low > 0.45
+    assert fell_old and not fell
+
+
+@pytest.mark.skipif(not (MOCAP / "cmu-dev" / "07_11.bvh").exists(),
+                    reason="../shared/mocap/cmu-dev/07_11.bvh is not available")
+def test_a_swing_that_would_land_out_of_reach_is_landed_by_the_balance():
+    """CMU-dev 07_11 (a walk, seed 1): from 1.89 s the character, faster than its operator, stands on its right foot
+    while his left swing goes on at his pace. Followed to his landing, it vaulted over its stance foot: the pelvis
+    sank 0.14 m below its target and the walk fell at 2.9 s (measured). Predicted at his usual landing time, the
+    capture point is beyond a recovery step's reach, so the swing is taken over at once."""
+    from stylesync.metrics.dev_suite import suite_config
+    from stylesync.session import Session
+    from stylesync.sources.registry import open_source
+
+    spec = f"bvh:{MOCAP / 'cmu-dev' / '07_11.bvh'}"
+
+    def run(flag: bool):
+        opened = open_source(spec, seed=1, duration_s=12.0)
+        cfg, _ = suite_config(spec, opened, 1, 12.0)
+        session = Session(dataclasses.replace(cfg, motion=MotionConfig(recovery_on_reach_limit=flag)), opened.source)
+        taken: list[float] = []
+        sink: list[float] = []
+
+        def on_tick(state, ref):
+            step = session.motion.recovery.step
+            if step is not None and step.taken_over and step.start_s not in taken:
+                taken.append(step.start_s)
+            if 1.8 <= state.time_s <= 2.5:
+                sink.append(float(ref.pelvis_world[2] - state.root_pos_world[2]))
+
+        session.on_tick = on_tick
+        result = session.run()
+        opened.source.close()
+        return taken, max(sink), result.fall_time_s or 12.0
+
+    taken, sink, fall = run(True)
+    taken_old, sink_old, fall_old = run(False)
+    assert taken and 1.85 <= taken[0] <= 1.95  # measured: 1.89 s, as his swing begins
+    assert not any(t < 2.5 for t in taken_old)
+    assert sink < 0.05 and sink_old > 0.1  # measured: 0.007 m against 0.136 m
+    assert fall > fall_old + 1.0  # measured: 4.3 s against 2.9 s

@@ -189,6 +189,12 @@ class MotionConfig:
     # would not catch the character's capture point: the stopping landing (pose_optimization.py) is then reached in
     # a recovery step's time, not in his slower lowering of the foot
     recovery_on_stopping_step: bool = True
+    # ... and at once when, held to his timing, the swing would land too late: the capture point, where it will be at
+    # his usual landing time (the centre of pressure held at the stance sole's point nearest to it), is further from
+    # the stance ankle than a recovery step reaches (recovery_step_reach_share). A character faster than its operator
+    # vaulted over its stance foot and sank while his slower swing went on (docs/decisions.md, "Landing before the
+    # capture point is out of reach")
+    recovery_on_reach_limit: bool = True
     # ... and in the character's double stance, whatever the operator does: once its capture point has been outside
     # the support polygon of its soles (by more than the margin) for this many times his usual double stance, a
     # recovery step (he walks on, or stands on one foot, while the character waits for a lift-off of his that
@@ -205,6 +211,12 @@ class MotionConfig:
     # landing from where the hip is (a landing at the leg's full reach otherwise hovers above the ground while the
     # body runs on)
     recovery_landing_reach: bool = True
+    # A foot that must land lowers the pelvis target to no less than this share of the leg's reach above the foot's
+    # target: lower, the foot cannot be brought within reach, and the legs could not hold the body there. Measured
+    # from an operator's pelvis target far from the body (0.45 m to the side of it in the kick in place, 0.87 m
+    # ahead of it in a walk's rest), the foot was out of reach, and the pelvis target dropped to the foot's own
+    # height (docs/decisions.md, "A pelvis target out of a landing foot's reach"; 0: no floor) [-]
+    landing_pelvis_floor_share: float = 0.6
     # A recovery step's landing is planned on the capture point of the body with the swing leg carried along by the
     # pelvis (MassProperties.com_velocity_carried): the leg's own swing moves the whole body's capture point with
     # the foot, and the ground stops that motion when the foot lands. Planned on the whole body's, the landing
@@ -230,6 +242,9 @@ class MotionConfig:
                               f"{self.capture_bound_sole_share}")
         _positive("MotionConfig.recovery_swing_s", self.recovery_swing_s)
         _non_negative("MotionConfig.recovery_step_height_m", self.recovery_step_height_m)
+        if not 0.0 <= self.landing_pelvis_floor_share <= 1.0:
+            raise ConfigError(f"MotionConfig.landing_pelvis_floor_share must be within [0, 1], got "
+                              f"{self.landing_pelvis_floor_share}")
         _non_negative("MotionConfig.recovery_min_stance_s", self.recovery_min_stance_s)
         _positive("MotionConfig.recovery_step_reach_share", self.recovery_step_reach_share)
         _positive("MotionConfig.recovery_swing_overrun", self.recovery_swing_overrun)

@@ -484,7 +484,9 @@ class MotionOptimizer:
         # A foot that has to reach the ground and does not touch it yet (a stance foot, or the swing foot held
         # for a late contact) must be within the leg's reach of its hip: the pelvis is lowered as far as that
         # needs. With the pelvis at the operator's height (Eq. 9) the legs are nearly straight, and a foot ahead
-        # of the body could otherwise never land.
+        # of the body could otherwise never land. It is lowered no further than landing_pelvis_floor_share of the
+        # reach above the foot: a foot out of reach from the hip even then (the operator's pelvis target may be far
+        # from the body) would otherwise put the pelvis target on the ground.
         landing_step = (self.cfg.recovery_landing_reach and self.char_fsm.recovery_step
                         and self.recovery.landing_due(state.time_s))
         for side, sign in (("left", 1.0), ("right", -1.0)):
@@ -497,8 +499,9 @@ class MotionOptimizer:
                     hip_xy = state.link_origin_world[_LINK[f"{side}_hip"]][:2]
                 reach = LANDING_REACH * CHAR_LEG_LENGTH_M
                 d2 = float(np.sum((tick.targets[side][:2] - hip_xy) ** 2))
-                tick.pelvis_d[2] = min(tick.pelvis_d[2],
-                                       tick.targets[side][2] + float(np.sqrt(max(reach * reach - d2, 0.0))))
+                above_foot = max(float(np.sqrt(max(reach * reach - d2, 0.0))),
+                                 self.cfg.landing_pelvis_floor_share * reach)
+                tick.pelvis_d[2] = min(tick.pelvis_d[2], tick.targets[side][2] + above_foot)
 
     def _operator_capture_point(self, tick: _Tick) -> np.ndarray:
         """(3,) the operator's capture point, his COM height taken above his ankles plus the character's ankle
@@ -627,7 +630,9 @@ class MotionOptimizer:
         as he does) becomes a recovery step, which lands the foot where the capture point will be. With
         ``recovery_on_stopping_step``, a swing whose landing the last tick's :meth:`_stopping_landing` moved to catch
         the capture point (he stops on this step, the character cannot) becomes one at once: his foot, lowered as
-        he comes to rest, would land it 0.3-0.5 s later while the capture point runs on."""
+        he comes to rest, would land it 0.3-0.5 s later while the capture point runs on. With
+        ``recovery_on_reach_limit``, so does a swing that, held to his timing, would land when the capture point is
+        already out of a recovery step's reach (:meth:`_capture_beyond_reach_at_his_landing`)."""
         cfg = self.cfg
         sw = swing_side(tick.ch_state)
         overrun_s = cfg.recovery_swing_overrun * self._op_swing_s
@@ -635,15 +640,30 @@ class MotionOptimizer:
         if cfg.recovery_on_stopping_step and stopping_side is not None and stopping_side == sw:
             overrun_s = 0.0
         if (not cfg.recovery_steps or sw is None or sw != self._swing or self.char_fsm.recovery_step
-                or self.char_fsm.hold_reference or state.time_s - self._swing_t0_s < overrun_s):
+                or self.char_fsm.hold_reference):
             return
         other = _OTHER_SIDE[sw]
         stance_q = state.link_quat_wxyz[_LINK[f"{other}_ankle"]]
+        if cfg.recovery_on_reach_limit and self._capture_beyond_reach_at_his_landing(tick, state, sw, stance_q):
+            overrun_s = 0.0
+        if state.time_s - self._swing_t0_s < overrun_s:
+            return
         xi, _ = capture_point(tick.com_c, tick.com_vel_c, self.g)
         if sole_outside_m(xi, tick.a_c[other], stance_q) <= cfg.recovery_step_margin_m:
             return
         self.recovery.take_over(sw, state.time_s, state.link_origin_world[_LINK[f"{sw}_ankle"]])
         self.char_fsm.take_over_swing(state.time_s, cfg.recovery_swing_s + cfg.late_contact_timeout_s)
+
+    def _capture_beyond_reach_at_his_landing(self, tick: _Tick, state: CharacterState, side: str,
+                                            stance_quat_wxyz: np.ndarray) -> bool:
+        """Whether the capture point, at the end of the operator's usual swing time from the swing's start (now, if
+        that is past), will be further from the stance ankle than a recovery step reaches: the balance has to land
+        the swing of ``side`` before he would (recovery_step.RecoveryStepper.capture_landing's prediction)."""
+        stance = _OTHER_SIDE[side]
+        remaining_s = max(self._op_swing_s - (state.time_s - self._swing_t0_s), 0.0)
+        _, xi_land = self.recovery.capture_landing(remaining_s, tick.com_c, tick.com_vel_c, tick.a_c[stance],
+                                                   stance_quat_wxyz, tick.R_root_d, side)
+        return float(np.hypot(*(xi_land - tick.a_c[stance][:2]))) > self.recovery.max_step_m
 
     def _swing_target(self, tick: _Tick, state: CharacterState, side: str) -> np.ndarray:
         """Where the swing foot goes this tick.

@@ -30,8 +30,9 @@ own:
   (``ReferencePose.recovery_ankle_world``).
 
 The step's timing is the nominal swing time; its position is what adapts, each tick, to the capture point. A
-swing of the operator's that he holds up too long while the character cannot stand on one foot is taken over by
-such a step in the air (:meth:`RecoveryStepper.take_over`): the foot is lowered from where it is.
+swing of the operator's that he holds up too long while the character cannot stand on one foot, or that would land
+at his pace only once the capture point is out of a step's reach, is taken over by such a step in the air
+(:meth:`RecoveryStepper.take_over`, pose_optimization.py): the foot is lowered from where it is.
 """
 
 from __future__ import annotations
