@@ -142,12 +142,14 @@ PELVIS_LEVEL = ControlConfig(whole_body=WholeBodyConfig(single_stance_pelvis_sha
 # operator stops on not yet landed at once (with either, several of the traced falls come later or not at all).
 TRACED_MOTION = {"recovery_step_reach_share": 0.6, "recovery_on_stopping_step": False,
                  "recovery_double_stance_overrun": 0.0, "liftoff_capture_behind_m": None, "foot_yaw_control": False,
-                 "liftoff_shift_tolerance_m": None, "recovery_landing_without_swing": False}
+                 "liftoff_shift_tolerance_m": None, "recovery_landing_without_swing": False,
+                 "landing_pelvis_floor_share": 0.0, "recovery_on_reach_limit": False}
 # The scenarios traced before MotionConfig.foot_yaw_control run with the feet's twist left where it was (and the
-# weight shift from standing and the recovery steps' landing as they were then; with the controller, the recovery
-# foot task off: NO_FOOT_TASK).
+# weight shift from standing, the recovery steps' landing and the step timing as they were then; with the
+# controller, the recovery foot task off: NO_FOOT_TASK).
 NO_FOOT_TASK = ControlConfig(whole_body=WholeBodyConfig(recovery_foot_task_weight=0.0))
-TWIST_FREE = {"foot_yaw_control": False, "liftoff_shift_tolerance_m": None, "recovery_landing_without_swing": False}
+TWIST_FREE = {"foot_yaw_control": False, "liftoff_shift_tolerance_m": None, "recovery_landing_without_swing": False,
+              "landing_pelvis_floor_share": 0.0, "recovery_on_reach_limit": False}
 
 
 def _run(spec: str, seconds: float, motion: MotionConfig, seed: int = 0, control: ControlConfig | None = None):
@@ -622,7 +624,8 @@ def _suite_run(spec: str, seed: int, motion: MotionConfig, control: ControlConfi
                     reason="../shared/mocap/cmu-dev/09_06.bvh is not available")
 def test_the_swing_foot_of_a_recovery_step_follows_its_target():
     """CMU-dev 09_06 (a run, seed 0) steps on its own from 0.96 s. Through the joint posture alone the swing ankle
-    trailed its target by 0.2-0.3 m at mid-swing (traced); the recovery foot task keeps it close."""
+    trailed its target by 0.2-0.3 m at mid-swing (traced); the recovery foot task keeps it close. Run with the step
+    timing it was traced with (with ``recovery_on_reach_limit`` the run's swings are taken over in the air)."""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '09_06.bvh'}"
 
     def lag(control: ControlConfig) -> float:
@@ -637,7 +640,8 @@ def test_the_swing_foot_of_a_recovery_step_follows_its_target():
                 raise _Stop
 
         try:
-            _suite_run(spec, 0, MotionConfig(), control, on_tick)
+            _suite_run(spec, 0, MotionConfig(landing_pelvis_floor_share=0.0, recovery_on_reach_limit=False), control,
+                       on_tick)
         except _Stop:
             pass
         assert len(gaps) > 10
@@ -661,6 +665,15 @@ def test_recovery_steps_that_land_where_the_body_will_be_keep_a_walk_on_rough_gr
     assert not _suite_run(spec, 1, MotionConfig(), ControlConfig()).fell
     old = _suite_run(spec, 1, MotionConfig(recovery_landing_without_swing=False), NO_FOOT_TASK)
     assert old.fell
+
+
+def test_the_pelvis_floor_share_is_checked():
+    from stylesync.errors import ConfigError
+
+    with pytest.raises(ConfigError):
+        MotionConfig(landing_pelvis_floor_share=1.5)
+    with pytest.raises(ConfigError):
+        MotionConfig(landing_pelvis_floor_share=-0.1)
 
 
 def test_a_landing_foot_out_of_reach_does_not_put_the_pelvis_target_on_the_ground():
