@@ -644,7 +644,8 @@ class MotionOptimizer:
             return
         other = _OTHER_SIDE[sw]
         stance_q = state.link_quat_wxyz[_LINK[f"{other}_ankle"]]
-        if cfg.recovery_on_reach_limit and self._capture_beyond_reach_at_his_landing(tick, state, sw, stance_q):
+        if (overrun_s > 0.0 and cfg.recovery_on_reach_limit
+                and self._capture_beyond_reach_at_his_landing(tick, state, sw, stance_q)):
             overrun_s = 0.0
         if state.time_s - self._swing_t0_s < overrun_s:
             return
