@@ -17,6 +17,7 @@ Per control tick, from the smoothed operator sample and the character's current 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -50,6 +51,7 @@ from stylesync.motion.recovery_step import (
     RecoveryStepper,
     beyond_sole_towards_m,
     capture_point,
+    capture_point_after,
     operator_stands,
     soles_on_ground,
     stands_on,
@@ -659,12 +661,12 @@ class MotionOptimizer:
                                             stance_quat_wxyz: np.ndarray) -> bool:
         """Whether the capture point, at the end of the operator's usual swing time from the swing's start (now, if
         that is past), will be further from the stance ankle than a recovery step reaches: the balance has to land
-        the swing of ``side`` before he would (recovery_step.RecoveryStepper.capture_landing's prediction)."""
-        stance = _OTHER_SIDE[side]
+        the swing of ``side`` before he would (recovery_step.capture_point_after, as a recovery step's landing
+        predicts it)."""
+        ankle = tick.a_c[_OTHER_SIDE[side]]
         remaining_s = max(self._op_swing_s - (state.time_s - self._swing_t0_s), 0.0)
-        _, xi_land = self.recovery.capture_landing(remaining_s, tick.com_c, tick.com_vel_c, tick.a_c[stance],
-                                                   stance_quat_wxyz, tick.R_root_d, side)
-        return float(np.hypot(*(xi_land - tick.a_c[stance][:2]))) > self.recovery.max_step_m
+        x, y = capture_point_after(tick.com_c, tick.com_vel_c, self.g, ankle, stance_quat_wxyz, remaining_s)
+        return math.hypot(x - float(ankle[0]), y - float(ankle[1])) > self.recovery.max_step_m
 
     def _swing_target(self, tick: _Tick, state: CharacterState, side: str) -> np.ndarray:
         """Where the swing foot goes this tick.

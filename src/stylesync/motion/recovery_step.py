@@ -37,6 +37,7 @@ at his pace only once the capture point is out of a step's reach, is taken over 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -83,6 +84,20 @@ def capture_point(com_world: np.ndarray, com_vel_world: np.ndarray, gravity_mps2
     h the COM height above the ground."""
     omega = float(np.sqrt(gravity_mps2 / max(float(com_world[2]), 0.1)))
     return np.asarray(com_world, dtype=float)[:2] + np.asarray(com_vel_world, dtype=float)[:2] / omega, omega
+
+
+def capture_point_after(com_world: np.ndarray, com_vel_world: np.ndarray, gravity_mps2: float,
+                        stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray,
+                        remaining_s: float) -> tuple[float, float]:
+    """The capture point (horizontal) ``remaining_s`` from now, with the centre of pressure held at the stance
+    sole's point nearest to it: ``ξ(t + τ) = p + (ξ(t) - p) e^(ω τ)`` (Eq. 21's pendulum) [m]. On plain floats (model/
+    sole.py's ``*_points``): it runs on every tick of an operator's swing."""
+    xi, omega = capture_point(com_world, com_vel_world, gravity_mps2)
+    x, y = float(xi[0]), float(xi[1])
+    polygon = convex_hull_points(sole_points_xy(stance_ankle_world, stance_foot_quat_wxyz, _SOLE_POINTS))
+    _, (px, py) = outside_distance_points((x, y), polygon)
+    grow = math.exp(omega * remaining_s)
+    return px + (x - px) * grow, py + (y - py) * grow
 
 
 def soles_on_ground(state: CharacterState) -> list[str]:
