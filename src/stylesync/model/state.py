@@ -67,8 +67,8 @@ class MassProperties:
     def com_velocity_carried(self, state: CharacterState, links: tuple[int, ...], carrier: int) -> np.ndarray:
         """Whole-body COM velocity [m/s] (world) with the ``links`` (indices into LINK_NAMES) moving as the link
         ``carrier`` does: their own motion relative to it left out."""
-        vel = state.link_com_vel_world
-        return self._weights @ vel + self._weights[list(links)] @ (vel[carrier] - vel[list(links)])
+        vel, carried = state.link_com_vel_world, list(links)
+        return self._weights @ vel + self._weights[carried] @ (vel[carrier] - vel[carried])
 
 
 @dataclass

@@ -87,6 +87,7 @@ _OTHER_SIDE = {"left": "right", "right": "left"}
 _LINK = {n: i for i, n in enumerate(LINK_NAMES)}
 _ROOT_LINK = _LINK["root"]
 CHAR_LEG_LENGTH_M = THIGH_LENGTH_M + SHANK_LENGTH_M
+_LANDING_REACH_M = LANDING_REACH * CHAR_LEG_LENGTH_M  # hip-ankle distance at which a landing foot is aimed [m]
 OPERATOR_VELOCITY_SETTLE_S = 0.2  # the operator's filtered COM velocity is taken as settled from then on [s]
 HEEL_AHEAD_OF_ANKLE_M = FOOT_CENTER_AHEAD_OF_ANKLE_M - FOOT_LENGTH_M / 2  # < 0: the heel is behind the ankle [m]
 
@@ -204,6 +205,8 @@ class MotionOptimizer:
         self.cfg = cfg
         self.g = gravity_mps2
         self.dt_s = 1.0 / control_hz
+        # A landing foot lowers the pelvis target to at least this height above the foot's target [m]
+        self._landing_pelvis_floor_m = cfg.landing_pelvis_floor_share * _LANDING_REACH_M
         self.op_fsm = OperatorStanceFsm(cfg.stance_height_threshold_m, cfg.stance_hysteresis_m)
         self.char_fsm = CharacterStanceFsm(cfg.late_contact_timeout_s, cfg.min_swing_s)
         self._op_leg_m: float | None = None
@@ -499,10 +502,9 @@ class MotionOptimizer:
                     # The character's own step: from where its hip is (the operator's pelvis target may be
                     # anywhere behind a body that carries momentum he does not have).
                     hip_xy = state.link_origin_world[_LINK[f"{side}_hip"]][:2]
-                reach = LANDING_REACH * CHAR_LEG_LENGTH_M
                 d2 = float(np.sum((tick.targets[side][:2] - hip_xy) ** 2))
-                above_foot = max(float(np.sqrt(max(reach * reach - d2, 0.0))),
-                                 self.cfg.landing_pelvis_floor_share * reach)
+                above_foot = max(float(np.sqrt(max(_LANDING_REACH_M * _LANDING_REACH_M - d2, 0.0))),
+                                 self._landing_pelvis_floor_m)
                 tick.pelvis_d[2] = min(tick.pelvis_d[2], tick.targets[side][2] + above_foot)
 
     def _operator_capture_point(self, tick: _Tick) -> np.ndarray:
