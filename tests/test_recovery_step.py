@@ -19,6 +19,7 @@ from stylesync.motion.recovery_step import (
     beyond_sole_towards_m,
     capture_point,
     operator_stands,
+    soles_on_ground,
     stands_on,
     support_outside_along,
 )
@@ -93,8 +94,9 @@ def test_a_capture_point_beyond_the_left_foot_lifts_the_right_foot_and_lands_it_
     stepper.end(1.4)
     assert stepper.step is None
     # Another only after the minimum double stance.
-    assert stepper.trigger(1.45, com, vel, ANKLES, QUATS, ["left", "right"]) is None
-    assert stepper.trigger(1.55, com, vel, ANKLES, QUATS, ["left", "right"]) is not None
+    wait_s = stepper.cfg.recovery_min_stance_s
+    assert stepper.trigger(1.4 + 0.5 * wait_s, com, vel, ANKLES, QUATS, ["left", "right"]) is None
+    assert stepper.trigger(1.4 + 1.5 * wait_s, com, vel, ANKLES, QUATS, ["left", "right"]) is not None
 
 
 def test_recovery_steps_can_be_switched_off():
@@ -143,13 +145,15 @@ PELVIS_LEVEL = ControlConfig(whole_body=WholeBodyConfig(single_stance_pelvis_sha
 TRACED_MOTION = {"recovery_step_reach_share": 0.6, "recovery_on_stopping_step": False,
                  "recovery_double_stance_overrun": 0.0, "liftoff_capture_behind_m": None, "foot_yaw_control": False,
                  "liftoff_shift_tolerance_m": None, "recovery_landing_without_swing": False,
-                 "landing_pelvis_floor_share": 0.0, "recovery_on_reach_limit": False}
+                 "landing_pelvis_floor_share": 0.0, "recovery_on_reach_limit": False, "recovery_min_stance_s": 0.1}
 # The scenarios traced before MotionConfig.foot_yaw_control run with the feet's twist left where it was (and the
 # weight shift from standing, the recovery steps' landing and the step timing as they were then; with the
 # controller, the recovery foot task off: NO_FOOT_TASK).
 NO_FOOT_TASK = ControlConfig(whole_body=WholeBodyConfig(recovery_foot_task_weight=0.0))
 TWIST_FREE = {"foot_yaw_control": False, "liftoff_shift_tolerance_m": None, "recovery_landing_without_swing": False,
-              "landing_pelvis_floor_share": 0.0, "recovery_on_reach_limit": False}
+              "landing_pelvis_floor_share": 0.0, "recovery_on_reach_limit": False, "recovery_min_stance_s": 0.1}
+# The scenarios traced before the shorter double stance between recovery steps (MotionConfig.recovery_min_stance_s).
+WAIT_TRACED = {"recovery_min_stance_s": 0.1}
 
 
 def _run(spec: str, seconds: float, motion: MotionConfig, seed: int = 0, control: ControlConfig | None = None):
@@ -662,8 +666,8 @@ def test_recovery_steps_that_land_where_the_body_will_be_keep_a_walk_on_rough_gr
     """CMU-dev 03_02 (walking over uneven ground, seed 1) fell 2.2 s in with the recovery step's foot driven by the
     joint posture alone and its landing planned on the capture point its own swing moved (measured)."""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '03_02.bvh'}"
-    assert not _suite_run(spec, 1, MotionConfig(), ControlConfig()).fell
-    old = _suite_run(spec, 1, MotionConfig(recovery_landing_without_swing=False), NO_FOOT_TASK)
+    assert not _suite_run(spec, 1, MotionConfig(**WAIT_TRACED), ControlConfig()).fell
+    old = _suite_run(spec, 1, MotionConfig(recovery_landing_without_swing=False, **WAIT_TRACED), NO_FOOT_TASK)
     assert old.fell
 
 
@@ -693,8 +697,8 @@ def test_a_landing_foot_out_of_reach_does_not_put_the_pelvis_target_on_the_groun
         assert len(heights) > 20
         return min(heights), result.fell
 
-    low, fell = lowest_pelvis_target(MotionConfig())
-    low_old, fell_old = lowest_pelvis_target(MotionConfig(landing_pelvis_floor_share=0.0))
+    low, fell = lowest_pelvis_target(MotionConfig(**WAIT_TRACED))
+    low_old, fell_old = lowest_pelvis_target(MotionConfig(landing_pelvis_floor_share=0.0, **WAIT_TRACED))
     assert low_old < 0.3
     assert low > 0.45
     assert fell_old and not fell
@@ -738,3 +742,44 @@ def test_a_swing_that_would_land_out_of_reach_is_landed_by_the_balance():
     assert not any(t < 2.5 for t in taken_old)
     assert sink < 0.05 and sink_old > 0.1  # measured: 0.007 m against 0.136 m
     assert fall > fall_old + 1.0  # measured: 4.3 s against 2.9 s
+
+
+@pytest.mark.skipif(not (MOCAP / "deepmimic" / "humanoid3d_stealthy_walk.txt").exists(),
+                    reason="../shared/mocap/deepmimic/humanoid3d_stealthy_walk.txt is not available")
+def test_the_next_recovery_step_begins_while_both_soles_are_down():
+    """The DeepMimic stealthy walk, seed 2: a recovery step's right foot lands at 3.49 s with the capture point 4 cm
+    outside the soles and moving out to the left. With 0.1 s of double stance kept before the next step, the right
+    sole unloaded again meanwhile (3.53 s); the next step then had only the left sole to stand on and lifted the right
+    foot, which cannot land across the left one, and the walk fell at 4.67 s (measured). After 0.03 s both soles are
+    still down, and the left foot steps out."""
+    spec = f"deepmimic:{MOCAP / 'deepmimic' / 'humanoid3d_stealthy_walk.txt'}"
+
+    def run(wait_s: float) -> tuple[list[tuple[float, str, int]], object]:
+        steps: list[tuple[float, str, int]] = []
+        holder: dict = {}
+
+        def on_tick(state, ref):
+            step = holder["session"].motion.recovery.step
+            if step is not None and (not steps or steps[-1][0] != step.start_s):
+                steps.append((step.start_s, step.side, len(soles_on_ground(state))))
+
+        from stylesync.metrics.dev_suite import suite_config
+        from stylesync.session import Session
+        from stylesync.sources.registry import open_source
+
+        opened = open_source(spec, seed=2, duration_s=12.0)
+        cfg, _ = suite_config(spec, opened, 2, 12.0)
+        session = holder["session"] = Session(
+            dataclasses.replace(cfg, motion=MotionConfig(recovery_min_stance_s=wait_s)), opened.source)
+        session.on_tick = on_tick
+        result = session.run()
+        opened.source.close()
+        return steps, result
+
+    steps, result = run(MotionConfig().recovery_min_stance_s)
+    steps_old, result_old = run(0.1)
+    after = [s for s in steps if 3.49 < s[0] < 3.7]
+    after_old = [s for s in steps_old if 3.49 < s[0] < 3.7]
+    assert after and after[0][1] == "left" and after[0][2] == 2  # measured: 3.53 s, the left foot, both soles down
+    assert after_old and after_old[0][1] == "right" and after_old[0][2] == 1  # measured: 3.60 s, on the left sole
+    assert result_old.fell and not result.fell

@@ -168,12 +168,15 @@ class MotionConfig:
     step_outside_capture_point_m: tuple[float, float] = (0.0, 0.04)
     # Recovery steps (motion/recovery_step.py): while the operator stands, the character steps on its own when its
     # capture point is further than the margin outside the support polygon of its soles [m]; the step's nominal
-    # swing time [s] and height [m]; the double stance kept after one before another [s].
+    # swing time [s] and height [m]; the double stance kept after one before another, and the time the operator
+    # must have stood before the first [s]. At 0.1 s a foot that had just landed could unload again before the next
+    # step began, leaving only the sole that cannot catch the body (docs/decisions.md, "The double stance between
+    # two recovery steps").
     recovery_steps: bool = True
     recovery_step_margin_m: float = 0.02
     recovery_swing_s: float = 0.2
     recovery_step_height_m: float = 0.05
-    recovery_min_stance_s: float = 0.1
+    recovery_min_stance_s: float = 0.03
     # A recovery step lands its ankle at most this share of the leg's length from the stance ankle (the pelvis lowered
     # as the leg needs, recovery_landing_reach): at 0.6 the steps that stop a walk landed short of the capture point,
     # and each left the body faster (docs/decisions.md, "Longer recovery steps") [-]
