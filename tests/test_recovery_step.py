@@ -752,34 +752,32 @@ def test_the_next_recovery_step_begins_while_both_soles_are_down():
     sole unloaded again meanwhile (3.53 s); the next step then had only the left sole to stand on and lifted the right
     foot, which cannot land across the left one, and the walk fell at 4.67 s (measured). After 0.03 s both soles are
     still down, and the left foot steps out."""
+    from stylesync.metrics.dev_suite import suite_config
+    from stylesync.session import Session
+    from stylesync.sources.registry import open_source
+
     spec = f"deepmimic:{MOCAP / 'deepmimic' / 'humanoid3d_stealthy_walk.txt'}"
 
-    def run(wait_s: float) -> tuple[list[tuple[float, str, int]], object]:
+    def run(wait_s: float):
+        """The recovery steps begun (start time [s], swing side, soles on the ground then), and the result."""
+        opened = open_source(spec, seed=2, duration_s=12.0)
+        cfg, _ = suite_config(spec, opened, 2, 12.0)
+        session = Session(dataclasses.replace(cfg, motion=MotionConfig(recovery_min_stance_s=wait_s)), opened.source)
         steps: list[tuple[float, str, int]] = []
-        holder: dict = {}
 
         def on_tick(state, ref):
-            step = holder["session"].motion.recovery.step
+            step = session.motion.recovery.step
             if step is not None and (not steps or steps[-1][0] != step.start_s):
                 steps.append((step.start_s, step.side, len(soles_on_ground(state))))
 
-        from stylesync.metrics.dev_suite import suite_config
-        from stylesync.session import Session
-        from stylesync.sources.registry import open_source
-
-        opened = open_source(spec, seed=2, duration_s=12.0)
-        cfg, _ = suite_config(spec, opened, 2, 12.0)
-        session = holder["session"] = Session(
-            dataclasses.replace(cfg, motion=MotionConfig(recovery_min_stance_s=wait_s)), opened.source)
         session.on_tick = on_tick
         result = session.run()
         opened.source.close()
-        return steps, result
+        return [x for x in steps if 3.49 < x[0] < 3.7], result
 
-    steps, result = run(MotionConfig().recovery_min_stance_s)
-    steps_old, result_old = run(0.1)
-    after = [s for s in steps if 3.49 < s[0] < 3.7]
-    after_old = [s for s in steps_old if 3.49 < s[0] < 3.7]
-    assert after and after[0][1] == "left" and after[0][2] == 2  # measured: 3.53 s, the left foot, both soles down
-    assert after_old and after_old[0][1] == "right" and after_old[0][2] == 1  # measured: 3.60 s, on the left sole
+    after, result = run(MotionConfig().recovery_min_stance_s)
+    after_old, result_old = run(0.1)
+    # measured: 3.53 s, the left foot, both soles down; with 0.1 s, 3.60 s, the right foot, the left sole alone
+    assert after and after[0][1] == "left" and after[0][2] == 2 and after[0][0] < 3.55
+    assert after_old and after_old[0][1] == "right" and after_old[0][2] == 1 and after_old[0][0] > 3.58
     assert result_old.fell and not result.fell
