@@ -608,7 +608,10 @@ def test_the_com_velocity_with_a_leg_carried_leaves_out_only_the_legs_own_motion
     assert np.allclose(mass.com_velocity_carried(state, leg, root), [0.5, -0.2, 0.1])  # type: ignore[arg-type]
 
 
-def _suite_run(spec: str, seed: int, motion: MotionConfig, control: ControlConfig, on_tick=None):
+def _suite_run(spec: str, seed: int, motion: MotionConfig, control: ControlConfig, on_tick=None, watch=None):
+    """One development-suite run of ``spec`` (its configuration and source as the suite opens them) with ``motion``
+    and ``control``. ``on_tick(state, ref)`` is called each control tick; or ``watch(session)`` returns that
+    callback, for one that reads the session itself."""
     from stylesync.metrics.dev_suite import suite_config
     from stylesync.session import Session
     from stylesync.sources.registry import open_source
@@ -616,6 +619,8 @@ def _suite_run(spec: str, seed: int, motion: MotionConfig, control: ControlConfi
     opened = open_source(spec, seed=seed, duration_s=12.0)
     cfg, _ = suite_config(spec, opened, seed, 12.0)
     session = Session(dataclasses.replace(cfg, motion=motion, control=control), opened.source)
+    if watch is not None:
+        on_tick = watch(session)
     if on_tick is not None:
         session.on_tick = on_tick
     result = session.run()
@@ -711,29 +716,22 @@ def test_a_swing_that_would_land_out_of_reach_is_landed_by_the_balance():
     while his left swing goes on at his pace. Followed to his landing, it vaulted over its stance foot: the pelvis
     sank 0.14 m below its target and the walk fell at 2.9 s (measured). Predicted at his usual landing time, the
     capture point is beyond a recovery step's reach, so the swing is taken over at once."""
-    from stylesync.metrics.dev_suite import suite_config
-    from stylesync.session import Session
-    from stylesync.sources.registry import open_source
-
     spec = f"bvh:{MOCAP / 'cmu-dev' / '07_11.bvh'}"
 
     def run(flag: bool):
-        opened = open_source(spec, seed=1, duration_s=12.0)
-        cfg, _ = suite_config(spec, opened, 1, 12.0)
-        session = Session(dataclasses.replace(cfg, motion=MotionConfig(recovery_on_reach_limit=flag)), opened.source)
         taken: list[float] = []
         sink: list[float] = []
 
-        def on_tick(state, ref):
-            step = session.motion.recovery.step
-            if step is not None and step.taken_over and step.start_s not in taken:
-                taken.append(step.start_s)
-            if 1.8 <= state.time_s <= 2.5:
-                sink.append(float(ref.pelvis_world[2] - state.root_pos_world[2]))
+        def watch(session):
+            def on_tick(state, ref):
+                step = session.motion.recovery.step
+                if step is not None and step.taken_over and step.start_s not in taken:
+                    taken.append(step.start_s)
+                if 1.8 <= state.time_s <= 2.5:
+                    sink.append(float(ref.pelvis_world[2] - state.root_pos_world[2]))
+            return on_tick
 
-        session.on_tick = on_tick
-        result = session.run()
-        opened.source.close()
+        result = _suite_run(spec, 1, MotionConfig(recovery_on_reach_limit=flag), ControlConfig(), watch=watch)
         return taken, max(sink), result.fall_time_s or 12.0
 
     taken, sink, fall = run(True)
@@ -752,27 +750,20 @@ def test_the_next_recovery_step_begins_while_both_soles_are_down():
     sole unloaded again meanwhile (3.53 s); the next step then had only the left sole to stand on and lifted the right
     foot, which cannot land across the left one, and the walk fell at 4.67 s (measured). After 0.03 s both soles are
     still down, and the left foot steps out."""
-    from stylesync.metrics.dev_suite import suite_config
-    from stylesync.session import Session
-    from stylesync.sources.registry import open_source
-
     spec = f"deepmimic:{MOCAP / 'deepmimic' / 'humanoid3d_stealthy_walk.txt'}"
 
     def run(wait_s: float):
         """The recovery steps begun (start time [s], swing side, soles on the ground then), and the result."""
-        opened = open_source(spec, seed=2, duration_s=12.0)
-        cfg, _ = suite_config(spec, opened, 2, 12.0)
-        session = Session(dataclasses.replace(cfg, motion=MotionConfig(recovery_min_stance_s=wait_s)), opened.source)
         steps: list[tuple[float, str, int]] = []
 
-        def on_tick(state, ref):
-            step = session.motion.recovery.step
-            if step is not None and (not steps or steps[-1][0] != step.start_s):
-                steps.append((step.start_s, step.side, len(soles_on_ground(state))))
+        def watch(session):
+            def on_tick(state, ref):
+                step = session.motion.recovery.step
+                if step is not None and (not steps or steps[-1][0] != step.start_s):
+                    steps.append((step.start_s, step.side, len(soles_on_ground(state))))
+            return on_tick
 
-        session.on_tick = on_tick
-        result = session.run()
-        opened.source.close()
+        result = _suite_run(spec, 2, MotionConfig(recovery_min_stance_s=wait_s), ControlConfig(), watch=watch)
         return [x for x in steps if 3.49 < x[0] < 3.7], result
 
     after, result = run(MotionConfig().recovery_min_stance_s)
