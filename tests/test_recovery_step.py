@@ -19,6 +19,7 @@ from stylesync.motion.recovery_step import (
     beyond_sole_towards_m,
     capture_point,
     operator_stands,
+    out_of_reach_after_wait,
     soles_on_ground,
     stands_on,
     support_outside_along,
@@ -151,7 +152,8 @@ TRACED_MOTION = {"recovery_step_reach_share": 0.6, "recovery_on_stopping_step": 
 # controller, the recovery foot task off: NO_FOOT_TASK).
 NO_FOOT_TASK = ControlConfig(whole_body=WholeBodyConfig(recovery_foot_task_weight=0.0))
 TWIST_FREE = {"foot_yaw_control": False, "liftoff_shift_tolerance_m": None, "recovery_landing_without_swing": False,
-              "landing_pelvis_floor_share": 0.0, "recovery_on_reach_limit": False, "recovery_min_stance_s": 0.1}
+              "landing_pelvis_floor_share": 0.0, "recovery_on_reach_limit": False, "recovery_min_stance_s": 0.1,
+              "recovery_ds_on_reach_limit": False}
 # The scenarios traced before the shorter double stance between recovery steps (MotionConfig.recovery_min_stance_s).
 WAIT_TRACED = {"recovery_min_stance_s": 0.1}
 
@@ -568,6 +570,58 @@ def test_the_outward_direction_of_a_capture_point_tells_behind_from_ahead():
     assert out < 0.0 and along == 0.0
 
 
+def test_a_capture_point_out_of_reach_after_the_wait_is_told_from_one_a_step_then_catches():
+    """Eq. 21's pendulum in two phases: the centre of pressure in both soles for the wait, then in the stance sole
+    for the swing. A capture point 1 cm ahead of the soles, still, stays within a step's reach (0.6 m) after a 0.3 s
+    wait and a 0.2 s swing; moving 0.3 m/s it leaves it after that wait, not after none."""
+    feet = ["left", "right"]
+    com = np.array([FOOT_CENTER_AHEAD_OF_ANKLE_M + FOOT_LENGTH_M / 2 + 0.01, 0.0, 0.8])
+    still, moving = np.zeros(3), np.array([0.3, 0.0, 0.0])
+    omega = np.sqrt(G / 0.8)
+    toes = FOOT_CENTER_AHEAD_OF_ANKLE_M + FOOT_LENGTH_M / 2
+    assert toes + 0.01 * np.exp(omega * 0.5) < 0.6 < toes + (0.01 + 0.3 / omega) * np.exp(omega * 0.5)
+    assert toes + (0.01 + 0.3 / omega) * np.exp(omega * 0.2) < 0.6
+    assert not out_of_reach_after_wait(com, still, G, ANKLES, QUATS, feet, 0.3, 0.2, 0.6)
+    assert out_of_reach_after_wait(com, moving, G, ANKLES, QUATS, feet, 0.3, 0.2, 0.6)
+    assert not out_of_reach_after_wait(com, moving, G, ANKLES, QUATS, feet, 0.0, 0.2, 0.6)
+    # within the soles it never leaves: the centre of pressure holds it
+    assert not out_of_reach_after_wait(np.array([0.05, 0.0, 0.8]), still, G, ANKLES, QUATS, feet, 5.0, 0.2, 0.6)
+
+
+@pytest.mark.skipif(not (MOCAP / "deepmimic" / "humanoid3d_zombie_walk.txt").exists(),
+                    reason="../shared/mocap/deepmimic/humanoid3d_zombie_walk.txt is not available")
+def test_a_double_stance_that_would_wait_out_of_reach_steps_at_once():
+    """The DeepMimic zombie walk, seed 1: at 3.67 s the operator lifts his right foot; the character, on both feet,
+    has its capture point 8 cm outside them and moving out. Without the rule, its right swing (taken over) landed at
+    3.83 s, and it then waited in double stance for his next lift-off, 0.9 s away on a zombie's slow gait, and for
+    its double stance to be overdue: its own step began at 4.32 s with the capture point 0.31 m out, and the walk fell
+    at 4.74 s (measured). Stepping as soon as the wait for his lift-off would leave the capture point out of a step's
+    reach while a step now still catches it (3.67 s), it walks on."""
+    spec = f"deepmimic:{MOCAP / 'deepmimic' / 'humanoid3d_zombie_walk.txt'}"
+
+    def run(on: bool):
+        """The first recovery step begun from double stance after 3.4 s (start time [s]; a swing of his taken over
+        is not one), and the result."""
+        starts: list[float] = []
+
+        def watch(session):
+            def on_tick(state, ref):
+                step = session.motion.recovery.step
+                if step is not None and step.start_s > 3.4 and not step.taken_over and not starts:
+                    starts.append(step.start_s)
+            return on_tick
+
+        result = _suite_run(spec, 1, MotionConfig(recovery_ds_on_reach_limit=on), ControlConfig(), watch=watch)
+        return starts, result
+
+    at_once, result = run(True)
+    waiting, result_waiting = run(False)
+    assert at_once and 3.6 < at_once[0] < 3.7  # measured: 3.67 s
+    assert waiting and waiting[0] > 4.2  # measured: 4.32 s
+    assert not result.fell
+    assert result_waiting.fell and result_waiting.fall_time_s is not None and result_waiting.fall_time_s < 5.0
+
+
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "10_04.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/10_04.bvh is not available")
 def test_a_capture_point_behind_both_feet_steps_back_at_once():
@@ -576,9 +630,10 @@ def test_a_capture_point_behind_both_feet_steps_back_at_once():
     next lift-off and then for the double stance to be overdue (the step back began at 2.08 s, 0.38 m out), and it fell
     backwards in the clip (2.72 s). Stepping back as soon as the capture point is behind, it walks on. (Traced with
     the recovery steps' landing and swing foot as they were then: with the recovery foot task and the carried capture
-    point, the waiting character does not fall either.)"""
+    point, the waiting character does not fall either; so does it with the double stance's reach rule,
+    ``recovery_ds_on_reach_limit``, which steps it at once as well.)"""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '10_04.bvh'}"
-    then = {"recovery_landing_without_swing": False}
+    then = {"recovery_landing_without_swing": False, "recovery_ds_on_reach_limit": False}
     at_once, session = _run(spec, 4.0, MotionConfig(**then), control=NO_FOOT_TASK)
     assert not at_once.fell
     waiting, _ = _run(spec, 4.0, MotionConfig(**then, recovery_step_behind_cos=None), control=NO_FOOT_TASK)
@@ -715,7 +770,8 @@ def test_a_swing_that_would_land_out_of_reach_is_landed_by_the_balance():
     """CMU-dev 07_11 (a walk, seed 1): from 1.89 s the character, faster than its operator, stands on its right foot
     while his left swing goes on at his pace. Followed to his landing, it vaulted over its stance foot: the pelvis
     sank 0.14 m below its target and the walk fell at 2.9 s (measured). Predicted at his usual landing time, the
-    capture point is beyond a recovery step's reach, so the swing is taken over at once."""
+    capture point is beyond a recovery step's reach, so the swing is taken over at once. (Traced before the double
+    stance's reach rule, ``recovery_ds_on_reach_limit``, which is off here.)"""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '07_11.bvh'}"
 
     def run(flag: bool):
@@ -731,7 +787,8 @@ def test_a_swing_that_would_land_out_of_reach_is_landed_by_the_balance():
                     sink.append(float(ref.pelvis_world[2] - state.root_pos_world[2]))
             return on_tick
 
-        result = _suite_run(spec, 1, MotionConfig(recovery_on_reach_limit=flag), ControlConfig(), watch=watch)
+        result = _suite_run(spec, 1, MotionConfig(recovery_on_reach_limit=flag, recovery_ds_on_reach_limit=False),
+                            ControlConfig(), watch=watch)
         return taken, max(sink), result.fall_time_s or 12.0
 
     taken, sink, fall = run(True)

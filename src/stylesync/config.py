@@ -203,6 +203,12 @@ class MotionConfig:
     # recovery step (he walks on, or stands on one foot, while the character waits for a lift-off of his that
     # comes too late for it; 0: off) [-]
     recovery_double_stance_overrun: float = 1.5
+    # ... and at once when waiting for his next lift-off (the rest of his double stance, or the rest of his swing and a
+    # double stance of his usual length) and then a recovery step's swing would leave the capture point further from
+    # either stance ankle than a recovery step reaches, while a recovery step now captures it: the wait is his gait's,
+    # and the character's capture point runs out of reach before it ends (with the overrun, off at 0;
+    # docs/decisions.md, "A double stance that waits out of reach")
+    recovery_ds_on_reach_limit: bool = True
     # ... at once where the capture point has left that polygon behind: the outward direction from the polygon's
     # nearest point to the capture point has a share below minus this of the heading's forward axis (a step of an
     # operator walking forwards can never catch it; docs/decisions.md, "A capture point behind both feet"; None: off)

@@ -53,6 +53,7 @@ from stylesync.motion.recovery_step import (
     capture_point,
     capture_point_after,
     operator_stands,
+    out_of_reach_after_wait,
     soles_on_ground,
     stands_on,
     support_outside_along,
@@ -607,9 +608,11 @@ class MotionOptimizer:
         """Step timing adapted to the balance in double stance: whether the character's capture point has been
         outside the support polygon of its soles on the ground, by more than the recovery step's margin, for
         ``recovery_double_stance_overrun`` times the operator's usual double stance, or at all behind the feet
-        (``recovery_step_behind_cos``). A character's double stance ends with his next lift-off; where he walks on
-        from a step the character has already landed, or holds a foot up at a clip's end, that lift-off comes after
-        the capture point has run out of reach; and his next step forwards never reaches one behind the feet."""
+        (``recovery_step_behind_cos``), or so far out that his next lift-off comes too late for any step
+        (``recovery_ds_on_reach_limit``, :meth:`_his_lift_off_too_late`). A character's double stance ends with his
+        next lift-off; where he walks on from a step the character has already landed, or holds a foot up at a clip's
+        end, that lift-off comes after the capture point has run out of reach; and his next step forwards never
+        reaches one behind the feet."""
         cfg = self.cfg
         on_ground = soles_on_ground(state)
         if cfg.recovery_double_stance_overrun <= 0.0 or not cfg.recovery_steps or not on_ground:
@@ -625,7 +628,33 @@ class MotionOptimizer:
             return True  # behind both feet: no step of his forwards catches it (his steps back, it steps first)
         if self._outside_since_s is None:
             self._outside_since_s = state.time_s
-        return state.time_s - self._outside_since_s >= cfg.recovery_double_stance_overrun * self._op_ds_s
+        if state.time_s - self._outside_since_s >= cfg.recovery_double_stance_overrun * self._op_ds_s:
+            return True
+        return cfg.recovery_ds_on_reach_limit and self._his_lift_off_too_late(tick, state, on_ground, quats)
+
+    def _his_lift_off_too_late(self, tick: _Tick, state: CharacterState, on_ground: list[str],
+                               quats: dict[str, np.ndarray]) -> bool:
+        """Whether a step begun at the operator's next lift-off (:meth:`_wait_for_his_lift_off_s`) would land with
+        the capture point out of a recovery step's reach whichever foot stands, while a recovery step begun now
+        captures it (recovery_step.out_of_reach_after_wait, RecoveryStepper.capture_residual_m; with one sole on
+        the ground, the first test alone). Waiting cannot be better then; where no step now captures it either, the
+        pendulum's prediction is no reason to step before him (the controller may still bring it back)."""
+        if not out_of_reach_after_wait(tick.com_c, tick.com_vel_c, self.g, tick.a_c, quats, on_ground,
+                                       self._wait_for_his_lift_off_s(tick, state), self.cfg.recovery_swing_s,
+                                       self.recovery.max_step_m):
+            return False
+        if len(on_ground) < 2:
+            return True
+        return min(self.recovery.capture_residual_m(tick.com_c, tick.com_vel_c, tick.a_c[s], quats[s], tick.R_root_d,
+                                                    _OTHER_SIDE[s]) for s in on_ground) <= 0.0
+
+    def _wait_for_his_lift_off_s(self, tick: _Tick, state: CharacterState) -> float:
+        """How long until the operator's next lift-off, on his usual timing [s]: the rest of his double stance, or
+        the rest of his swing and a double stance of his usual length."""
+        elapsed_s = state.time_s - self._op_state_t0_s
+        if tick.op_state is Stance.DS:
+            return max(self._op_ds_s - elapsed_s, 0.0)
+        return max(self._op_swing_s - elapsed_s, 0.0) + self._op_ds_s
 
     def _land_overrun_swing(self, tick: _Tick, state: CharacterState) -> None:
         """Step timing adapted to the balance: a swing that has lasted ``recovery_swing_overrun`` times the

@@ -86,6 +86,15 @@ def capture_point(com_world: np.ndarray, com_vel_world: np.ndarray, gravity_mps2
     return np.asarray(com_world, dtype=float)[:2] + np.asarray(com_vel_world, dtype=float)[:2] / omega, omega
 
 
+def _grown_from(x: float, y: float, polygon: list[tuple[float, float]], omega: float,
+                remaining_s: float) -> tuple[float, float]:
+    """A capture point (x, y) ``remaining_s`` later, the centre of pressure held at the polygon's point nearest to it:
+    ``ξ(t + τ) = p + (ξ(t) - p) e^(ω τ)`` (Eq. 21's pendulum) [m]."""
+    _, (px, py) = outside_distance_points((x, y), polygon)
+    grow = math.exp(omega * remaining_s)
+    return px + (x - px) * grow, py + (y - py) * grow
+
+
 def capture_point_after(com_world: np.ndarray, com_vel_world: np.ndarray, gravity_mps2: float,
                         stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray,
                         remaining_s: float) -> tuple[float, float]:
@@ -93,11 +102,26 @@ def capture_point_after(com_world: np.ndarray, com_vel_world: np.ndarray, gravit
     sole's point nearest to it: ``ξ(t + τ) = p + (ξ(t) - p) e^(ω τ)`` (Eq. 21's pendulum) [m]. On plain floats (model/
     sole.py's ``*_points``): it runs on every tick of an operator's swing."""
     xi, omega = capture_point(com_world, com_vel_world, gravity_mps2)
-    x, y = float(xi[0]), float(xi[1])
     polygon = convex_hull_points(sole_points_xy(stance_ankle_world, stance_foot_quat_wxyz, _SOLE_POINTS))
-    _, (px, py) = outside_distance_points((x, y), polygon)
-    grow = math.exp(omega * remaining_s)
-    return px + (x - px) * grow, py + (y - py) * grow
+    return _grown_from(float(xi[0]), float(xi[1]), polygon, omega, remaining_s)
+
+
+def out_of_reach_after_wait(com_world: np.ndarray, com_vel_world: np.ndarray, gravity_mps2: float,
+                            ankles_world: dict[str, np.ndarray], feet_quat_wxyz: dict[str, np.ndarray],
+                            on_ground: list[str], wait_s: float, swing_s: float, reach_m: float) -> bool:
+    """Whether a step begun ``wait_s`` from now lands too late, whichever foot it leaves standing: with the centre of
+    pressure held in the support polygon of the soles ``on_ground`` for ``wait_s``, then in the stance sole for the
+    swing's ``swing_s`` (each time at its point nearest to the capture point, Eq. 21's pendulum), the capture point
+    would end further than ``reach_m`` from every stance ankle. On plain floats."""
+    xi, omega = capture_point(com_world, com_vel_world, gravity_mps2)
+    soles = {s: convex_hull_points(sole_points_xy(ankles_world[s], feet_quat_wxyz[s], _SOLE_POINTS)) for s in on_ground}
+    support = convex_hull_points([p for s in on_ground for p in soles[s]])
+    x, y = _grown_from(float(xi[0]), float(xi[1]), support, omega, wait_s)
+    for s in on_ground:
+        lx, ly = _grown_from(x, y, soles[s], omega, swing_s)
+        if math.hypot(lx - float(ankles_world[s][0]), ly - float(ankles_world[s][1])) <= reach_m:
+            return False
+    return True
 
 
 def soles_on_ground(state: CharacterState) -> list[str]:
