@@ -4,6 +4,9 @@ added by one line (a hand-position task switched on by a flag)."""
 
 from __future__ import annotations
 
+import dataclasses
+from pathlib import Path
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -11,7 +14,7 @@ import pytest
 from stylesync import rotations as rot
 from stylesync.config import ControlConfig, OperatorConfig, SessionConfig, WholeBodyConfig, WorldConfig
 from stylesync.control.contacts import FORCES_PER_SOLE, SoleContact
-from stylesync.control.formulation import WholeBodyFormulation, hinge_limits
+from stylesync.control.formulation import INFINITY, WholeBodyFormulation, hinge_limits
 from stylesync.control.solver import DaqpSolver
 from stylesync.control.tasks import JointPostureTask, Task, TaskRows
 from stylesync.control.whole_body import _TORQUE_LIMIT_FLAT, HAND_REACH_SHARE
@@ -20,6 +23,8 @@ from stylesync.model.character_model import CharacterModel
 from stylesync.session import Session
 from stylesync.sim.pybullet_backend import PyBulletBackend
 from stylesync.sources.builtin_operator import builtin_operator
+
+MOCAP = Path(__file__).resolve().parents[2] / "shared" / "mocap"
 
 
 @pytest.fixture(scope="module")
@@ -122,6 +127,61 @@ def test_hinge_limits_bound_the_accelerations_that_keep_them_over_the_horizon(st
         assert lo[k] <= 0.0 <= hi[k]
     np.testing.assert_array_equal(problem.b, problem.lower[:problem.n_eq])
     np.testing.assert_array_equal(problem.upper[:problem.n_eq], problem.lower[:problem.n_eq])  # equalities
+
+
+def test_opening_a_problems_limits_opens_its_torque_and_hinge_rows_only(standing):
+    """What gives way when a QP has no feasible point: the torque rows and the hinges' rows are bounded by
+    ±INFINITY, every other bound (the root's equations, the soles' rows, their forces) stays, and the problem opened
+    is a copy. Its solution still obeys the equations of motion and the contacts."""
+    _, model = standing
+    limits = hinge_limits(model.joint_limits_rad)
+    formulation = WholeBodyFormulation(_TORQUE_LIMIT_FLAT, limits, 10.0, 0.05)
+    posture = formulation.add_task(JointPostureTask(10.0, 0.05))
+    posture.desired_accel = np.zeros(N_DOFS - ROOT_DOFS)
+    contacts = [SoleContact(s, 0.9, 45.0 * 9.8) for s in ("left", "right")]
+    problem = formulation.build(model, contacts)
+    lower, upper = problem.lower.copy(), problem.upper.copy()
+    opened = formulation.with_limits_opened(problem)
+    n_eq, n_tau, n_rows = problem.n_eq, N_DOFS - ROOT_DOFS, len(problem.lower)
+    changed = np.flatnonzero((opened.lower != problem.lower) | (opened.upper != problem.upper))
+    assert changed.tolist() == list(range(n_eq, n_eq + n_tau)) + list(range(n_rows - len(limits), n_rows))
+    assert np.all(opened.lower[changed] <= -INFINITY) and np.all(opened.upper[changed] >= INFINITY)
+    np.testing.assert_array_equal(problem.lower, lower)  # the problem itself is left as it was
+    np.testing.assert_array_equal(problem.upper, upper)
+    result = DaqpSolver().solve(opened)
+    assert result.solved
+    qdd, lam = result.x[:N_DOFS], result.x[N_DOFS:]
+    residual = model.mass_matrix @ qdd + model.bias_forces - np.hstack([c.generator for c in contacts]) @ lam
+    np.testing.assert_allclose(residual[:ROOT_DOFS], 0.0, atol=1e-6)
+    for c in contacts:
+        jac, acc = c.constraint_rows(10.0)
+        np.testing.assert_allclose(jac @ qdd, acc, atol=1e-6)
+
+
+@pytest.mark.skipif(not (MOCAP / "cmu-dev" / "07_11.bvh").exists(),
+                    reason="../shared/mocap/cmu-dev/07_11.bvh is not available")
+def test_a_qp_with_no_feasible_point_does_not_throw_the_limbs():
+    """CMU-dev 07_11 (a walk, seed 2): at 1.35 s a recovery step begins from a double stance with the feet 0.64 m
+    apart; the QP has no feasible point for four ticks (DAQP exit -1), and its last iterate, applied as torques,
+    threw the arms at 38 m/s: "the motion diverged" at 1.37 s with the pelvis at 0.77 m (measured). Solved again
+    with the torque and hinge limits opened, the walk completes."""
+    from stylesync.metrics.dev_suite import suite_config
+    from stylesync.sources.registry import open_source
+
+    spec = f"bvh:{MOCAP / 'cmu-dev' / '07_11.bvh'}"
+
+    def run(relax: bool):
+        opened = open_source(spec, seed=2, duration_s=12.0)
+        cfg, _ = suite_config(spec, opened, 2, 12.0)
+        control = ControlConfig(whole_body=WholeBodyConfig(relax_limits_when_infeasible=relax))
+        session = Session(dataclasses.replace(cfg, control=control), opened.source)
+        result = session.run()
+        opened.source.close()
+        return result, session.controller.relaxed_solves
+
+    (relaxed, count), (last_iterate, _) = run(True), run(False)
+    assert not relaxed.fell and count > 0
+    assert last_iterate.fell and "diverged" in last_iterate.fall_reason and last_iterate.fall_time_s < 1.5
 
 
 def test_warm_start_reaches_the_cold_solution(standing):

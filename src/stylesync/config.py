@@ -350,6 +350,12 @@ class WholeBodyConfig:
     # acceleration from the swing leg, whose foot then went back instead of forward (docs/decisions.md, "The pelvis
     # in single stance")
     single_stance_pelvis_share: float = 0.3
+    # A QP with no feasible point is solved again with the joint torque limits and the hinges' limit horizon opened
+    # (the torques are clipped to their limits afterwards, and the engine keeps the joints within theirs); the root's
+    # equations of motion and the soles' contact rows stay. A supporting leg stretched to its knee's limit closes a
+    # chain whose contact rows then ask for more than the limits allow, and the last iterate of the failed solve,
+    # applied as torques, threw the limbs at 30-40 m/s (docs/decisions.md, "A QP with no feasible point")
+    relax_limits_when_infeasible: bool = True
 
     def __post_init__(self) -> None:
         for n in ("joint_tracking_omega_rad_s", "joint_tracking_damping_ratio", "momentum_moment_weight_per_m",

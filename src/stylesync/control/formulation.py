@@ -169,6 +169,17 @@ class WholeBodyFormulation:
             upper[row:] = np.maximum(2.0 * (self._limit_upper - q - qd * t) / (t * t), 0.0)
         return QpProblem(h_mat, g, rows, lower, upper, n_eq, n_f)
 
+    def with_limits_opened(self, problem: QpProblem) -> QpProblem:
+        """A copy of ``problem`` without its joint torque limits and its hinges' limit horizon (those rows bounded by
+        ±INFINITY): what may give way when the problem has no feasible point. The root's equations of motion, the
+        soles' contact rows and their forces' bounds stay."""
+        lower, upper = problem.lower.copy(), problem.upper.copy()
+        n_tau = N_DOFS - ROOT_DOFS
+        lower[problem.n_eq:problem.n_eq + n_tau], upper[problem.n_eq:problem.n_eq + n_tau] = -INFINITY, INFINITY
+        if self.limits:
+            lower[-len(self.limits):], upper[-len(self.limits):] = -INFINITY, INFINITY
+        return QpProblem(problem.H, problem.g, problem.rows, lower, upper, problem.n_eq, problem.n_forces)
+
     @staticmethod
     def torques(model: CharacterModel, problem: QpProblem, x: np.ndarray) -> np.ndarray:
         """(n_joint_dofs,) joint torques of a solution: the joint rows of the equations of motion [N·m]."""

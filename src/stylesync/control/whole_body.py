@@ -97,6 +97,7 @@ class WholeBodyController(ControllerBase):
         self.wb = wb = cfg.whole_body
         self.model = model
         self._tau = Torques.zeros()  # held from one control tick to the next [N·m]
+        self.relaxed_solves = 0  # QPs with no feasible point solved again with their limits opened
         omega, zeta = wb.joint_tracking_omega_rad_s, wb.joint_tracking_damping_ratio
         self.kp, self.kd = omega * omega, 2.0 * zeta * omega
         self.formulation = WholeBodyFormulation(_TORQUE_LIMIT_FLAT, hinge_limits(model.joint_limits_rad),
@@ -213,6 +214,12 @@ class WholeBodyController(ControllerBase):
         self.posture.dof_scale = self._leg_share[tuple(support)]
         problem = self.formulation.build(model, contacts)
         result = self.solver.solve(problem)
+        if not result.solved and self.wb.relax_limits_when_infeasible:
+            failed = result.exitflag
+            result = self.solver.solve(self.formulation.with_limits_opened(problem))
+            self.relaxed_solves += 1
+            log.info("t=%.2f s: the whole-body QP found no optimum (DAQP exit %d); solved again with the torque and "
+                     "hinge limits opened (exit %d)", state.time_s, failed, result.exitflag)
         if not result.solved:
             log.warning("t=%.2f s: the whole-body QP found no optimum (DAQP exit %d); its last iterate is used",
                         state.time_s, result.exitflag)
