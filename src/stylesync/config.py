@@ -204,8 +204,8 @@ class MotionConfig:
     # comes too late for it; 0: off) [-]
     recovery_double_stance_overrun: float = 1.5
     # ... and at once when waiting for his next lift-off (the rest of his double stance, or the rest of his swing and a
-    # double stance of his usual length) and then a recovery step's swing would leave the capture point further from
-    # either stance ankle than a recovery step reaches, while a recovery step now captures it: the wait is his gait's,
+    # double stance of his usual length) and then a recovery step's swing would leave the capture point out of a
+    # recovery step's reach whichever foot stands, while a recovery step now captures it: the wait is his gait's,
     # and the character's capture point runs out of reach before it ends (with the overrun, off at 0;
     # docs/decisions.md, "A double stance that waits out of reach")
     recovery_ds_on_reach_limit: bool = True

@@ -18,6 +18,11 @@ The same parts as the paper's controller (controller.py), composed as tasks of o
 Why not Eq. 17-18 alone: they assume a static body and feet that push as asked. Measured with that mapping, the
 standing character toppled when it waved its arms and the walk fell within a second of its first step
 (docs/decisions.md). Adding a task is one class in ``tasks/`` and one ``add_task`` line in ``__init__``.
+
+A QP with no feasible point (a supporting leg stretched to its knee's limit can close a chain whose contact rows ask
+for more than the limits allow) is solved again with its torque and hinge limits opened
+(``WholeBodyFormulation.with_limits_opened``, WholeBodyConfig.relax_limits_when_infeasible): the torques are clipped
+to their limits as always, and the failed solve's last iterate is not applied.
 """
 
 from __future__ import annotations
