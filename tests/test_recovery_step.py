@@ -18,6 +18,7 @@ from stylesync.motion.recovery_step import (
     RecoveryStepper,
     beyond_sole_towards_m,
     capture_point,
+    not_across,
     operator_stands,
     out_of_reach_after_wait,
     soles_on_ground,
@@ -83,7 +84,13 @@ def test_a_capture_point_beyond_the_left_foot_lifts_the_right_foot_and_lands_it_
     landing, xi_land = stepper.capture_landing(0.3, com, vel, ANKLES["left"], IDENTITY, np.eye(3), "right")
     assert xi_land[0] > xi[0]  # it keeps diverging over the stance sole
     assert landing[0] > ANKLES["right"][0] + 0.1  # the right foot goes forward
-    assert landing[1] <= ANKLES["left"][1] - MIN_FOOT_SEPARATION_M + 1e-9  # never across the left foot
+    # Well ahead of the left foot (a crossover step's clearance), it may land nearer the left foot's line than
+    # MIN_FOOT_SEPARATION_M: the capture point is 6 cm inwards of the left ankle, and so is the landing.
+    assert landing[0] > ANKLES["left"][0] + stepper.cfg.recovery_cross_clear_m
+    assert ANKLES["left"][1] - MIN_FOOT_SEPARATION_M < landing[1] < ANKLES["left"][1]
+    never_across = RecoveryStepper(MotionConfig(recovery_cross_clear_m=None), CHAR_LEG_LENGTH_M, G)
+    landing_old, _ = never_across.capture_landing(0.3, com, vel, ANKLES["left"], IDENTITY, np.eye(3), "right")
+    assert landing_old[1] == pytest.approx(ANKLES["left"][1] - MIN_FOOT_SEPARATION_M)  # kept outwards
     reach_m = stepper.cfg.recovery_step_reach_share * CHAR_LEG_LENGTH_M
     assert np.linalg.norm(landing[:2] - ANKLES["left"][:2]) <= reach_m + 0.11
     assert stands_on(xi_land, ANKLES["left"], IDENTITY, landing, np.eye(3))
@@ -98,6 +105,24 @@ def test_a_capture_point_beyond_the_left_foot_lifts_the_right_foot_and_lands_it_
     wait_s = stepper.cfg.recovery_min_stance_s
     assert stepper.trigger(1.4 + 0.5 * wait_s, com, vel, ANKLES, QUATS, ["left", "right"]) is None
     assert stepper.trigger(1.4 + 1.5 * wait_s, com, vel, ANKLES, QUATS, ["left", "right"]) is not None
+
+
+def test_a_crossover_landing_needs_its_clearance_ahead_or_behind():
+    """Heading frame x forward, y left; the left foot stands at the origin and the right foot swings. Across the
+    left foot (y > -MIN_FOOT_SEPARATION_M) a landing stays only if it is at least the clearance ahead or behind;
+    beside the stance foot it is moved outwards, and with no clearance (None) always."""
+    stance = np.array([0.0, 0.0, ANKLE_HEIGHT_M])
+    across_ahead, across_beside = np.array([0.3, 0.2, ANKLE_HEIGHT_M]), np.array([0.05, 0.2, ANKLE_HEIGHT_M])
+    np.testing.assert_allclose(not_across(across_ahead, stance, np.eye(3), "right", 0.15), across_ahead)
+    behind = np.array([-0.2, 0.1, ANKLE_HEIGHT_M])
+    np.testing.assert_allclose(not_across(behind, stance, np.eye(3), "right", 0.15), behind)
+    moved = not_across(across_beside, stance, np.eye(3), "right", 0.15)
+    np.testing.assert_allclose(moved, [0.05, -MIN_FOOT_SEPARATION_M, ANKLE_HEIGHT_M])
+    np.testing.assert_allclose(not_across(across_ahead, stance, np.eye(3), "right", None),
+                               [0.3, -MIN_FOOT_SEPARATION_M, ANKLE_HEIGHT_M])
+    # the left foot swinging over a right stance: mirrored
+    np.testing.assert_allclose(not_across(-across_beside * [1, 1, -1], stance, np.eye(3), "left", 0.15)[1],
+                               MIN_FOOT_SEPARATION_M)
 
 
 def test_recovery_steps_can_be_switched_off():
@@ -146,16 +171,18 @@ PELVIS_LEVEL = ControlConfig(whole_body=WholeBodyConfig(single_stance_pelvis_sha
 TRACED_MOTION = {"recovery_step_reach_share": 0.6, "recovery_on_stopping_step": False,
                  "recovery_double_stance_overrun": 0.0, "liftoff_capture_behind_m": None, "foot_yaw_control": False,
                  "liftoff_shift_tolerance_m": None, "recovery_landing_without_swing": False,
-                 "landing_pelvis_floor_share": 0.0, "recovery_on_reach_limit": False, "recovery_min_stance_s": 0.1}
+                 "landing_pelvis_floor_share": 0.0, "recovery_on_reach_limit": False, "recovery_min_stance_s": 0.1,
+                 "recovery_cross_clear_m": None}
 # The scenarios traced before MotionConfig.foot_yaw_control run with the feet's twist left where it was (and the
 # weight shift from standing, the recovery steps' landing and the step timing as they were then; with the
 # controller, the recovery foot task off: NO_FOOT_TASK).
 NO_FOOT_TASK = ControlConfig(whole_body=WholeBodyConfig(recovery_foot_task_weight=0.0))
 TWIST_FREE = {"foot_yaw_control": False, "liftoff_shift_tolerance_m": None, "recovery_landing_without_swing": False,
               "landing_pelvis_floor_share": 0.0, "recovery_on_reach_limit": False, "recovery_min_stance_s": 0.1,
-              "recovery_ds_on_reach_limit": False}
-# The scenarios traced before the shorter double stance between recovery steps (MotionConfig.recovery_min_stance_s).
-WAIT_TRACED = {"recovery_min_stance_s": 0.1}
+              "recovery_ds_on_reach_limit": False, "recovery_cross_clear_m": None}
+# The scenarios traced before the shorter double stance between recovery steps (MotionConfig.recovery_min_stance_s)
+# and the crossover recovery steps (MotionConfig.recovery_cross_clear_m).
+WAIT_TRACED = {"recovery_min_stance_s": 0.1, "recovery_cross_clear_m": None}
 
 
 def _run(spec: str, seconds: float, motion: MotionConfig, seed: int = 0, control: ControlConfig | None = None):
@@ -417,14 +444,16 @@ def test_a_kick_waits_until_the_weight_is_over_the_stance_ankle_as_the_operators
     inner edge of its left sole (its COM still 9 cm inwards of the ankle), the character fell towards the kicking
     side at 2.4 s. Waiting (at most ``liftoff_weight_shift_s``) until its capture point is within 1 cm of its stance
     ankle, it kicks and stands through 5 s. (With the recovery steps that land, the early lift-off's fall comes later,
-    at 3.8 s, against 2.4 s before.)"""
+    at 3.8 s, against 2.4 s before. Traced before the crossover recovery steps, off here: they catch the early
+    lift-off's fall as well.)"""
     spec = "deepmimic:kick"
-    matched, _ = _run(spec, 5.0, MotionConfig())
-    edge_only, _ = _run(spec, 5.0, MotionConfig(liftoff_shift_tolerance_m=None))
+    then = {"recovery_cross_clear_m": None}
+    matched, _ = _run(spec, 5.0, MotionConfig(**then))
+    edge_only, _ = _run(spec, 5.0, MotionConfig(liftoff_shift_tolerance_m=None, **then))
     assert not matched.fell
     assert edge_only.fell
-    early, _ = _run(spec, 5.0, MotionConfig(liftoff_shift_tolerance_m=None, recovery_landing_without_swing=False),
-                    control=NO_FOOT_TASK)
+    early, _ = _run(spec, 5.0, MotionConfig(liftoff_shift_tolerance_m=None, recovery_landing_without_swing=False,
+                                            **then), control=NO_FOOT_TASK)
     assert early.fell and early.fall_time_s is not None and early.fall_time_s < 3.0
 
 
@@ -535,11 +564,13 @@ def test_a_rear_foot_stays_down_while_the_capture_point_is_behind_the_front_heel
     """CMU-dev 07_11, seed 4: the walker sets off from rest with his feet apart. The character, still at rest, lifted
     its rear foot with him while its capture point was behind its front heel: on the front foot alone it could
     only fall back (it fell in the clip on every seed). With the rear foot kept down (at most
-    ``liftoff_weight_shift_s``) until the capture point is over the front sole, it walks the clip (2.58 s)."""
+    ``liftoff_weight_shift_s``) until the capture point is over the front sole, it walks the clip (2.58 s). (Traced
+    before the crossover recovery steps, off here: they catch the lifted rear foot's fall as well.)"""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '07_11.bvh'}"
     clip_end_s = 2.58
-    kept, _ = _run(spec, clip_end_s, MotionConfig(), seed=4)
-    lifted, _ = _run(spec, clip_end_s, MotionConfig(liftoff_capture_behind_m=None), seed=4)
+    kept, _ = _run(spec, clip_end_s, MotionConfig(recovery_cross_clear_m=None), seed=4)
+    lifted, _ = _run(spec, clip_end_s, MotionConfig(liftoff_capture_behind_m=None, recovery_cross_clear_m=None),
+                     seed=4)
     assert not kept.fell
     assert lifted.fell and lifted.fall_time_s is not None and lifted.fall_time_s < clip_end_s
 
@@ -611,7 +642,8 @@ def test_a_double_stance_that_would_wait_out_of_reach_steps_at_once():
                     starts.append(step.start_s)
             return on_tick
 
-        result = _suite_run(spec, 1, MotionConfig(recovery_ds_on_reach_limit=on), ControlConfig(), watch=watch)
+        motion = MotionConfig(recovery_ds_on_reach_limit=on, recovery_cross_clear_m=None)  # traced without crossing
+        result = _suite_run(spec, 1, motion, ControlConfig(), watch=watch)
         return starts, result
 
     at_once, result = run(True)

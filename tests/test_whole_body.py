@@ -174,7 +174,8 @@ def test_a_qp_with_no_feasible_point_does_not_throw_the_limbs():
         opened = open_source(spec, seed=2, duration_s=12.0)
         cfg, _ = suite_config(spec, opened, 2, 12.0)
         control = ControlConfig(whole_body=WholeBodyConfig(relax_limits_when_infeasible=relax))
-        session = Session(dataclasses.replace(cfg, control=control), opened.source)
+        motion = dataclasses.replace(cfg.motion, recovery_cross_clear_m=None)  # traced before crossover steps
+        session = Session(dataclasses.replace(cfg, control=control, motion=motion), opened.source)
         result = session.run()
         opened.source.close()
         return result, session.controller.relaxed_solves

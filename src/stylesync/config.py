@@ -181,6 +181,12 @@ class MotionConfig:
     # as the leg needs, recovery_landing_reach): at 0.6 the steps that stop a walk landed short of the capture point,
     # and each left the body faster (docs/decisions.md, "Longer recovery steps") [-]
     recovery_step_reach_share: float = 0.75
+    # A recovery step may land across the stance foot (a crossover step) where its ankle lands at least this far ahead
+    # of or behind the stance ankle, in the heading frame; nearer, at least 1.2 hip half-widths outwards of it (None:
+    # never across). Kept on its own side, a swing foot could only land beside the stance foot when the capture point
+    # left the stance sole on the far side, and the other foot's step out came too late (docs/decisions.md,
+    # "Crossover recovery steps") [m]
+    recovery_cross_clear_m: float | None = 0.15
     # ... also while the operator is on one foot but the character, its step for his counted as taken (early
     # contact), stands on both and waits for his next change
     recovery_while_step_counted: bool = True
@@ -246,6 +252,8 @@ class MotionConfig:
                               f"got '{self.swing_placement}'")
         _positive("MotionConfig.stance_height_threshold_m", self.stance_height_threshold_m)
         _non_negative("MotionConfig.recovery_step_margin_m", self.recovery_step_margin_m)
+        if self.recovery_cross_clear_m is not None:
+            _non_negative("MotionConfig.recovery_cross_clear_m", self.recovery_cross_clear_m)
         if not 0.0 <= self.capture_bound_sole_share <= 1.0:
             raise ConfigError(f"MotionConfig.capture_bound_sole_share must be within [0, 1], got "
                               f"{self.capture_bound_sole_share}")

@@ -23,7 +23,10 @@ own:
   (``MotionConfig.recovery_landing_without_swing``): the leg's own swing, which the ground stops at the landing,
   would otherwise move the landing with the foot;
 * within the leg's reach (``MotionConfig.recovery_step_reach_share`` of its length from the stance ankle) and
-  never across the stance foot (at least ``MIN_FOOT_SEPARATION_M`` outwards of it, in the heading frame);
+  across the stance foot only as a crossover step, landing at least ``MotionConfig.recovery_cross_clear_m`` ahead of
+  or behind the stance ankle, and otherwise at least ``MIN_FOOT_SEPARATION_M`` outwards of it (heading frame): a
+  capture point that leaves the stance sole on the side away from the swing foot is caught by one step, as the
+  operator's own crossing steps catch it;
 * the foot rises ``recovery_step_height_m`` at mid-swing, follows a smooth step from its lift-off point to the
   landing, and after ``recovery_swing_s`` is lowered below the ground until it touches (the stance FSM ends the
   step on its contact); the whole-body controller tracks that target with a task of its own
@@ -194,14 +197,16 @@ def stands_on(xi_world: np.ndarray, stance_ankle_world: np.ndarray, stance_foot_
 
 
 def not_across(landing_world: np.ndarray, stance_ankle_world: np.ndarray, heading_world: np.ndarray,
-               side: str) -> np.ndarray:
+               side: str, cross_clear_m: float | None = None) -> np.ndarray:
     """(3,) a swing ankle's landing moved sideways, if needed, to at least ``MIN_FOOT_SEPARATION_M`` outwards of
-    the stance ankle in the heading frame (``heading_world``: (3, 3), x forward, y left): a foot landing across
-    the stance foot leaves the body's weight outside the new stance and the legs crossed."""
+    the stance ankle in the heading frame (``heading_world``: (3, 3), x forward, y left), unless it lands at least
+    ``cross_clear_m`` ahead of or behind the stance ankle (a crossover step, its foot clear of the stance foot; None:
+    never across). A foot landing across the stance foot beside it would land on it."""
     base = np.array([stance_ankle_world[0], stance_ankle_world[1], 0.0])
     rel = heading_world.T @ (np.array([landing_world[0], landing_world[1], 0.0]) - base)
     out = _OUT[side]
-    rel[1] = out * max(out * rel[1], MIN_FOOT_SEPARATION_M)
+    if cross_clear_m is None or abs(rel[0]) < cross_clear_m:
+        rel[1] = out * max(out * rel[1], MIN_FOOT_SEPARATION_M)
     landing = base + heading_world @ rel
     landing[2] = landing_world[2]
     return landing
@@ -287,7 +292,8 @@ class RecoveryStepper:
                         stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray, heading_world: np.ndarray,
                         side: str) -> tuple[np.ndarray, np.ndarray]:
         """Where the ``side`` ankle lands (3,) so that the capture point, ``remaining_s`` from now, is on the
-        trailing edge of its sole (within reach, not across the stance foot), and that capture point (2,) [m].
+        trailing edge of its sole (within reach, across the stance foot only as a crossover step), and that capture
+        point (2,) [m].
         ``heading_world``: (3, 3) the heading frame's rotation (x forward, y left)."""
         xi, omega = capture_point(com_world, com_vel_world, self.g)
         _, cop = outside_distance_m(xi, convex_hull_xy(sole_corners_world(stance_ankle_world,
@@ -303,14 +309,15 @@ class RecoveryStepper:
         half_extent = abs(u_heading[0]) * FOOT_LENGTH_M / 2 + abs(u_heading[1]) * FOOT_WIDTH_M / 2
         centre = np.array([xi_land[0], xi_land[1], 0.0]) + half_extent * u
         ankle = centre - R @ np.array([FOOT_CENTER_AHEAD_OF_ANKLE_M, 0.0, 0.0])
-        # Within reach, and never across the stance foot (heading frame, relative to the stance ankle).
+        # Within reach, and across the stance foot only as a crossover step (heading frame, relative to the stance
+        # ankle).
         base = np.array([stance_ankle_world[0], stance_ankle_world[1], 0.0])
         rel = R.T @ (ankle - base)
         rel[2] = 0.0
         length = float(np.linalg.norm(rel[:2]))
         if length > self.max_step_m:
             rel[:2] *= self.max_step_m / length
-        landing = not_across(base + R @ rel, stance_ankle_world, R, side)
+        landing = not_across(base + R @ rel, stance_ankle_world, R, side, self.cfg.recovery_cross_clear_m)
         landing[2] = ANKLE_HEIGHT_M
         return landing, xi_land
 
