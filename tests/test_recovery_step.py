@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import suite_run
 
 from stylesync.config import ControlConfig, MotionConfig, OperatorConfig, SessionConfig, WholeBodyConfig
 from stylesync.model.character import ANKLE_HEIGHT_M, FOOT_CENTER_AHEAD_OF_ANKLE_M, FOOT_LENGTH_M
@@ -643,7 +644,7 @@ def test_a_double_stance_that_would_wait_out_of_reach_steps_at_once():
             return on_tick
 
         motion = MotionConfig(recovery_ds_on_reach_limit=on, recovery_cross_clear_m=None)  # traced without crossing
-        result = _suite_run(spec, 1, motion, ControlConfig(), watch=watch)
+        result = suite_run(spec, 1, motion, ControlConfig(), watch=watch)
         return starts, result
 
     at_once, result = run(True)
@@ -695,26 +696,6 @@ def test_the_com_velocity_with_a_leg_carried_leaves_out_only_the_legs_own_motion
     assert np.allclose(mass.com_velocity_carried(state, leg, root), [0.5, -0.2, 0.1])  # type: ignore[arg-type]
 
 
-def _suite_run(spec: str, seed: int, motion: MotionConfig, control: ControlConfig, on_tick=None, watch=None):
-    """One development-suite run of ``spec`` (its configuration and source as the suite opens them) with ``motion``
-    and ``control``. ``on_tick(state, ref)`` is called each control tick; or ``watch(session)`` returns that
-    callback, for one that reads the session itself."""
-    from stylesync.metrics.dev_suite import suite_config
-    from stylesync.session import Session
-    from stylesync.sources.registry import open_source
-
-    opened = open_source(spec, seed=seed, duration_s=12.0)
-    cfg, _ = suite_config(spec, opened, seed, 12.0)
-    session = Session(dataclasses.replace(cfg, motion=motion, control=control), opened.source)
-    if watch is not None:
-        on_tick = watch(session)
-    if on_tick is not None:
-        session.on_tick = on_tick
-    result = session.run()
-    opened.source.close()
-    return result
-
-
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "09_06.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/09_06.bvh is not available")
@@ -736,7 +717,7 @@ def test_the_swing_foot_of_a_recovery_step_follows_its_target():
                 raise _Stop
 
         try:
-            _suite_run(spec, 0, MotionConfig(landing_pelvis_floor_share=0.0, recovery_on_reach_limit=False), control,
+            suite_run(spec, 0, MotionConfig(landing_pelvis_floor_share=0.0, recovery_on_reach_limit=False), control,
                        on_tick)
         except _Stop:
             pass
@@ -758,8 +739,8 @@ def test_recovery_steps_that_land_where_the_body_will_be_keep_a_walk_on_rough_gr
     """CMU-dev 03_02 (walking over uneven ground, seed 1) fell 2.2 s in with the recovery step's foot driven by the
     joint posture alone and its landing planned on the capture point its own swing moved (measured)."""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '03_02.bvh'}"
-    assert not _suite_run(spec, 1, MotionConfig(**WAIT_TRACED), ControlConfig()).fell
-    old = _suite_run(spec, 1, MotionConfig(recovery_landing_without_swing=False, **WAIT_TRACED), NO_FOOT_TASK)
+    assert not suite_run(spec, 1, MotionConfig(**WAIT_TRACED), ControlConfig()).fell
+    old = suite_run(spec, 1, MotionConfig(recovery_landing_without_swing=False, **WAIT_TRACED), NO_FOOT_TASK)
     assert old.fell
 
 
@@ -785,7 +766,7 @@ def test_a_landing_foot_out_of_reach_does_not_put_the_pelvis_target_on_the_groun
             if 2.1 <= state.time_s <= 2.45:
                 heights.append(float(ref.pelvis_world[2]))
 
-        result = _suite_run("deepmimic:kick", 1, motion, ControlConfig(), on_tick)
+        result = suite_run("deepmimic:kick", 1, motion, ControlConfig(), on_tick)
         assert len(heights) > 20
         return min(heights), result.fell
 
@@ -819,7 +800,7 @@ def test_a_swing_that_would_land_out_of_reach_is_landed_by_the_balance():
                     sink.append(float(ref.pelvis_world[2] - state.root_pos_world[2]))
             return on_tick
 
-        result = _suite_run(spec, 1, MotionConfig(recovery_on_reach_limit=flag, recovery_ds_on_reach_limit=False),
+        result = suite_run(spec, 1, MotionConfig(recovery_on_reach_limit=flag, recovery_ds_on_reach_limit=False),
                             ControlConfig(), watch=watch)
         return taken, max(sink), result.fall_time_s or 12.0
 
@@ -852,7 +833,7 @@ def test_the_next_recovery_step_begins_while_both_soles_are_down():
                     steps.append((step.start_s, step.side, len(soles_on_ground(state))))
             return on_tick
 
-        result = _suite_run(spec, 2, MotionConfig(recovery_min_stance_s=wait_s), ControlConfig(), watch=watch)
+        result = suite_run(spec, 2, MotionConfig(recovery_min_stance_s=wait_s), ControlConfig(), watch=watch)
         return [x for x in steps if 3.49 < x[0] < 3.7], result
 
     after, result = run(MotionConfig().recovery_min_stance_s)

@@ -4,15 +4,15 @@ added by one line (a hand-position task switched on by a flag)."""
 
 from __future__ import annotations
 
-import dataclasses
 from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 import pytest
+from conftest import suite_run
 
 from stylesync import rotations as rot
-from stylesync.config import ControlConfig, OperatorConfig, SessionConfig, WholeBodyConfig, WorldConfig
+from stylesync.config import ControlConfig, MotionConfig, OperatorConfig, SessionConfig, WholeBodyConfig, WorldConfig
 from stylesync.control.contacts import FORCES_PER_SOLE, SoleContact
 from stylesync.control.formulation import INFINITY, WholeBodyFormulation, hinge_limits
 from stylesync.control.solver import DaqpSolver
@@ -165,20 +165,19 @@ def test_a_qp_with_no_feasible_point_does_not_throw_the_limbs():
     apart; the QP has no feasible point for four ticks (DAQP exit -1), and its last iterate, applied as torques,
     threw the arms at 38 m/s: "the motion diverged" at 1.37 s with the pelvis at 0.77 m (measured). Solved again
     with the torque and hinge limits opened, the walk completes."""
-    from stylesync.metrics.dev_suite import suite_config
-    from stylesync.sources.registry import open_source
-
     spec = f"bvh:{MOCAP / 'cmu-dev' / '07_11.bvh'}"
 
     def run(relax: bool):
-        opened = open_source(spec, seed=2, duration_s=12.0)
-        cfg, _ = suite_config(spec, opened, 2, 12.0)
+        sessions = []
+
+        def watch(session):
+            sessions.append(session)
+            return None
+
         control = ControlConfig(whole_body=WholeBodyConfig(relax_limits_when_infeasible=relax))
-        motion = dataclasses.replace(cfg.motion, recovery_cross_clear_m=None)  # traced before crossover steps
-        session = Session(dataclasses.replace(cfg, control=control, motion=motion), opened.source)
-        result = session.run()
-        opened.source.close()
-        return result, session.controller.relaxed_solves
+        motion = MotionConfig(recovery_cross_clear_m=None)  # traced before the crossover steps
+        result = suite_run(spec, 2, motion, control, watch=watch)
+        return result, sessions[0].controller.relaxed_solves
 
     (relaxed, count), (last_iterate, _) = run(True), run(False)
     assert not relaxed.fell and count > 0
