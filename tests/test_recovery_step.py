@@ -11,6 +11,7 @@ import pytest
 from conftest import suite_run
 
 from stylesync.config import ControlConfig, MotionConfig, OperatorConfig, SessionConfig, WholeBodyConfig
+from stylesync.errors import ConfigError
 from stylesync.model.character import ANKLE_HEIGHT_M, FOOT_CENTER_AHEAD_OF_ANKLE_M, FOOT_LENGTH_M
 from stylesync.model.sole import convex_hull_xy, outside_distance_m, sole_corners_world
 from stylesync.motion.pose_optimization import CHAR_LEG_LENGTH_M
@@ -96,7 +97,7 @@ def test_a_capture_point_beyond_the_left_foot_lifts_the_right_foot_and_lands_it_
     assert np.linalg.norm(landing[:2] - ANKLES["left"][:2]) <= reach_m + 0.11
     assert stands_on(xi_land, ANKLES["left"], IDENTITY, landing, np.eye(3))
     # The swing trajectory: rises mid-swing, then is aimed below the ground until it touches.
-    mid = stepper.swing_target(1.15, com, vel, ANKLES["left"], IDENTITY, np.eye(3))
+    mid = stepper.swing_target(1.1, com, vel, ANKLES["left"], IDENTITY, np.eye(3))
     assert mid[2] > ANKLE_HEIGHT_M + 0.03
     late = stepper.swing_target(1.4, com, vel, ANKLES["left"], IDENTITY, np.eye(3))
     assert late[2] < ANKLE_HEIGHT_M and np.allclose(late[:2], step.landing_world[:2])
@@ -173,17 +174,18 @@ TRACED_MOTION = {"recovery_step_reach_share": 0.6, "recovery_on_stopping_step": 
                  "recovery_double_stance_overrun": 0.0, "liftoff_capture_behind_m": None, "foot_yaw_control": False,
                  "liftoff_shift_tolerance_m": None, "recovery_landing_without_swing": False,
                  "landing_pelvis_floor_share": 0.0, "recovery_on_reach_limit": False, "recovery_min_stance_s": 0.1,
-                 "recovery_cross_clear_m": None}
+                 "recovery_cross_clear_m": None, "recovery_touchdown_share": 1.0}
 # The scenarios traced before MotionConfig.foot_yaw_control run with the feet's twist left where it was (and the
 # weight shift from standing, the recovery steps' landing and the step timing as they were then; with the
 # controller, the recovery foot task off: NO_FOOT_TASK).
 NO_FOOT_TASK = ControlConfig(whole_body=WholeBodyConfig(recovery_foot_task_weight=0.0))
 TWIST_FREE = {"foot_yaw_control": False, "liftoff_shift_tolerance_m": None, "recovery_landing_without_swing": False,
               "landing_pelvis_floor_share": 0.0, "recovery_on_reach_limit": False, "recovery_min_stance_s": 0.1,
-              "recovery_ds_on_reach_limit": False, "recovery_cross_clear_m": None}
-# The scenarios traced before the shorter double stance between recovery steps (MotionConfig.recovery_min_stance_s)
-# and the crossover recovery steps (MotionConfig.recovery_cross_clear_m).
-WAIT_TRACED = {"recovery_min_stance_s": 0.1, "recovery_cross_clear_m": None}
+              "recovery_ds_on_reach_limit": False, "recovery_cross_clear_m": None, "recovery_touchdown_share": 1.0}
+# The scenarios traced before the shorter double stance between recovery steps (MotionConfig.recovery_min_stance_s),
+# the crossover recovery steps (MotionConfig.recovery_cross_clear_m) and the earlier touchdown of a recovery step's
+# foot (MotionConfig.recovery_touchdown_share).
+WAIT_TRACED = {"recovery_min_stance_s": 0.1, "recovery_cross_clear_m": None, "recovery_touchdown_share": 1.0}
 
 
 def _run(spec: str, seconds: float, motion: MotionConfig, seed: int = 0, control: ControlConfig | None = None):
@@ -643,7 +645,8 @@ def test_a_double_stance_that_would_wait_out_of_reach_steps_at_once():
                     starts.append(step.start_s)
             return on_tick
 
-        motion = MotionConfig(recovery_ds_on_reach_limit=on, recovery_cross_clear_m=None)  # traced without crossing
+        # traced without crossing, and with the touchdown at the swing's end
+        motion = MotionConfig(recovery_ds_on_reach_limit=on, recovery_cross_clear_m=None, recovery_touchdown_share=1.0)
         result = suite_run(spec, 1, motion, ControlConfig(), watch=watch)
         return starts, result
 
@@ -745,8 +748,6 @@ def test_recovery_steps_that_land_where_the_body_will_be_keep_a_walk_on_rough_gr
 
 
 def test_the_pelvis_floor_share_is_checked():
-    from stylesync.errors import ConfigError
-
     with pytest.raises(ConfigError):
         MotionConfig(landing_pelvis_floor_share=1.5)
     with pytest.raises(ConfigError):
@@ -842,3 +843,51 @@ def test_the_next_recovery_step_begins_while_both_soles_are_down():
     assert after and after[0][1] == "left" and after[0][2] == 2 and after[0][0] < 3.55
     assert after_old and after_old[0][1] == "right" and after_old[0][2] == 1 and after_old[0][0] > 3.58
     assert result_old.fell and not result.fell
+
+
+def test_the_swing_target_is_back_at_the_ground_by_the_touchdown_share():
+    com, vel = np.array([0.1, 0.03, 0.8]), np.array([0.45, 0.05, 0.0])
+    heights = {}
+    for share in (0.9, 1.0):
+        stepper = RecoveryStepper(MotionConfig(recovery_touchdown_share=share), CHAR_LEG_LENGTH_M, G)
+        stepper.trigger(1.0, com, vel, ANKLES, QUATS, ["left", "right"])
+        swing_s = stepper.cfg.recovery_swing_s
+        heights[share] = [stepper.swing_target(1.0 + phase * swing_s, com, vel, ANKLES["left"], IDENTITY,
+                                               np.eye(3))[2] for phase in (0.45, 0.5, 0.95)]
+    assert heights[1.0][1] == pytest.approx(ANKLE_HEIGHT_M + MotionConfig().recovery_step_height_m)  # top at 0.5
+    assert heights[0.9][0] == pytest.approx(ANKLE_HEIGHT_M + MotionConfig().recovery_step_height_m)  # at 0.45
+    assert heights[1.0][2] > ANKLE_HEIGHT_M  # still coming down
+    assert heights[0.9][2] < ANKLE_HEIGHT_M  # down already, aimed below the ground
+    with pytest.raises(ConfigError):
+        MotionConfig(recovery_touchdown_share=0.0)
+
+
+@pytest.mark.skipif(not (MOCAP / "cmu-dev" / "07_11.bvh").exists(),
+                    reason="../shared/mocap/cmu-dev/07_11.bvh is not available")
+def test_recovery_steps_that_touch_down_on_time_stop_a_walk():
+    """CMU-dev 07_11 (a walk, seed 2) stops in the rest after its clip (from 2.58 s) with steps of its own. With the
+    foot target at the ground only at the swing's end, the feet trailed it and touched down late (the steps lasted
+    0.23-0.25 s against the nominal 0.2 s), the capture point ran on beyond the planned landings, and the walk fell at
+    2.78 s (measured). Brought down by 0.9 of the swing, the feet touch down near its end, and the walk comes to
+    rest."""
+    spec = f"bvh:{MOCAP / 'cmu-dev' / '07_11.bvh'}"
+
+    def run(share: float):
+        durations: list[float] = []
+        started: list[float] = []
+
+        def on_tick(state, ref):
+            if ref.recovery_ankle_world and not started:
+                started.append(state.time_s)
+            elif not ref.recovery_ankle_world and started:
+                durations.append(state.time_s - started.pop())
+
+        result = suite_run(spec, 2, MotionConfig(recovery_touchdown_share=share), ControlConfig(), on_tick)
+        return durations, result
+
+    durations, result = run(0.9)
+    durations_late, result_late = run(1.0)
+    assert durations and durations_late
+    assert float(np.median(durations)) < float(np.median(durations_late))
+    assert not result.fell
+    assert result_late.fell and result_late.fall_time_s is not None and result_late.fall_time_s > 2.58  # in the rest

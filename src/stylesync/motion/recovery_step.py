@@ -28,9 +28,10 @@ own:
   capture point that leaves the stance sole on the side away from the swing foot is caught by one step, as the
   operator's own crossing steps catch it;
 * the foot rises ``recovery_step_height_m`` at mid-swing, follows a smooth step from its lift-off point to the
-  landing, and after ``recovery_swing_s`` is lowered below the ground until it touches (the stance FSM ends the
-  step on its contact); the whole-body controller tracks that target with a task of its own
-  (``ReferencePose.recovery_ankle_world``).
+  landing, is back at the ground at ``recovery_touchdown_share`` of ``recovery_swing_s`` (it trails its target: so
+  it touches down near the swing's end, when its landing is planned for) and is then lowered below the ground until
+  it touches (the stance FSM ends the step on its contact); the whole-body controller tracks that target with a
+  task of its own (``ReferencePose.recovery_ankle_world``).
 
 The step's timing is the nominal swing time; its position is what adapts, each tick, to the capture point. A
 swing of the operator's that he holds up too long while the character cannot stand on one foot, or that would land
@@ -338,8 +339,11 @@ class RecoveryStepper:
         if phase < 1.0 and step.taken_over:
             # Already in the air: lowered from where it is to the ground by the time it is over the landing.
             target[2] = step.lift_off_world[2] + moved * (ANKLE_HEIGHT_M - step.lift_off_world[2])
-        elif phase < 1.0:
-            target[2] = ANKLE_HEIGHT_M + cfg.recovery_step_height_m * np.sin(np.pi * phase)
+        elif phase < cfg.recovery_touchdown_share:
+            # Up and down again by the touchdown share of the swing: the foot trails its target, and reaches the
+            # ground near the swing's end, when the landing is planned for.
+            touchdown = phase / cfg.recovery_touchdown_share
+            target[2] = ANKLE_HEIGHT_M + cfg.recovery_step_height_m * np.sin(np.pi * touchdown)
         else:
             target[2] = ANKLE_HEIGHT_M - LANDING_PRESS_M
         return target
