@@ -866,9 +866,9 @@ def test_the_swing_target_is_back_at_the_ground_by_the_touchdown_share():
                     reason="../shared/mocap/cmu-dev/07_11.bvh is not available")
 def test_recovery_steps_that_touch_down_on_time_stop_a_walk():
     """CMU-dev 07_11 (a walk, seed 2) stops in the rest after its clip (from 2.58 s) with steps of its own. With the
-    foot target at the ground only at the swing's end, the feet trailed it and touched down late (the steps lasted
-    0.23-0.25 s against the nominal 0.2 s), the capture point ran on beyond the planned landings, and the walk fell at
-    2.78 s (measured). Brought down by 0.9 of the swing, the feet touch down near its end, and the walk comes to
+    foot target at the ground only at the swing's end, the feet trailed it and touched down late (its three recovery
+    steps lasted 0.32, 0.60 and 0.23 s against the nominal 0.2 s), and the walk fell at 2.78 s (measured). Brought
+    down by 0.9 of the swing, the feet touch down sooner (five steps, 0.23 s at the median), and the walk comes to
     rest."""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '07_11.bvh'}"
 
