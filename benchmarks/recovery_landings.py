@@ -28,7 +28,7 @@ from stylesync.session import Session
 from stylesync.sources.registry import open_source
 
 MOCAP = Path(__file__).resolve().parents[2] / "shared" / "mocap"
-CLIPS = ("131_01,131_02,08_07,stealthy_walk,zombie_walk,07_11,08_08,10_04,09_06,09_11,jog,run,131_03,dance_b")
+CLIPS = "131_01,131_02,08_07,stealthy_walk,zombie_walk,07_11,08_08,10_04,09_06,09_11,jog,run,131_03,dance_b"
 DURATION_BINS_S = (0.0, 0.22, 0.25, 0.3, np.inf)
 
 
@@ -39,24 +39,25 @@ def watch_steps(session: Session) -> list[dict]:
     steps: list[dict] = []
     plan_target, plan_end = stepper.swing_target, stepper.end
 
+    record: dict = {}  # the step under way (its object, its first capture point and predicted landing one)
+
     def swing_target(time_s, com_world, com_vel_world, stance_ankle_world, stance_foot_quat_wxyz, heading_world):
         step = stepper.step
         elapsed_s = time_s - step.start_s
-        remaining_s = max(stepper.cfg.recovery_swing_s - elapsed_s, 0.0)
-        _, xi_land = stepper.capture_landing(remaining_s, com_world, com_vel_world, stance_ankle_world,
-                                             stance_foot_quat_wxyz, heading_world, step.side)
         xi, _ = capture_point(com_world, com_vel_world, stepper.g)
-        record = getattr(step, "_landing_record", None)
-        if record is None:
-            record = step._landing_record = {"taken_over": step.taken_over, "xi0": xi[:2].copy(),
-                                             "predicted": np.asarray(xi_land[:2], dtype=float).copy()}
+        if record.get("step") is not step:  # its first tick: where the landing is planned for
+            remaining_s = max(stepper.cfg.recovery_swing_s - elapsed_s, 0.0)
+            _, xi_land = stepper.capture_landing(remaining_s, com_world, com_vel_world, stance_ankle_world,
+                                                 stance_foot_quat_wxyz, heading_world, step.side)
+            record.clear()
+            record.update(step=step, taken_over=step.taken_over, xi0=xi[:2].copy(),
+                          predicted=np.asarray(xi_land[:2], dtype=float).copy())
         record["xi"], record["elapsed_s"] = xi[:2].copy(), elapsed_s
         return plan_target(time_s, com_world, com_vel_world, stance_ankle_world, stance_foot_quat_wxyz,
                            heading_world)
 
     def end(time_s):
-        record = getattr(stepper.step, "_landing_record", None) if stepper.step is not None else None
-        if record is not None:
+        if stepper.step is not None and record.get("step") is stepper.step:
             travel = record["predicted"] - record["xi0"]
             norm = float(np.linalg.norm(travel))
             direction = travel / norm if norm > 1e-6 else np.zeros(2)
