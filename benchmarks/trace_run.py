@@ -19,6 +19,8 @@ a recorded file started in its first pose and held for the rest after its end. C
     F asked    the COM task's horizontal force (Eq. 16 with the LIPM term, limited to what the support can give) [N]
     m a        the horizontal force the body actually took (mass times the COM's acceleration between ticks) [N]
     fL fR      the soles' normal forces [N]
+    --yaw      the headings [deg]: the reference's root (``ref``), the character's pelvis (``ch``) and feet (``ftL``,
+               ``ftR``)
 """
 
 from __future__ import annotations
@@ -29,6 +31,8 @@ import logging
 from pathlib import Path
 
 import numpy as np
+
+from stylesync import rotations as rot
 
 from stylesync.metrics.dev_suite import clip_specs, suite_config
 from stylesync.model.character import LINK_NAMES
@@ -62,6 +66,8 @@ def main() -> None:
     ap.add_argument("--every", type=int, default=6, help="print every this many control ticks (and each change "
                                                           "of stance)")
     ap.add_argument("--feet", action="store_true", help="also print the ankles' horizontal positions [m]")
+    ap.add_argument("--yaw", action="store_true", help="also print the headings of the reference's root, the "
+                                                        "character's pelvis and its feet [deg]")
     ap.add_argument("--past-fall", action="store_true", help="run on after the first fall (to see what follows it)")
     args = ap.parse_args()
     logging.disable(logging.WARNING)
@@ -106,7 +112,11 @@ def main() -> None:
               f"({taken[0]:+4.0f},{taken[1]:+4.0f}) {fl:5.0f} {fr:5.0f}"
               + ("".join(f" {s[0]}({state.link_origin_world[_ANKLE[s]][0]:+5.2f},"
                          f"{state.link_origin_world[_ANKLE[s]][1]:+5.2f})" for s in ("left", "right"))
-                 if args.feet else ""))
+                 if args.feet else "")
+              + (" yaw ref {:+5.0f} ch {:+5.0f} ftL {:+5.0f} ftR {:+5.0f}".format(
+                  *np.degrees([rot.yaw_from_quat(ref.root_quat_wxyz), rot.yaw_from_quat(state.root_quat_wxyz),
+                               *(rot.yaw_from_quat(state.link_quat_wxyz[_ANKLE[s]]) for s in ("left", "right"))]))
+                 if args.yaw else ""))
 
     session.on_tick = on_tick
     try:
