@@ -33,7 +33,6 @@ from pathlib import Path
 import numpy as np
 
 from stylesync import rotations as rot
-
 from stylesync.metrics.dev_suite import clip_specs, suite_config
 from stylesync.model.character import LINK_NAMES
 from stylesync.model.sole import convex_hull_xy, outside_distance_m, sole_corners_world
