@@ -12,7 +12,7 @@ from conftest import suite_run
 
 from stylesync.config import ControlConfig, MotionConfig, OperatorConfig, SessionConfig, WholeBodyConfig
 from stylesync.errors import ConfigError
-from stylesync.model.character import ANKLE_HEIGHT_M, FOOT_CENTER_AHEAD_OF_ANKLE_M, FOOT_LENGTH_M
+from stylesync.model.character import ANKLE_HEIGHT_M, FOOT_CENTER_AHEAD_OF_ANKLE_M, FOOT_LENGTH_M, LINK_NAMES
 from stylesync.model.sole import convex_hull_xy, outside_distance_m, sole_corners_world
 from stylesync.motion.pose_optimization import CHAR_LEG_LENGTH_M
 from stylesync.motion.recovery_step import (
@@ -174,18 +174,20 @@ TRACED_MOTION = {"recovery_step_reach_share": 0.6, "recovery_on_stopping_step": 
                  "recovery_double_stance_overrun": 0.0, "liftoff_capture_behind_m": None, "foot_yaw_control": False,
                  "liftoff_shift_tolerance_m": None, "recovery_landing_without_swing": False,
                  "landing_pelvis_floor_share": 0.0, "recovery_on_reach_limit": False, "recovery_min_stance_s": 0.1,
-                 "recovery_cross_clear_m": None, "recovery_touchdown_share": 1.0}
+                 "recovery_cross_clear_m": None, "recovery_touchdown_share": 1.0, "recovery_landing_gap_m": None}
 # The scenarios traced before MotionConfig.foot_yaw_control run with the feet's twist left where it was (and the
 # weight shift from standing, the recovery steps' landing and the step timing as they were then; with the
 # controller, the recovery foot task off: NO_FOOT_TASK).
 NO_FOOT_TASK = ControlConfig(whole_body=WholeBodyConfig(recovery_foot_task_weight=0.0))
 TWIST_FREE = {"foot_yaw_control": False, "liftoff_shift_tolerance_m": None, "recovery_landing_without_swing": False,
               "landing_pelvis_floor_share": 0.0, "recovery_on_reach_limit": False, "recovery_min_stance_s": 0.1,
-              "recovery_ds_on_reach_limit": False, "recovery_cross_clear_m": None, "recovery_touchdown_share": 1.0}
+              "recovery_ds_on_reach_limit": False, "recovery_cross_clear_m": None, "recovery_touchdown_share": 1.0,
+              "recovery_landing_gap_m": None}
 # The scenarios traced before the shorter double stance between recovery steps (MotionConfig.recovery_min_stance_s),
-# the crossover recovery steps (MotionConfig.recovery_cross_clear_m) and the earlier touchdown of a recovery step's
-# foot (MotionConfig.recovery_touchdown_share).
-WAIT_TRACED = {"recovery_min_stance_s": 0.1, "recovery_cross_clear_m": None, "recovery_touchdown_share": 1.0}
+# the crossover recovery steps (MotionConfig.recovery_cross_clear_m), the earlier touchdown of a recovery step's
+# foot (MotionConfig.recovery_touchdown_share) and its landing on a corner (MotionConfig.recovery_landing_gap_m).
+WAIT_TRACED = {"recovery_min_stance_s": 0.1, "recovery_cross_clear_m": None, "recovery_touchdown_share": 1.0,
+               "recovery_landing_gap_m": None}
 
 
 def _run(spec: str, seconds: float, motion: MotionConfig, seed: int = 0, control: ControlConfig | None = None):
@@ -646,7 +648,8 @@ def test_a_double_stance_that_would_wait_out_of_reach_steps_at_once():
             return on_tick
 
         # traced without crossing, and with the touchdown at the swing's end
-        motion = MotionConfig(recovery_ds_on_reach_limit=on, recovery_cross_clear_m=None, recovery_touchdown_share=1.0)
+        motion = MotionConfig(recovery_ds_on_reach_limit=on, recovery_cross_clear_m=None, recovery_touchdown_share=1.0,
+                              recovery_landing_gap_m=None)
         result = suite_run(spec, 1, motion, ControlConfig(), watch=watch)
         return starts, result
 
@@ -882,7 +885,8 @@ def test_recovery_steps_that_touch_down_on_time_stop_a_walk():
             elif not ref.recovery_ankle_world and started:
                 durations.append(state.time_s - started.pop())
 
-        result = suite_run(spec, 2, MotionConfig(recovery_touchdown_share=share), ControlConfig(), on_tick)
+        result = suite_run(spec, 2, MotionConfig(recovery_touchdown_share=share, recovery_landing_gap_m=None),
+                           ControlConfig(), on_tick)
         return durations, result
 
     durations, result = run(0.9)
@@ -891,3 +895,49 @@ def test_recovery_steps_that_touch_down_on_time_stop_a_walk():
     assert float(np.median(durations)) < float(np.median(durations_late))
     assert not result.fell
     assert result_late.fell and result_late.fall_time_s is not None and result_late.fall_time_s > 2.58  # in the rest
+
+
+def test_a_landing_gap_must_be_positive():
+    with pytest.raises(ConfigError, match="recovery_landing_gap_m"):
+        MotionConfig(recovery_landing_gap_m=0.0)
+
+
+@pytest.mark.skipif(not (MOCAP / "cmu-dev" / "08_08.bvh").exists(),
+                    reason="../shared/mocap/cmu-dev/08_08.bvh is not available")
+def test_a_recovery_step_that_reaches_the_ground_on_a_corner_has_landed():
+    """CMU-dev 08_08 (a fast walk, seed 3). Counted as landed only once it pressed the ground with 5 N, the recovery
+    step begun at 2.34 s lasted 0.43 s against its nominal 0.2 s: from 2.61 s its foot rested on a corner of its sole
+    (within 3 mm of the ground, tilted, pressing less than that) while the straight stance leg held the pelvis 7 cm
+    above its target (measured). Counted as landed once its sole reaches the ground after its horizontal travel, no
+    recovery step of the run lasts more than 0.25 s."""
+    spec = f"bvh:{MOCAP / 'cmu-dev' / '08_08.bvh'}"
+    side_ankle = {s: LINK_NAMES.index(f"{s}_ankle") for s in ("left", "right")}
+
+    def run(gap: float | None):
+        durations: list[float] = []
+        started: list[float] = []
+        resting: list[float] = []  # ticks of a recovery step with its sole within 3 mm of the ground, not pressing
+
+        def watch(session):
+            def on_tick(state, ref):
+                step = session.motion.recovery.step
+                if ref.recovery_ankle_world and not started:
+                    started.append(state.time_s)
+                elif not ref.recovery_ankle_world and started:
+                    durations.append(state.time_s - started.pop())
+                if step is not None and not state.feet_pressing()[step.side]:
+                    a = side_ankle[step.side]
+                    corners = sole_corners_world(state.link_origin_world[a], state.link_quat_wxyz[a])
+                    if corners[:, 2].min() < 0.003:
+                        resting.append(state.time_s)
+            return on_tick
+
+        result = suite_run(spec, 3, MotionConfig(recovery_landing_gap_m=gap), ControlConfig(), watch=watch)
+        return durations, resting, result
+
+    durations, _, result = run(MotionConfig().recovery_landing_gap_m)
+    durations_force, resting_force, result_force = run(None)
+    assert not result.fell and not result_force.fell
+    assert max(durations_force) > 0.4
+    assert len([t for t in resting_force if 2.6 < t < 2.8]) / SessionConfig().clocks.control_hz > 0.1
+    assert durations and max(durations) < 0.25

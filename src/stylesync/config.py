@@ -183,6 +183,12 @@ class MotionConfig:
     # ran on beyond the landing planned for the swing's end (docs/decisions.md, "Recovery steps that touch down on
     # time") [-]
     recovery_touchdown_share: float = 0.9
+    # ... and it has landed once its horizontal travel is over and the lowest corner of its sole is within this of
+    # the ground, not only once it presses with CONTACT_FORCE_N: a foot that came down on a corner, tilted, rested
+    # there with less than that while the stance leg, straight, held the pelvis above its target, and the body ran
+    # on over one foot (docs/decisions.md, "A recovery step that has reached the ground") (None: by the force
+    # only) [m]
+    recovery_landing_gap_m: float | None = 0.003
     # A recovery step lands its ankle at most this share of the leg's length from the stance ankle (the pelvis lowered
     # as the leg needs, recovery_landing_reach): at 0.6 the steps that stop a walk landed short of the capture point,
     # and each left the body faster (docs/decisions.md, "Longer recovery steps") [-]
@@ -264,6 +270,8 @@ class MotionConfig:
             raise ConfigError(f"MotionConfig.capture_bound_sole_share must be within [0, 1], got "
                               f"{self.capture_bound_sole_share}")
         _positive("MotionConfig.recovery_swing_s", self.recovery_swing_s)
+        if self.recovery_landing_gap_m is not None:
+            _positive("MotionConfig.recovery_landing_gap_m", self.recovery_landing_gap_m)
         if not 0.0 < self.recovery_touchdown_share <= 1.0:
             raise ConfigError(f"MotionConfig.recovery_touchdown_share must be within (0, 1], "
                               f"got {self.recovery_touchdown_share}")

@@ -40,7 +40,7 @@ from stylesync.model.character import (
     batch_model_quat_from_canonical,
     canonical_quat_from_model,
 )
-from stylesync.model.sole import sole_corner_points, sole_outside_m, sole_points_xy
+from stylesync.model.sole import sole_corner_points, sole_outside_m, sole_points_xy, sole_within_m
 from stylesync.model.state import CharacterState, MassProperties
 from stylesync.motion.balance_strategy import stance_hip_blend, swing_hip_feedback
 from stylesync.motion.bounds import BoundsMonitor, step_length_bound_m
@@ -310,6 +310,20 @@ class MotionOptimizer:
             can[side] = may
         return can
 
+    def _feet_down(self, state: CharacterState) -> dict[str, bool]:
+        """Per side, whether the foot is on the ground: it presses it (``CharacterState.feet_pressing``), or it is a
+        recovery step's foot past its horizontal travel whose sole's lowest corner is within
+        ``recovery_landing_gap_m`` of the ground (it has landed, if on a corner)."""
+        contact = state.feet_pressing()
+        gap, step = self.cfg.recovery_landing_gap_m, self.recovery.step
+        if gap is None or step is None or not self.char_fsm.recovery_step or contact[step.side]:
+            return contact
+        ankle = _LINK[f"{step.side}_ankle"]
+        if self.recovery.landing_due(state.time_s) and sole_within_m(state.link_origin_world[ankle],
+                                                                     state.link_quat_wxyz[ankle], gap):
+            contact[step.side] = True
+        return contact
+
     def _rear_foot_bears_weight(self, sample: OperatorSample, analysis: OperatorAnalysis, op_state: Stance) -> bool:
         """Whether the operator's raised foot still carries weight: it is behind his stance foot, and his capture
         point is more than ``rear_foot_support_margin_m`` behind his stance sole's heel (the character's sole scaled
@@ -339,7 +353,7 @@ class MotionOptimizer:
         op_state = self.op_fsm.update(sample.pos["ANKLE_LEFT"][2], sample.pos["ANKLE_RIGHT"][2])
         if op_state is not Stance.DS and self._rear_foot_bears_weight(sample, analysis, op_state):
             op_state = Stance.DS
-        contact = state.feet_pressing()
+        contact = self._feet_down(state)
         # Only a lift-off from double stance can wait for the weight to shift.
         lifting = op_state is not Stance.DS and self.char_fsm.state is Stance.DS
         can_lift = self._can_lift(sample, state, mass) if lifting else None
