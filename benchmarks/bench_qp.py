@@ -30,6 +30,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from stylesync.config import OperatorConfig, SessionConfig
+from stylesync.control.contacts import FORCES_PER_SOLE
 from stylesync.control.formulation import QpProblem
 from stylesync.control.solver import EQUALITY
 from stylesync.model.character import N_DOFS, ROOT_DOFS
@@ -37,7 +38,6 @@ from stylesync.session import Session
 from stylesync.sources.builtin_operator import builtin_operator
 
 N_TAU = N_DOFS - ROOT_DOFS  # joint-torque rows, after the equalities
-FORCES_PER_SOLE = 16
 
 
 def captured_problems(clip: str, duration_s: float, every: int) -> list[QpProblem]:
