@@ -14,7 +14,7 @@ from stylesync.config import ControlConfig, MotionConfig, OperatorConfig, Sessio
 from stylesync.errors import ConfigError
 from stylesync.model.character import ANKLE_HEIGHT_M, FOOT_CENTER_AHEAD_OF_ANKLE_M, FOOT_LENGTH_M, LINK_NAMES
 from stylesync.model.sole import convex_hull_xy, outside_distance_m, sole_corners_world
-from stylesync.motion.pose_optimization import CHAR_LEG_LENGTH_M
+from stylesync.motion.pose_optimization import CHAR_LEG_LENGTH_M, LANDING_REACH
 from stylesync.motion.recovery_step import (
     MIN_FOOT_SEPARATION_M,
     RecoveryStepper,
@@ -779,6 +779,40 @@ def test_a_landing_foot_out_of_reach_does_not_put_the_pelvis_target_on_the_groun
     assert low_old < 0.3
     assert low > 0.45
     assert fell_old and not fell
+
+
+@pytest.mark.skipif(not (MOCAP / "cmu-dev" / "09_06.bvh").exists(),
+                    reason="../shared/mocap/cmu-dev/09_06.bvh is not available")
+def test_an_operator_swing_is_aimed_within_the_legs_reach():
+    """CMU-dev 09_06 (a run, seed 1): placed as the runner's are, relative to his capture point and his stance foot,
+    the slower character's swing feet were aimed up to 2.3 m from their hip (measured), beyond where the leg can
+    land them even with the pelvis at its landing floor; the run fell 0.3 s after its clip's end. Aimed within that
+    reach (``swing_within_reach``), the feet land and the run completes its rest."""
+    spec = f"bvh:{MOCAP / 'cmu-dev' / '09_06.bvh'}"
+    floor = MotionConfig().landing_pelvis_floor_share * LANDING_REACH * CHAR_LEG_LENGTH_M
+    reach = float(np.sqrt((LANDING_REACH * CHAR_LEG_LENGTH_M) ** 2 - floor ** 2))
+
+    def run(within: bool):
+        far: list[float] = []
+
+        def watch(session):
+            aim = session.motion._swing_target
+
+            def recording(tick, state, side):
+                target = aim(tick, state, side)
+                hip = state.link_origin_world[state.link(f"{side}_hip")]
+                far.append(float(np.linalg.norm(target[:2] - hip[:2])))
+                return target
+
+            session.motion._swing_target = recording
+
+        result = suite_run(spec, 1, MotionConfig(swing_within_reach=within), ControlConfig(), watch=watch)
+        return max(far), result
+
+    far, result = run(True)
+    far_old, result_old = run(False)
+    assert far_old > 2.0 and result_old.fell
+    assert far <= reach + 1e-9 and not result.fell
 
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "07_11.bvh").exists(),

@@ -244,6 +244,12 @@ class MotionConfig:
     # ahead of it in a walk's rest), the foot was out of reach, and the pelvis target dropped to the foot's own
     # height (docs/decisions.md, "A pelvis target out of a landing foot's reach"; 0: no floor) [-]
     landing_pelvis_floor_share: float = 0.6
+    # An operator's swing is aimed within the leg's horizontal reach of the swing hip as it is, with the pelvis
+    # lowered to that floor (sqrt(1 - floor²) of the reach): a runner's foot, placed as his is relative to his
+    # capture point and his stance foot, was aimed up to 2.3 m from the slower character's hip, hovered there for
+    # half a second under the late contact's hold, and the body fell over its stance foot (docs/decisions.md, "A
+    # swing aimed out of the leg's reach") (False: aimed where the placement puts it)
+    swing_within_reach: bool = True
     # A recovery step's landing is planned on the capture point of the body with the swing leg carried along by the
     # pelvis (MassProperties.com_velocity_carried): the leg's own swing moves the whole body's capture point with
     # the foot, and the ground stops that motion when the foot lands. Planned on the whole body's, the landing

@@ -208,6 +208,8 @@ class MotionOptimizer:
         self.dt_s = 1.0 / control_hz
         # A landing foot lowers the pelvis target to at least this height above the foot's target [m]
         self._landing_pelvis_floor_m = cfg.landing_pelvis_floor_share * _LANDING_REACH_M
+        # How far from its hip, horizontally, a swing foot can land with the pelvis at that floor [m]
+        self._swing_reach_m = math.sqrt(max(_LANDING_REACH_M ** 2 - self._landing_pelvis_floor_m ** 2, 0.0))
         self.op_fsm = OperatorStanceFsm(cfg.stance_height_threshold_m, cfg.stance_hysteresis_m)
         self.char_fsm = CharacterStanceFsm(cfg.late_contact_timeout_s, cfg.min_swing_s)
         self._op_leg_m: float | None = None
@@ -767,6 +769,13 @@ class MotionOptimizer:
             self._swing_t0_s = state.time_s
         self._swing_offset *= self._swing_decay
         target[:2] += self._swing_offset
+        if cfg.swing_within_reach:
+            # Where the leg can land it: a target beyond that is followed by a foot that hovers while the body falls.
+            hip = state.link_origin_world[_LINK[f"{side}_hip"]]
+            away = target[:2] - hip[:2]
+            dist = float(np.linalg.norm(away))
+            if dist > self._swing_reach_m:
+                target[:2] = hip[:2] + away * (self._swing_reach_m / dist)
         return target
 
     # ---- 4. leg IK (Sec. 5.3) and balance strategy (Sec. 5.4) ------------------------------------------------
