@@ -174,7 +174,8 @@ TRACED_MOTION = {"recovery_step_reach_share": 0.6, "recovery_on_stopping_step": 
                  "recovery_double_stance_overrun": 0.0, "liftoff_capture_behind_m": None, "foot_yaw_control": False,
                  "liftoff_shift_tolerance_m": None, "recovery_landing_without_swing": False,
                  "landing_pelvis_floor_share": 0.0, "recovery_on_reach_limit": False, "recovery_min_stance_s": 0.1,
-                 "recovery_cross_clear_m": None, "recovery_touchdown_share": 1.0, "recovery_landing_gap_m": None}
+                 "recovery_cross_clear_m": None, "recovery_touchdown_share": 1.0, "recovery_landing_gap_m": None,
+                 "swing_within_reach": False}
 # The scenarios traced before MotionConfig.foot_yaw_control run with the feet's twist left where it was (and the
 # weight shift from standing, the recovery steps' landing and the step timing as they were then; with the
 # controller, the recovery foot task off: NO_FOOT_TASK).
@@ -182,12 +183,13 @@ NO_FOOT_TASK = ControlConfig(whole_body=WholeBodyConfig(recovery_foot_task_weigh
 TWIST_FREE = {"foot_yaw_control": False, "liftoff_shift_tolerance_m": None, "recovery_landing_without_swing": False,
               "landing_pelvis_floor_share": 0.0, "recovery_on_reach_limit": False, "recovery_min_stance_s": 0.1,
               "recovery_ds_on_reach_limit": False, "recovery_cross_clear_m": None, "recovery_touchdown_share": 1.0,
-              "recovery_landing_gap_m": None}
+              "recovery_landing_gap_m": None, "swing_within_reach": False}
 # The scenarios traced before the shorter double stance between recovery steps (MotionConfig.recovery_min_stance_s),
 # the crossover recovery steps (MotionConfig.recovery_cross_clear_m), the earlier touchdown of a recovery step's
-# foot (MotionConfig.recovery_touchdown_share) and its landing on a corner (MotionConfig.recovery_landing_gap_m).
+# foot (MotionConfig.recovery_touchdown_share), its landing on a corner (MotionConfig.recovery_landing_gap_m) and the
+# operator's swing kept within the leg's reach (MotionConfig.swing_within_reach).
 WAIT_TRACED = {"recovery_min_stance_s": 0.1, "recovery_cross_clear_m": None, "recovery_touchdown_share": 1.0,
-               "recovery_landing_gap_m": None}
+               "recovery_landing_gap_m": None, "swing_within_reach": False}
 
 
 def _run(spec: str, seconds: float, motion: MotionConfig, seed: int = 0, control: ControlConfig | None = None):
@@ -723,7 +725,8 @@ def test_the_swing_foot_of_a_recovery_step_follows_its_target():
                 raise _Stop
 
         try:
-            suite_run(spec, 0, MotionConfig(landing_pelvis_floor_share=0.0, recovery_on_reach_limit=False), control,
+            suite_run(spec, 0, MotionConfig(landing_pelvis_floor_share=0.0, recovery_on_reach_limit=False,
+                                            swing_within_reach=False), control,
                        on_tick)
         except _Stop:
             pass
@@ -966,7 +969,8 @@ def test_a_recovery_step_that_reaches_the_ground_on_a_corner_has_landed():
                         resting.append(state.time_s)
             return on_tick
 
-        result = suite_run(spec, 3, MotionConfig(recovery_landing_gap_m=gap), ControlConfig(), watch=watch)
+        result = suite_run(spec, 3, MotionConfig(recovery_landing_gap_m=gap, swing_within_reach=False), ControlConfig(),
+                           watch=watch)
         return durations, resting, result
 
     durations, _, result = run(MotionConfig().recovery_landing_gap_m)
