@@ -246,9 +246,10 @@ class MotionConfig:
     landing_pelvis_floor_share: float = 0.6
     # An operator's swing is aimed within the leg's horizontal reach of the swing hip as it is, with the pelvis
     # lowered to that floor (sqrt(1 - floor²) of the reach): a runner's foot, placed as his is relative to his
-    # capture point and his stance foot, was aimed up to 2.3 m from the slower character's hip, hovered there for
-    # half a second under the late contact's hold, and the body fell over its stance foot (docs/decisions.md, "A
-    # swing aimed out of the leg's reach") (False: aimed where the placement puts it)
+    # capture point and his stance foot, was aimed up to 2.3 m from the slower character's hip (CMU-dev 09_06); in
+    # the humanoid3d run such a foot hovered out of reach for half a second under the late contact's hold while the
+    # body fell over its stance foot (docs/decisions.md, "A swing aimed out of the leg's reach") (False: aimed where
+    # the placement puts it)
     swing_within_reach: bool = True
     # A recovery step's landing is planned on the capture point of the body with the swing leg carried along by the
     # pelvis (MassProperties.com_velocity_carried): the leg's own swing moves the whole body's capture point with

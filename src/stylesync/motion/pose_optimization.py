@@ -725,7 +725,8 @@ class MotionOptimizer:
         within the landing limits: a character slower or faster than the operator steps shorter or further, as far
         as it needs to stop over its feet (a foot-position form of Eq. 12's feedback). The move grows with the
         swing's progress (its time over the operator's last swing time): at lift-off the foot is behind the body,
-        and the full move would pull it further back.
+        and the full move would pull it further back. With ``swing_within_reach`` the target is kept within the
+        leg's horizontal reach of its hip, the pelvis at its landing floor.
         """
         cfg = self.cfg
         other = _OTHER_SIDE[side]
