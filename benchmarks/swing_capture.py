@@ -21,6 +21,7 @@ from trace_run import resolve
 from stylesync import rotations as rot
 from stylesync.metrics.dev_suite import suite_config
 from stylesync.model.character import FOOT_WIDTH_M, LINK_NAMES
+from stylesync.motion.pose_optimization import _inward_m
 from stylesync.motion.recovery_step import capture_point
 from stylesync.session import Session
 from stylesync.sources.registry import open_source
@@ -30,11 +31,9 @@ _UP = np.array([0.0, 0.0, 1.0])
 
 
 def inward_of_sole_m(point_world: np.ndarray, ankle_world: np.ndarray, foot_yaw_rad: float, stance: str) -> float:
-    """Distance of a point beyond the stance sole's inner edge, across the foot (> 0 towards the other foot) [m]."""
-    d = np.asarray(point_world, dtype=float)[:2] - np.asarray(ankle_world, dtype=float)[:2]
-    across = -np.sin(foot_yaw_rad) * d[0] + np.cos(foot_yaw_rad) * d[1]  # the foot frame's y (left)
-    inward = -across if stance == "left" else across
-    return float(inward - FOOT_WIDTH_M / 2)
+    """Distance of a point beyond the stance sole's inner edge, across the foot (> 0 towards the other foot) [m]:
+    the motion stage's own across-the-foot distance from the ankle, less half the sole's width."""
+    return _inward_m(point_world, ankle_world, foot_yaw_rad, stance) - FOOT_WIDTH_M / 2
 
 
 def swings(clip: str, seed: int, duration_s: float) -> tuple[list[dict], float | None]:
