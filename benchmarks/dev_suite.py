@@ -9,8 +9,9 @@ alternating versions, two at a time (one per core). A run lasts the clip (at mos
 standing lead-in of a clip, or the rest after a recorded file, included) through the Kinect sensor model with the
 given seed. Per category: runs, clips that could be opened, completion (no fall), runs through the clip (no fall
 before the clip's end; a fall in the rest after it counts against completion only), runs without a UHC/PHC
-termination, mean fall time, MPJPE (global, root-relative), steps (character / operator) and the median of the
-runs' largest transition delays. Nothing is tuned per clip: the same settings for every run. Writes dev_suite.md
+termination, mean fall time, MPJPE (global, root-relative), steps (character / operator), the median of how far
+the character went along its operator's path (metrics/imitation.path_progress) and the median of the runs' largest
+transition delays. Nothing is tuned per clip: the same settings for every run. Writes dev_suite.md
 and dev_suite.json under --out.
 """
 
@@ -55,8 +56,15 @@ try:
 finally:
     opened.source.close()
 m = summarize(result)
+if "path_progress" not in m:  # a version before metrics/imitation.path_progress: the same definition, here
+    import numpy as np
+    lg = result.log
+    ch, op, scale = lg.array("ch_joints")[:, 0], lg.array("op_joints")[:, 0], lg.array("scale")
+    dc, dr = ch[-1, :2] - ch[0, :2], scale[-1] * (op[-1, :2] - op[0, :2])
+    length = float(np.hypot(dr[0], dr[1]))
+    m["path_progress"] = float(dc @ dr) / length**2 if length >= 0.5 else None
 keys = ("fell", "fall_time_s", "sim_duration_s", "operator_steps", "character_steps", "state_transition_delay_s",
-        "mpjpe_global_mm", "mpjpe_root_mm", "uhc_fall_time_s", "realtime_factor")
+        "mpjpe_global_mm", "mpjpe_root_mm", "uhc_fall_time_s", "path_progress", "realtime_factor")
 print(json.dumps({"clip_end_s": clip_end, **{k: m.get(k) for k in keys}}))
 '''
 

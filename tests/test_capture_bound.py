@@ -142,13 +142,15 @@ def test_a_lunge_the_character_cannot_stop_from_is_not_asked_for():
     # ends in a step back and a fall at 3.3 s (the suite's punch completes 6 of 8 seeds with it, 8 without); so does
     # the step of MotionConfig.recovery_ds_on_reach_limit, which came after it (the suite's punch is the same).
     # Both runs also before a recovery step's landing on a corner (MotionConfig.recovery_landing_gap_m): with it the
-    # unbounded run holds too.
+    # unbounded run holds too. And both with the swing aimed at the operator's swing foot's present offset
+    # (MotionConfig.swing_landing "his_foot_now"), as it was then.
     bounded, worst = run(MotionConfig(recovery_step_behind_cos=None, recovery_ds_on_reach_limit=False,
-                                      recovery_landing_gap_m=None))
+                                      recovery_landing_gap_m=None, swing_landing="his_foot_now"))
     assert not bounded.fell
     assert worst <= 0.0
     # Traced with the feet's twist left where it was: with their yaw controlled (MotionConfig.foot_yaw_control) the
     # punch holds without the bound too; so it does with the double stance's reach rule, off in both runs.
     unbounded, _ = run(MotionConfig(capture_bound_sole_share=0.0, foot_yaw_control=False,
-                                    recovery_ds_on_reach_limit=False, recovery_landing_gap_m=None))
+                                    recovery_ds_on_reach_limit=False, recovery_landing_gap_m=None,
+                                    swing_landing="his_foot_now"))
     assert unbounded.fell and unbounded.fall_time_s < 6.0

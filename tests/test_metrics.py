@@ -61,6 +61,20 @@ def test_jitter_of_a_constant_acceleration():
     assert im.jitter_mps2(np.zeros((50, 4, 3)), dt) == 0.0
 
 
+def test_path_progress_of_a_character_that_goes_part_of_the_way_back_or_aside():
+    t = np.linspace(0.0, 1.0, 50)[:, None]
+    ref = np.hstack([4.0 * t, 3.0 * t, np.full_like(t, 0.9)])  # 5 m along (0.8, 0.6)
+    half = ref * [0.5, 0.5, 1.0]
+    assert im.path_progress(half, ref) == pytest.approx((0.5, 0.0))
+    back = ref * [-0.2, -0.2, 1.0]
+    assert im.path_progress(back, ref)[0] == pytest.approx(-0.2)
+    aside = np.hstack([-3.0 * t, 4.0 * t, np.full_like(t, 0.9)])  # 5 m square to his line
+    progress, sideways = im.path_progress(aside, ref)
+    assert progress == pytest.approx(0.0, abs=1e-12) and sideways == pytest.approx(5.0)
+    in_place = np.hstack([0.3 * t, 0.0 * t, np.full_like(t, 0.9)])
+    assert im.path_progress(ref, in_place) == (None, None)
+
+
 def test_uhc_termination_and_operator_scaling():
     ref = _walker()
     char = ref.copy()

@@ -36,6 +36,13 @@ QUATS = {"left": IDENTITY, "right": IDENTITY}
 MOCAP = Path(__file__).resolve().parents[2] / "shared" / "mocap"
 
 
+def traced_motion(**kwargs) -> MotionConfig:
+    """The scenarios of this module were traced with the swing aimed at the operator's swing foot's present offset
+    from his capture point (MotionConfig.swing_landing "his_foot_now", the swing as it was then): their motion
+    configurations start from it."""
+    return MotionConfig(**{"swing_landing": "his_foot_now", **kwargs})
+
+
 def test_support_polygon_distance_is_signed_and_finds_the_nearest_point():
     square = convex_hull_xy(np.array([[0, 0], [1, 0], [1, 1], [0, 1], [0.5, 0.5]], dtype=float))
     assert len(square) == 4
@@ -68,7 +75,7 @@ def test_sole_corners_span_the_foot_ahead_of_the_ankle():
 
 
 def test_no_step_while_the_capture_point_is_over_the_feet():
-    stepper = RecoveryStepper(MotionConfig(), CHAR_LEG_LENGTH_M, G)
+    stepper = RecoveryStepper(traced_motion(), CHAR_LEG_LENGTH_M, G)
     com = np.array([0.04, 0.0, 0.8])
     assert stepper.trigger(1.0, com, np.zeros(3), ANKLES, QUATS, ["left", "right"]) is None
     # Moving forward slowly: the capture point stays within the soles' toes.
@@ -76,7 +83,7 @@ def test_no_step_while_the_capture_point_is_over_the_feet():
 
 
 def test_a_capture_point_beyond_the_left_foot_lifts_the_right_foot_and_lands_it_beyond_the_capture_point():
-    stepper = RecoveryStepper(MotionConfig(), CHAR_LEG_LENGTH_M, G)
+    stepper = RecoveryStepper(traced_motion(), CHAR_LEG_LENGTH_M, G)
     com, vel = np.array([0.1, 0.03, 0.8]), np.array([0.45, 0.05, 0.0])  # forward and a little to the left
     xi, omega = capture_point(com, vel, G)
     assert omega == pytest.approx(np.sqrt(G / 0.8))
@@ -90,7 +97,7 @@ def test_a_capture_point_beyond_the_left_foot_lifts_the_right_foot_and_lands_it_
     # MIN_FOOT_SEPARATION_M: the capture point is 6 cm inwards of the left ankle, and so is the landing.
     assert landing[0] > ANKLES["left"][0] + stepper.cfg.recovery_cross_clear_m
     assert ANKLES["left"][1] - MIN_FOOT_SEPARATION_M < landing[1] < ANKLES["left"][1]
-    never_across = RecoveryStepper(MotionConfig(recovery_cross_clear_m=None), CHAR_LEG_LENGTH_M, G)
+    never_across = RecoveryStepper(traced_motion(recovery_cross_clear_m=None), CHAR_LEG_LENGTH_M, G)
     landing_old, _ = never_across.capture_landing(0.3, com, vel, ANKLES["left"], IDENTITY, np.eye(3), "right")
     assert landing_old[1] == pytest.approx(ANKLES["left"][1] - MIN_FOOT_SEPARATION_M)  # kept outwards
     reach_m = stepper.cfg.recovery_step_reach_share * CHAR_LEG_LENGTH_M
@@ -128,7 +135,7 @@ def test_a_crossover_landing_needs_its_clearance_ahead_or_behind():
 
 
 def test_recovery_steps_can_be_switched_off():
-    stepper = RecoveryStepper(MotionConfig(recovery_steps=False), CHAR_LEG_LENGTH_M, G)
+    stepper = RecoveryStepper(traced_motion(recovery_steps=False), CHAR_LEG_LENGTH_M, G)
     assert stepper.trigger(1.0, np.array([0.3, 0.0, 0.8]), np.array([1.0, 0.0, 0.0]), ANKLES, QUATS,
                            ["left", "right"]) is None
 
@@ -214,12 +221,12 @@ def test_a_walk_cut_mid_stride_comes_to_rest_with_its_own_last_step():
     spec = f"bvh:{MOCAP / 'cmu-dev' / '08_01.bvh'}"
     # Traced with the feet's twist left where it is; with the feet's yaw controlled it does not fall either, but
     # still sways in its last double stance at 0.1-0.17 m/s (measured).
-    result, session = _run(spec, 5.27, MotionConfig(foot_yaw_control=False))
+    result, session = _run(spec, 5.27, traced_motion(foot_yaw_control=False))
     assert not result.fell
     com_vel = session.mass.com_velocity(session.backend.read_state(result.sim_duration_s))
     assert float(np.linalg.norm(com_vel[:2])) < 0.05  # at rest at the end
-    assert not _run(spec, 5.27, MotionConfig())[0].fell
-    off, _ = _run(spec, 5.27, MotionConfig(recovery_steps=False))
+    assert not _run(spec, 5.27, traced_motion())[0].fell
+    off, _ = _run(spec, 5.27, traced_motion(recovery_steps=False))
     assert off.fell and off.fall_time_s is not None and off.fall_time_s > 2.27
 
 
@@ -243,13 +250,13 @@ def test_a_swing_he_stops_on_is_landed_at_once_where_the_capture_point_goes(monk
     monkeypatch.setattr(RecoveryStepper, "take_over", recorded)
     spec = f"bvh:{MOCAP / 'cmu-dev' / '08_04.bvh'}"
     clip_end_s = 3.99
-    result, session = _run(spec, clip_end_s + 3.0, MotionConfig(**TWIST_FREE), control=PELVIS_LEVEL)
+    result, session = _run(spec, clip_end_s + 3.0, traced_motion(**TWIST_FREE), control=PELVIS_LEVEL)
     assert not result.fell
     assert taken and clip_end_s < taken[0] < clip_end_s + 0.15
     com_vel = session.mass.com_velocity(session.backend.read_state(result.sim_duration_s))
     assert float(np.linalg.norm(com_vel[:2])) < 0.05  # at rest at the end
     taken.clear()
-    off, _ = _run(spec, clip_end_s + 3.0, MotionConfig(**TWIST_FREE, recovery_on_stopping_step=False),
+    off, _ = _run(spec, clip_end_s + 3.0, traced_motion(**TWIST_FREE, recovery_on_stopping_step=False),
                   control=PELVIS_LEVEL)
     assert taken and taken[0] > clip_end_s + 0.2
     assert off.fell and off.fall_time_s is not None and off.fall_time_s > clip_end_s
@@ -277,11 +284,11 @@ def test_a_double_stance_whose_capture_point_has_run_out_ends_in_a_step_of_its_o
     monkeypatch.setattr(RecoveryStepper, "trigger", recorded)
     spec = f"bvh:{MOCAP / 'cmu-dev' / '07_05.bvh'}"
     clip_end_s = 4.27
-    result, _ = _run(spec, clip_end_s + 3.0, MotionConfig(**TWIST_FREE), control=PELVIS_LEVEL)
+    result, _ = _run(spec, clip_end_s + 3.0, traced_motion(**TWIST_FREE), control=PELVIS_LEVEL)
     assert not result.fell
     assert any(3.9 < t < clip_end_s for t in began)
     began.clear()
-    off, _ = _run(spec, clip_end_s + 3.0, MotionConfig(**TWIST_FREE, recovery_double_stance_overrun=0.0),
+    off, _ = _run(spec, clip_end_s + 3.0, traced_motion(**TWIST_FREE, recovery_double_stance_overrun=0.0),
                   control=PELVIS_LEVEL)
     assert not any(3.9 < t < clip_end_s for t in began) and any(t > clip_end_s for t in began)
     assert off.fell and off.fall_time_s is not None and off.fall_time_s > clip_end_s
@@ -306,7 +313,7 @@ def test_the_fsm_lets_the_balance_land_a_swing_it_takes_over():
 
 
 def test_a_swing_taken_over_in_the_air_is_lowered_from_where_it_is_to_the_capture_landing():
-    cfg = MotionConfig()
+    cfg = traced_motion()
     stepper = RecoveryStepper(cfg, CHAR_LEG_LENGTH_M, G)
     com, vel = np.array([0.12, -0.02, 0.8]), np.array([0.5, 0.0, 0.0])
     raised = np.array([-0.1, 0.1, 0.25])
@@ -332,12 +339,12 @@ def test_a_late_contact_hold_keeps_the_walk_going():
     without the bound on the COM target's capture point (capture_bound.py), which also keeps the stopped targets from
     throwing this run; with everything on, it comes to rest too."""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '08_01.bvh'}"
-    on, _ = _run(spec, 5.27, MotionConfig(**TWIST_FREE, capture_bound_sole_share=0.0), seed=1, control=TRACED)
+    on, _ = _run(spec, 5.27, traced_motion(**TWIST_FREE, capture_bound_sole_share=0.0), seed=1, control=TRACED)
     assert not on.fell
-    off, _ = _run(spec, 5.27, MotionConfig(**TWIST_FREE, late_contact_keeps_momentum=False,
+    off, _ = _run(spec, 5.27, traced_motion(**TWIST_FREE, late_contact_keeps_momentum=False,
                                            capture_bound_sole_share=0.0), seed=1, control=TRACED)
     assert off.fell
-    default, _ = _run(spec, 5.27, MotionConfig(), seed=1)
+    default, _ = _run(spec, 5.27, traced_motion(), seed=1)
     assert not default.fell
 
 
@@ -347,14 +354,14 @@ def test_a_sideways_drift_steps_with_the_foot_that_can_catch_it_not_the_one_that
     across it): its step would leave the capture point outside; the right foot's step out catches it."""
     ankles = {"left": np.array([-0.298, 0.106, ANKLE_HEIGHT_M]), "right": np.array([-0.036, 0.058, ANKLE_HEIGHT_M])}
     com, vel = np.array([-0.073, 0.004, 0.8]), np.array([-0.03, -0.09, 0.0])
-    stepper = RecoveryStepper(MotionConfig(), CHAR_LEG_LENGTH_M, G)
+    stepper = RecoveryStepper(traced_motion(), CHAR_LEG_LENGTH_M, G)
     residual = {stance: stepper.capture_residual_m(com, vel, ankles[stance], IDENTITY, np.eye(3), swing)
                 for stance, swing in (("left", "right"), ("right", "left"))}
     assert residual["left"] <= 0.0 < residual["right"]
     step = stepper.trigger(1.0, com, vel, ankles, QUATS, ["left", "right"], np.eye(3))
     assert step is not None and step.side == "right"
     # Without the heading frame the nearer sole is the stance, as before.
-    stepper = RecoveryStepper(MotionConfig(), CHAR_LEG_LENGTH_M, G)
+    stepper = RecoveryStepper(traced_motion(), CHAR_LEG_LENGTH_M, G)
     step = stepper.trigger(1.0, com, vel, ankles, QUATS, ["left", "right"])
     assert step is not None and step.side == "left"
 
@@ -369,12 +376,32 @@ def test_a_recovery_step_lets_the_body_move_as_its_landing_assumes():
     ``recovery_landing_reach``) and the COM target unbounded (no ``capture_bound_sole_share``): with the body lowered
     for a landing as well, both come to rest."""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '07_01.bvh'}"
-    free, _ = _run(spec, 5.6, MotionConfig(**TWIST_FREE, recovery_landing_reach=False, capture_bound_sole_share=0.0),
+    free, _ = _run(spec, 5.6, traced_motion(**TWIST_FREE, recovery_landing_reach=False, capture_bound_sole_share=0.0),
                    control=TRACED)
     assert not free.fell
-    pulled, _ = _run(spec, 5.6, MotionConfig(**TWIST_FREE, recovery_step_free_com=False, recovery_landing_reach=False,
+    pulled, _ = _run(spec, 5.6, traced_motion(**TWIST_FREE, recovery_step_free_com=False, recovery_landing_reach=False,
                                              capture_bound_sole_share=0.0), control=TRACED)
     assert pulled.fell and pulled.fall_time_s is not None and pulled.fall_time_s > 2.6
+
+
+def test_the_walk_goes_the_operators_way_with_its_swing_aimed_at_his_last_landing():
+    """The built-in walk, 8 s, seed 0: each swing goes from where the character's foot lifted off to a landing placed
+    from its capture point as his last landing was from his, and the character goes his way. Aimed at the offset
+    his swing foot has now (far behind his capture point while it swings) and started relative to the stance foot
+    as his is, the swing went back before it came forward, and the character walked backwards (measured)."""
+    from stylesync.metrics.summary import summarize
+    from stylesync.session import Session
+    from stylesync.sources.registry import open_source
+
+    progress = {}
+    for landing in ("his_last_landing", "his_foot_now"):
+        opened = open_source("builtin:walk", seed=0, duration_s=8.0)
+        cfg = SessionConfig(duration_s=8.0, seed=0, motion=MotionConfig(swing_landing=landing))
+        result = Session(cfg, opened.source).run()
+        assert not result.fell
+        progress[landing] = summarize(result)["path_progress"]
+    assert progress["his_last_landing"] > 0.25
+    assert progress["his_foot_now"] < 0.0
 
 
 def test_targets_that_follow_the_operator_keep_the_walk_up_with_him():
@@ -386,7 +413,7 @@ def test_targets_that_follow_the_operator_keep_the_walk_up_with_him():
     covered = {}
     for tau in (0.0, 0.5):
         opened = open_source("builtin:walk", seed=0, duration_s=7.0)
-        cfg = SessionConfig(duration_s=7.0, seed=0, motion=MotionConfig(**TWIST_FREE, reference_follows_operator_s=tau),
+        cfg = SessionConfig(duration_s=7.0, seed=0, motion=traced_motion(**TWIST_FREE, reference_follows_operator_s=tau),
                             control=TRACED)
         session = Session(cfg, opened.source)
         start = {}
@@ -436,10 +463,10 @@ def test_a_step_from_standing_waits_for_the_weight_to_shift():
     the operator's stance by his ankles alone (no rear-foot support), so that only the wait differs; with the whole
     balance layer (the default) it falls at 3.44 s."""
     spec = f"bvh:{MOCAP / 'cmu' / '131_01.bvh'}"
-    shifted, _ = _run(spec, 3.5, MotionConfig(rear_foot_support_margin_m=None, **TRACED_MOTION), control=TRACED)
-    at_once, _ = _run(spec, 3.5, MotionConfig(liftoff_weight_shift_s=0.0, rear_foot_support_margin_m=None,
+    shifted, _ = _run(spec, 3.5, traced_motion(rear_foot_support_margin_m=None, **TRACED_MOTION), control=TRACED)
+    at_once, _ = _run(spec, 3.5, traced_motion(liftoff_weight_shift_s=0.0, rear_foot_support_margin_m=None,
                                               **TRACED_MOTION), control=TRACED)
-    default, _ = _run(spec, 3.5, MotionConfig())
+    default, _ = _run(spec, 3.5, traced_motion())
     assert not default.fell or (default.fall_time_s is not None and default.fall_time_s > 3.0)
     assert at_once.fell and at_once.fall_time_s is not None and at_once.fall_time_s < 2.1
     assert not shifted.fell or (shifted.fall_time_s is not None and shifted.fall_time_s > 2.5)
@@ -455,11 +482,11 @@ def test_a_kick_waits_until_the_weight_is_over_the_stance_ankle_as_the_operators
     lift-off's fall as well.)"""
     spec = "deepmimic:kick"
     then = {"recovery_cross_clear_m": None}
-    matched, _ = _run(spec, 5.0, MotionConfig(**then))
-    edge_only, _ = _run(spec, 5.0, MotionConfig(liftoff_shift_tolerance_m=None, **then))
+    matched, _ = _run(spec, 5.0, traced_motion(**then))
+    edge_only, _ = _run(spec, 5.0, traced_motion(liftoff_shift_tolerance_m=None, **then))
     assert not matched.fell
     assert edge_only.fell
-    early, _ = _run(spec, 5.0, MotionConfig(liftoff_shift_tolerance_m=None, recovery_landing_without_swing=False,
+    early, _ = _run(spec, 5.0, traced_motion(liftoff_shift_tolerance_m=None, recovery_landing_without_swing=False,
                                             **then), control=NO_FOOT_TASK)
     assert early.fell and early.fall_time_s is not None and early.fall_time_s < 3.0
 
@@ -480,7 +507,7 @@ def test_a_rear_foot_on_its_toes_is_read_as_still_standing():
     out = {}
     for margin in (None, 0.02):
         opened = open_source(spec, seed=0, duration_s=5.0)
-        cfg = SessionConfig(duration_s=5.0, seed=0, motion=MotionConfig(rear_foot_support_margin_m=margin,
+        cfg = SessionConfig(duration_s=5.0, seed=0, motion=traced_motion(rear_foot_support_margin_m=margin,
                                                                          recovery_while_step_counted=False,
                                                                          **TRACED_MOTION),
                             control=TRACED,
@@ -510,8 +537,8 @@ def test_a_recovery_step_that_must_land_lowers_the_body_until_its_foot_reaches_t
     bound on the COM target's capture point (capture_bound.py), with which the character, braked in its double
     stances, comes to rest either way."""
     spec = f"bvh:{MOCAP / 'cmu' / '02_01.bvh'}"
-    reach, _ = _run(spec, 5.85, MotionConfig(capture_bound_sole_share=0.0, **TRACED_MOTION), seed=2, control=TRACED)
-    hover, _ = _run(spec, 5.85, MotionConfig(recovery_landing_reach=False, capture_bound_sole_share=0.0,
+    reach, _ = _run(spec, 5.85, traced_motion(capture_bound_sole_share=0.0, **TRACED_MOTION), seed=2, control=TRACED)
+    hover, _ = _run(spec, 5.85, traced_motion(recovery_landing_reach=False, capture_bound_sole_share=0.0,
                                              **TRACED_MOTION), seed=2, control=TRACED)
     assert not reach.fell
     assert hover.fell and hover.fall_time_s is not None and hover.fall_time_s > 2.85  # in the rest
@@ -543,7 +570,7 @@ def test_a_character_waiting_with_its_step_counted_may_still_step_on_its_own():
     for allowed in (False, True):
         opened = open_source(spec, seed=2, duration_s=5.4)
         cfg = SessionConfig(duration_s=5.4, seed=2,
-                            motion=MotionConfig(**TWIST_FREE, recovery_while_step_counted=allowed),
+                            motion=traced_motion(**TWIST_FREE, recovery_while_step_counted=allowed),
                             control=NO_FOOT_TASK,
                             clocks=dataclasses.replace(SessionConfig().clocks, mocap_hz=opened.mocap_hz))
         session = Session(cfg, opened.source)
@@ -575,8 +602,8 @@ def test_a_rear_foot_stays_down_while_the_capture_point_is_behind_the_front_heel
     before the crossover recovery steps, off here: they catch the lifted rear foot's fall as well.)"""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '07_11.bvh'}"
     clip_end_s = 2.58
-    kept, _ = _run(spec, clip_end_s, MotionConfig(recovery_cross_clear_m=None), seed=4)
-    lifted, _ = _run(spec, clip_end_s, MotionConfig(liftoff_capture_behind_m=None, recovery_cross_clear_m=None),
+    kept, _ = _run(spec, clip_end_s, traced_motion(recovery_cross_clear_m=None), seed=4)
+    lifted, _ = _run(spec, clip_end_s, traced_motion(liftoff_capture_behind_m=None, recovery_cross_clear_m=None),
                      seed=4)
     assert not kept.fell
     assert lifted.fell and lifted.fall_time_s is not None and lifted.fall_time_s < clip_end_s
@@ -590,8 +617,8 @@ def test_a_lighter_pelvis_on_one_foot_lets_a_running_stride_swing_forward():
     and the body sinks and falls in the clip (0.98 s). At ``single_stance_pelvis_share`` 0.3 the swing lands 0.73 m
     ahead of the stance ankle and the run completes, the 3 s rest after the clip included (4.41 s)."""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '02_03.bvh'}"
-    light, _ = _run(spec, 4.41, MotionConfig(**TWIST_FREE))
-    level, _ = _run(spec, 4.41, MotionConfig(**TWIST_FREE),
+    light, _ = _run(spec, 4.41, traced_motion(**TWIST_FREE))
+    level, _ = _run(spec, 4.41, traced_motion(**TWIST_FREE),
                     control=ControlConfig(whole_body=WholeBodyConfig(single_stance_pelvis_share=1.0)))
     assert not light.fell
     assert level.fell and level.fall_time_s is not None and level.fall_time_s < 1.41
@@ -650,7 +677,7 @@ def test_a_double_stance_that_would_wait_out_of_reach_steps_at_once():
             return on_tick
 
         # traced without crossing, and with the touchdown at the swing's end
-        motion = MotionConfig(recovery_ds_on_reach_limit=on, recovery_cross_clear_m=None, recovery_touchdown_share=1.0,
+        motion = traced_motion(recovery_ds_on_reach_limit=on, recovery_cross_clear_m=None, recovery_touchdown_share=1.0,
                               recovery_landing_gap_m=None)
         result = suite_run(spec, 1, motion, ControlConfig(), watch=watch)
         return starts, result
@@ -675,9 +702,9 @@ def test_a_capture_point_behind_both_feet_steps_back_at_once():
     ``recovery_ds_on_reach_limit``, which steps it at once as well.)"""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '10_04.bvh'}"
     then = {"recovery_landing_without_swing": False, "recovery_ds_on_reach_limit": False}
-    at_once, session = _run(spec, 4.0, MotionConfig(**then), control=NO_FOOT_TASK)
+    at_once, session = _run(spec, 4.0, traced_motion(**then), control=NO_FOOT_TASK)
     assert not at_once.fell
-    waiting, _ = _run(spec, 4.0, MotionConfig(**then, recovery_step_behind_cos=None), control=NO_FOOT_TASK)
+    waiting, _ = _run(spec, 4.0, traced_motion(**then, recovery_step_behind_cos=None), control=NO_FOOT_TASK)
     assert waiting.fell and waiting.fall_time_s is not None and waiting.fall_time_s < 3.0
 
 
@@ -725,7 +752,7 @@ def test_the_swing_foot_of_a_recovery_step_follows_its_target():
                 raise _Stop
 
         try:
-            suite_run(spec, 0, MotionConfig(landing_pelvis_floor_share=0.0, recovery_on_reach_limit=False,
+            suite_run(spec, 0, traced_motion(landing_pelvis_floor_share=0.0, recovery_on_reach_limit=False,
                                             swing_within_reach=False), control,
                        on_tick)
         except _Stop:
@@ -748,16 +775,16 @@ def test_recovery_steps_that_land_where_the_body_will_be_keep_a_walk_on_rough_gr
     """CMU-dev 03_02 (walking over uneven ground, seed 1) fell 2.2 s in with the recovery step's foot driven by the
     joint posture alone and its landing planned on the capture point its own swing moved (measured)."""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '03_02.bvh'}"
-    assert not suite_run(spec, 1, MotionConfig(**WAIT_TRACED), ControlConfig()).fell
-    old = suite_run(spec, 1, MotionConfig(recovery_landing_without_swing=False, **WAIT_TRACED), NO_FOOT_TASK)
+    assert not suite_run(spec, 1, traced_motion(**WAIT_TRACED), ControlConfig()).fell
+    old = suite_run(spec, 1, traced_motion(recovery_landing_without_swing=False, **WAIT_TRACED), NO_FOOT_TASK)
     assert old.fell
 
 
 def test_the_pelvis_floor_share_is_checked():
     with pytest.raises(ConfigError):
-        MotionConfig(landing_pelvis_floor_share=1.5)
+        traced_motion(landing_pelvis_floor_share=1.5)
     with pytest.raises(ConfigError):
-        MotionConfig(landing_pelvis_floor_share=-0.1)
+        traced_motion(landing_pelvis_floor_share=-0.1)
 
 
 def test_a_landing_foot_out_of_reach_does_not_put_the_pelvis_target_on_the_ground():
@@ -777,8 +804,8 @@ def test_a_landing_foot_out_of_reach_does_not_put_the_pelvis_target_on_the_groun
         assert len(heights) > 20
         return min(heights), result.fell
 
-    low, fell = lowest_pelvis_target(MotionConfig(**WAIT_TRACED))
-    low_old, fell_old = lowest_pelvis_target(MotionConfig(landing_pelvis_floor_share=0.0, **WAIT_TRACED))
+    low, fell = lowest_pelvis_target(traced_motion(**WAIT_TRACED))
+    low_old, fell_old = lowest_pelvis_target(traced_motion(landing_pelvis_floor_share=0.0, **WAIT_TRACED))
     assert low_old < 0.3
     assert low > 0.45
     assert fell_old and not fell
@@ -792,7 +819,7 @@ def test_an_operator_swing_is_aimed_within_the_legs_reach():
     land them even with the pelvis at its landing floor; the run fell 0.3 s after its clip's end. Aimed within that
     reach (``swing_within_reach``), the feet land and the run completes its rest."""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '09_06.bvh'}"
-    floor = MotionConfig().landing_pelvis_floor_share * LANDING_REACH * CHAR_LEG_LENGTH_M
+    floor = traced_motion().landing_pelvis_floor_share * LANDING_REACH * CHAR_LEG_LENGTH_M
     reach = float(np.sqrt((LANDING_REACH * CHAR_LEG_LENGTH_M) ** 2 - floor ** 2))
 
     def run(within: bool):
@@ -809,7 +836,7 @@ def test_an_operator_swing_is_aimed_within_the_legs_reach():
 
             session.motion._swing_target = recording
 
-        result = suite_run(spec, 1, MotionConfig(swing_within_reach=within), ControlConfig(), watch=watch)
+        result = suite_run(spec, 1, traced_motion(swing_within_reach=within), ControlConfig(), watch=watch)
         return max(far), result
 
     far, result = run(True)
@@ -841,7 +868,7 @@ def test_a_swing_that_would_land_out_of_reach_is_landed_by_the_balance():
                     sink.append(float(ref.pelvis_world[2] - state.root_pos_world[2]))
             return on_tick
 
-        result = suite_run(spec, 1, MotionConfig(recovery_on_reach_limit=flag, recovery_ds_on_reach_limit=False),
+        result = suite_run(spec, 1, traced_motion(recovery_on_reach_limit=flag, recovery_ds_on_reach_limit=False),
                             ControlConfig(), watch=watch)
         return taken, max(sink), result.fall_time_s or 12.0
 
@@ -874,10 +901,10 @@ def test_the_next_recovery_step_begins_while_both_soles_are_down():
                     steps.append((step.start_s, step.side, len(soles_on_ground(state))))
             return on_tick
 
-        result = suite_run(spec, 2, MotionConfig(recovery_min_stance_s=wait_s), ControlConfig(), watch=watch)
+        result = suite_run(spec, 2, traced_motion(recovery_min_stance_s=wait_s), ControlConfig(), watch=watch)
         return [x for x in steps if 3.49 < x[0] < 3.7], result
 
-    after, result = run(MotionConfig().recovery_min_stance_s)
+    after, result = run(traced_motion().recovery_min_stance_s)
     after_old, result_old = run(0.1)
     # measured: 3.53 s, the left foot, both soles down; with 0.1 s, 3.60 s, the right foot, the left sole alone
     assert after and after[0][1] == "left" and after[0][2] == 2 and after[0][0] < 3.55
@@ -889,17 +916,17 @@ def test_the_swing_target_is_back_at_the_ground_by_the_touchdown_share():
     com, vel = np.array([0.1, 0.03, 0.8]), np.array([0.45, 0.05, 0.0])
     heights = {}
     for share in (0.9, 1.0):
-        stepper = RecoveryStepper(MotionConfig(recovery_touchdown_share=share), CHAR_LEG_LENGTH_M, G)
+        stepper = RecoveryStepper(traced_motion(recovery_touchdown_share=share), CHAR_LEG_LENGTH_M, G)
         stepper.trigger(1.0, com, vel, ANKLES, QUATS, ["left", "right"])
         swing_s = stepper.cfg.recovery_swing_s
         heights[share] = [stepper.swing_target(1.0 + phase * swing_s, com, vel, ANKLES["left"], IDENTITY,
                                                np.eye(3))[2] for phase in (0.45, 0.5, 0.95)]
-    assert heights[1.0][1] == pytest.approx(ANKLE_HEIGHT_M + MotionConfig().recovery_step_height_m)  # top at 0.5
-    assert heights[0.9][0] == pytest.approx(ANKLE_HEIGHT_M + MotionConfig().recovery_step_height_m)  # at 0.45
+    assert heights[1.0][1] == pytest.approx(ANKLE_HEIGHT_M + traced_motion().recovery_step_height_m)  # top at 0.5
+    assert heights[0.9][0] == pytest.approx(ANKLE_HEIGHT_M + traced_motion().recovery_step_height_m)  # at 0.45
     assert heights[1.0][2] > ANKLE_HEIGHT_M  # still coming down
     assert heights[0.9][2] < ANKLE_HEIGHT_M  # down already, aimed below the ground
     with pytest.raises(ConfigError):
-        MotionConfig(recovery_touchdown_share=0.0)
+        traced_motion(recovery_touchdown_share=0.0)
 
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "07_11.bvh").exists(),
@@ -922,7 +949,7 @@ def test_recovery_steps_that_touch_down_on_time_stop_a_walk():
             elif not ref.recovery_ankle_world and started:
                 durations.append(state.time_s - started.pop())
 
-        result = suite_run(spec, 2, MotionConfig(recovery_touchdown_share=share, recovery_landing_gap_m=None),
+        result = suite_run(spec, 2, traced_motion(recovery_touchdown_share=share, recovery_landing_gap_m=None),
                            ControlConfig(), on_tick)
         return durations, result
 
@@ -936,7 +963,7 @@ def test_recovery_steps_that_touch_down_on_time_stop_a_walk():
 
 def test_a_landing_gap_must_be_positive():
     with pytest.raises(ConfigError, match="recovery_landing_gap_m"):
-        MotionConfig(recovery_landing_gap_m=0.0)
+        traced_motion(recovery_landing_gap_m=0.0)
 
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "08_08.bvh").exists(),
@@ -969,11 +996,11 @@ def test_a_recovery_step_that_reaches_the_ground_on_a_corner_has_landed():
                         resting.append(state.time_s)
             return on_tick
 
-        result = suite_run(spec, 3, MotionConfig(recovery_landing_gap_m=gap, swing_within_reach=False), ControlConfig(),
+        result = suite_run(spec, 3, traced_motion(recovery_landing_gap_m=gap, swing_within_reach=False), ControlConfig(),
                            watch=watch)
         return durations, resting, result
 
-    durations, _, result = run(MotionConfig().recovery_landing_gap_m)
+    durations, _, result = run(traced_motion().recovery_landing_gap_m)
     durations_force, resting_force, result_force = run(None)
     assert not result.fell and not result_force.fell
     assert max(durations_force) > 0.4

@@ -175,8 +175,10 @@ def test_a_qp_with_no_feasible_point_does_not_throw_the_limbs():
             return None
 
         control = ControlConfig(whole_body=WholeBodyConfig(relax_limits_when_infeasible=relax))
-        # traced before the crossover steps and the earlier touchdown of a recovery step's foot
-        motion = MotionConfig(recovery_cross_clear_m=None, recovery_touchdown_share=1.0, recovery_landing_gap_m=None)
+        # traced before the crossover steps, the earlier touchdown of a recovery step's foot and the swing aimed at
+        # the operator's last landing
+        motion = MotionConfig(recovery_cross_clear_m=None, recovery_touchdown_share=1.0, recovery_landing_gap_m=None,
+                              swing_landing="his_foot_now")
         result = suite_run(spec, 2, motion, control, watch=watch)
         return result, sessions[0].controller.relaxed_solves
 

@@ -107,6 +107,7 @@ class FilterConfig:
 
 
 SWING_PLACEMENTS = ("capture_point", "pelvis")
+SWING_LANDINGS = ("his_last_landing", "his_foot_now")
 
 
 @dataclass(frozen=True)
@@ -158,11 +159,23 @@ class MotionConfig:
     # point, scaled, from the character's capture point ("capture_point"), or relative to his pelvis from the
     # character's pelvis ("pelvis", no balance feedback, as Sec. 7.2's c_d = c_v = 0).
     swing_placement: str = "capture_point"
+    # With "capture_point", the landing's offset from the character's capture point is the one his foot had from his
+    # when it last came down on that side ("his_last_landing"), and the swing goes from where the character's foot
+    # lifted off to that landing as his swing proceeds; or ("his_foot_now") the offset his swing foot has from his
+    # capture point now, from a start placed relative to the stance foot as his is to his. During his swing his foot
+    # is far behind his capture point (0.7 m at his lift-off in the built-in walk): with "his_foot_now" the swing
+    # went back by up to 0.4 m before it came forward, and the character walked backwards (docs/decisions.md, "A
+    # character that walked backwards").
+    swing_landing: str = "his_last_landing"
     # With "capture_point", where the swing foot lands relative to the character's capture point, in the heading
     # frame: at least this far behind it (a foot landing ahead of it stops the body and, once the rear foot
     # lifts, drops it backwards; the linear inverted pendulum's steady gait lands about step / (e^(ωT) - 1)
     # behind, 0.1 m at this character's walking step and time) [m]
     step_behind_capture_point_m: float = 0.1
+    # ... and, with swing_landing "his_last_landing", at most this far behind it: a runner's foot lands 0.6-1 m
+    # behind his capture point, and copied from the smaller character's the body ran away from its feet and fell in
+    # the rest after the short runs (docs/decisions.md, "A character that walked backwards") (None: no bound) [m]
+    step_behind_capture_point_max_m: float | None = 0.3
     # and this far outside it, sideways (min, max): a foot further out throws the body back harder than the
     # next step can catch, and the sway grows from step to step [m]
     step_outside_capture_point_m: tuple[float, float] = (0.0, 0.04)
@@ -266,6 +279,13 @@ class MotionConfig:
         if not lo <= hi:
             raise ConfigError(f"MotionConfig.step_outside_capture_point_m must be (min, max), got {(lo, hi)}")
         _non_negative("MotionConfig.step_behind_capture_point_m", self.step_behind_capture_point_m)
+        if (self.step_behind_capture_point_max_m is not None
+                and self.step_behind_capture_point_max_m < self.step_behind_capture_point_m):
+            raise ConfigError(f"MotionConfig.step_behind_capture_point_max_m ({self.step_behind_capture_point_max_m}) "
+                              f"must be at least step_behind_capture_point_m ({self.step_behind_capture_point_m})")
+        if self.swing_landing not in SWING_LANDINGS:
+            raise ConfigError(f"MotionConfig.swing_landing must be one of {', '.join(SWING_LANDINGS)}, "
+                              f"got '{self.swing_landing}'")
         if self.swing_placement not in SWING_PLACEMENTS:
             raise ConfigError(f"MotionConfig.swing_placement must be one of {', '.join(SWING_PLACEMENTS)}, "
                               f"got '{self.swing_placement}'")

@@ -74,7 +74,7 @@ def _headline(metrics: dict | None) -> dict | None:
     if metrics is None:
         return None
     keys = ("fell", "fall_time_s", "sim_duration_s", "mpjpe_global_mm", "mpjpe_root_mm", "uhc_fall_time_s",
-            "foot_skate_mm", "operator_steps", "character_steps", "realtime_factor")
+            "path_progress", "foot_skate_mm", "operator_steps", "character_steps", "realtime_factor")
     return {k: metrics.get(k) for k in keys}
 
 
@@ -143,25 +143,26 @@ def _mean(values: list[float], fmt: str) -> str:
 
 def write_summary(out: Path, jobs: list[Job], settings: BatchSettings, counts: BatchCounts) -> dict:
     """batch.json, batch.md and report.html: per folder of clips, runs done and failed, completion (no fall),
-    runs without a UHC termination, mean fall time, MPJPE, foot skating."""
+    runs without a UHC termination, mean fall time, MPJPE, foot skating, how far along the operator's path."""
     results = [r for r in (read_result(out, job) for job in jobs) if r is not None]
     groups: dict[str, list[dict]] = {}
     for r in results:
         groups.setdefault(r["group"], []).append(r)
     header = ("| clips in | runs | failed | complete (no fall) | no UHC termination | mean fall time [s] | "
-              "MPJPE global [mm] | MPJPE root-rel. [mm] | foot skate [mm] |")
-    lines = [header, "|" + "---|" * 9]
+              "MPJPE global [mm] | MPJPE root-rel. [mm] | foot skate [mm] | along his path, median |")
+    lines = [header, "|" + "---|" * 10]
     for group, rs in sorted(groups.items()):
         ok = [r["metrics"] for r in rs if r["status"] == "ok" and r.get("metrics")]
         falls = [m["fall_time_s"] for m in ok if m.get("fell") and m.get("fall_time_s") is not None]
         complete = sum(1 for m in ok if not m.get("fell"))
         no_uhc = sum(1 for m in ok if m.get("uhc_fall_time_s") is None)
         col = {k: [m[k] for m in ok if m.get(k) is not None] for k in ("mpjpe_global_mm", "mpjpe_root_mm",
-                                                                        "foot_skate_mm")}
+                                                                        "foot_skate_mm", "path_progress")}
         lines.append(f"| {group} | {len(rs)} | {len(rs) - len(ok)} | {_share(complete, len(ok))} | "
                      f"{_share(no_uhc, len(ok))} | "
                      f"{_mean(falls, '.2f')} | {_mean(col['mpjpe_global_mm'], '.0f')} | "
-                     f"{_mean(col['mpjpe_root_mm'], '.0f')} | {_mean(col['foot_skate_mm'], '.1f')} |")
+                     f"{_mean(col['mpjpe_root_mm'], '.0f')} | {_mean(col['foot_skate_mm'], '.1f')} | "
+                     f"{format(float(np.median(col['path_progress'])), '.2f') if col['path_progress'] else '-'} |")
     failures = [f"- {r['name']}: {r['error']}" for r in results if r["status"] != "ok"]
     text = (f"# stylesync batch\n\n{len(results)} of {counts.total} runs have a result ({counts.failed} failed this "
             f"time, {counts.retried} retried, {counts.skipped} from an earlier run).\n\n" + "\n".join(lines) + "\n"

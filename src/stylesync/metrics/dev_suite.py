@@ -93,7 +93,8 @@ def run_clip(spec: str, seed: int, duration_s: float, controller: str) -> dict:
     result = run_and_release(cfg, opened.source)
     m = summarize(result)
     keys = ("fell", "fall_time_s", "sim_duration_s", "operator_steps", "character_steps",
-            "state_transition_delay_s", "mpjpe_global_mm", "mpjpe_root_mm", "uhc_fall_time_s", "realtime_factor")
+            "state_transition_delay_s", "mpjpe_global_mm", "mpjpe_root_mm", "uhc_fall_time_s", "path_progress",
+            "realtime_factor")
     return {"clip_end_s": clip_end, **{k: m.get(k) for k in keys}}
 
 
@@ -111,6 +112,10 @@ def _mean(values: list[float], fmt: str) -> str:
     return format(float(np.mean(values)), fmt) if values else "-"
 
 
+def _median(values: list[float], fmt: str) -> str:
+    return format(float(np.median(values)), fmt) if values else "-"
+
+
 def category_row(cat: str, version: str, rs: list[dict]) -> str:
     """One row of the per-category table (runs that could not be opened are counted, not averaged)."""
     ok = [r for r in rs if "error" not in r]
@@ -125,6 +130,7 @@ def category_row(cat: str, version: str, rs: list[dict]) -> str:
              _mean([r["mpjpe_global_mm"] for r in ok if r.get("mpjpe_global_mm") is not None], ".0f"),
              _mean([r["mpjpe_root_mm"] for r in ok if r.get("mpjpe_root_mm") is not None], ".0f"),
              f"{sum(r['character_steps'] for r in ok)}/{sum(r['operator_steps'] for r in ok)}",
+             _median([r["path_progress"] for r in ok if r.get("path_progress") is not None], ".2f"),
              f"{np.median(delays):.3f}" if delays else "-"]
     return "| " + " | ".join(cells) + " |"
 
@@ -133,8 +139,8 @@ def table(rows: list[dict], versions: list[str]) -> str:
     """The per-category Markdown table, one row per category and version (controller or code version)."""
     lines = ["| category | version | runs | opened | complete (no fall) | through the clip (no fall before its end) | "
              "no UHC termination | mean fall time [s] | MPJPE global [mm] | MPJPE root-rel. [mm] | steps char/op | "
-             "max delay median [s] |",
-             "|" + "---|" * 12]
+             "along his path, median | max delay median [s] |",
+             "|" + "---|" * 13]
     for cat in ORDER:
         for v in versions:
             rs = [r for r in rows if r["category"] == cat and r["version"] == v]

@@ -42,6 +42,24 @@ def uhc_fall_index(char_pos: np.ndarray, ref_pos: np.ndarray, limit_m: float = U
     return int(over[0]) if len(over) else None
 
 
+PATH_MIN_DISTANCE_M = 0.5  # an operator who moves less than this over the ground has no path to follow [m]
+
+
+def path_progress(char_root_world: np.ndarray, ref_root_world: np.ndarray,
+                  min_distance_m: float = PATH_MIN_DISTANCE_M) -> tuple[float | None, float | None]:
+    """How far the character went along its operator's path: its root's horizontal displacement from the first to
+    the last tick, projected on the (scaled) operator's, over the length of his (1: as far as he went, 0: in place,
+    negative: the other way), and its distance sideways of his line [m]. ``char_root_world`` and ``ref_root_world``
+    (T, 3) in metres; (None, None) when he moved less than ``min_distance_m``."""
+    c = np.asarray(char_root_world, dtype=float)
+    r = np.asarray(ref_root_world, dtype=float)
+    dc, dr = c[-1, :2] - c[0, :2], r[-1, :2] - r[0, :2]
+    length = float(np.hypot(dr[0], dr[1]))
+    if length < min_distance_m:
+        return None, None
+    return float(dc @ dr) / length**2, abs(float(dc[0] * dr[1] - dc[1] * dr[0])) / length
+
+
 def foot_skate_mm(foot_pos: np.ndarray, in_contact: np.ndarray) -> float:
     """Foot skating [mm]: mean horizontal displacement, per tick, of a foot that is in contact at both ends of the
     tick. ``foot_pos`` (T, F, 3), ``in_contact`` (T, F) booleans."""

@@ -90,12 +90,15 @@ def imitation_metrics(result: SessionResult) -> dict:
     ref = im.scale_operator_to_character(lg.array("op_joints"), lg.array("scale"), ch[0, 0])
     uhc = im.uhc_fall_index(ch, ref)
     feet = [im.JOINT_PAIRS.index(("left_ankle", "ANKLE_LEFT")), im.JOINT_PAIRS.index(("right_ankle", "ANKLE_RIGHT"))]
+    progress, sideways = im.path_progress(ch[:, 0], ref[:, 0])
     rel_ch, rel_ref = ch - ch[:, :1], ref - ref[:, :1]
     foot_down = np.stack([lg.array("contact_l"), lg.array("contact_r")], axis=1) > CONTACT_FORCE_N
     return {
         "mpjpe_global_mm": round(im.mpjpe_mm(ch, ref), 1),
         "mpjpe_root_mm": round(im.mpjpe_mm(ch, ref, root_relative=True), 1),
         "uhc_fall_time_s": None if uhc is None else float(t[uhc]),
+        "path_progress": None if progress is None else round(progress, 3),
+        "path_sideways_m": None if sideways is None else round(sideways, 3),
         "foot_skate_mm": round(im.foot_skate_mm(ch[:, feet], foot_down), 3),
         "jitter_mps2": round(im.jitter_mps2(ch, dt), 3),
         "sync_lag_s": round(im.sync_lag_s(rel_ref.reshape(len(t), -1), rel_ch.reshape(len(t), -1), dt), 4),

@@ -140,6 +140,9 @@ def joint_targets(local: dict[str, np.ndarray], hinge: dict[str, float]) -> np.n
     return joint_pos
 
 
+_MIRROR_Y = np.array([1.0, -1.0, 1.0])  # a heading-frame offset to the other side
+
+
 class _SmoothedRate:
     """Rate of change of a sampled vector: finite difference, exponentially averaged (_VELOCITY_SMOOTHING)."""
 
@@ -228,6 +231,11 @@ class MotionOptimizer:
         self._swing: str | None = None
         self._swing_offset = np.zeros(2)  # lift-off foot position minus the first swing target, decaying [m]
         self._swing_t0_s = 0.0  # when the character's current swing began [s]
+        self._liftoff_xy = np.zeros(2)  # where the current swing's foot lifted off [m]
+        # Per side, the offset of the operator's foot from his capture point when it last came down, scaled, in his
+        # heading frame (x forwards, y to the left) [m]; the side he has just landed, to be recorded this tick
+        self._his_landing: dict[str, np.ndarray] = {}
+        self._his_landed_side: str | None = None
         self._planted_yaw: dict[str, float] = {}  # each planted foot's yaw when it last pressed the ground [rad]
         self._op_swing_s = OPERATOR_SWING_S  # the operator's swing time, averaged over his swings [s]
         self._op_state: Stance | None = None
@@ -365,6 +373,7 @@ class MotionOptimizer:
                 self._op_last_ds_s = state.time_s - self._op_state_t0_s
                 self._op_ds_s += 0.5 * (min(max(self._op_last_ds_s, 0.05), 1.0) - self._op_ds_s)
             if self._op_state in (Stance.LS, Stance.RS):
+                self._his_landed_side = swing_side(self._op_state)
                 swing_s = min(max(state.time_s - self._op_state_t0_s, 0.2), 1.0)
                 self._op_swing_s += 0.5 * (swing_s - self._op_swing_s)
             self._op_state, self._op_state_t0_s = op_state, state.time_s
@@ -470,6 +479,7 @@ class MotionOptimizer:
     def _plan_feet(self, tick: _Tick, state: CharacterState, mass: MassProperties) -> None:
         """A planted foot where it is, the swing foot where the operator's is (or where a recovery step lands); the
         pelvis lowered as far as a foot that must land needs."""
+        self._record_his_landing(tick)
         self._recovery_step(tick, state)
         self._land_overrun_swing(tick, state)
         tick.weights = stance_weights(tick.ch_state, self._ds_left_share(tick.com_c, tick.a_c))
@@ -523,6 +533,14 @@ class MotionOptimizer:
                 above_foot = max(float(np.sqrt(max(_LANDING_REACH_M * _LANDING_REACH_M - d2, 0.0))),
                                  self._landing_pelvis_floor_m)
                 tick.pelvis_d[2] = min(tick.pelvis_d[2], tick.targets[side][2] + above_foot)
+
+    def _record_his_landing(self, tick: _Tick) -> None:
+        """On the tick the operator lands a foot: its offset from his capture point, scaled, in his heading frame
+        (the landing the character's swing on that side aims for relative to its own, swing_landing)."""
+        side, self._his_landed_side = self._his_landed_side, None
+        if side is not None:
+            ankle = tick.sample.pos[f"ANKLE_{_SIDE_UP[side]}"]
+            self._his_landing[side] = tick.R_root_d.T @ (tick.scale * (ankle - self._operator_capture_point(tick)))
 
     def _operator_capture_point(self, tick: _Tick) -> np.ndarray:
         """(3,) the operator's capture point, his COM height taken above his ankles plus the character's ankle
@@ -719,26 +737,41 @@ class MotionOptimizer:
         """Where the swing foot goes this tick.
 
         Where the operator's foot is, scaled, relative to the character's body ("pelvis": from its pelvis as his
-        is from his; no balance feedback, as Sec. 7.2's c_d = c_v = 0), or ("capture_point") relative to the
-        stance foot as his is to his, moved as the swing proceeds towards where the foot lands relative to the
-        character's capture point (COM + v / ω, ω = sqrt(g / h), the LIPM of Eq. 21) as his does relative to his,
-        within the landing limits: a character slower or faster than the operator steps shorter or further, as far
-        as it needs to stop over its feet (a foot-position form of Eq. 12's feedback). The move grows with the
-        swing's progress (its time over the operator's last swing time): at lift-off the foot is behind the body,
-        and the full move would pull it further back. With ``swing_within_reach`` the target is kept within the
-        leg's horizontal reach of its hip, the pelvis at its landing floor.
+        is from his; no balance feedback, as Sec. 7.2's c_d = c_v = 0), or ("capture_point") on the way from
+        where the character's foot lifted off to where it lands relative to the character's capture point
+        (COM + v / ω, ω = sqrt(g / h), the LIPM of Eq. 21) as his landed relative to his the last time on that side
+        (``swing_landing``), within the landing limits: a character slower or faster than the operator steps
+        shorter or further, as far as it needs to stop over its feet (a foot-position form of Eq. 12's feedback).
+        The way is covered with the swing's progress (its time over the operator's usual swing time); the foot's
+        height is his, scaled (his style). With ``swing_within_reach`` the target is kept within the leg's
+        horizontal reach of its hip, the pelvis at its landing floor.
         """
         cfg = self.cfg
         other = _OTHER_SIDE[side]
         a_h, a_c, scale, R_root_d = tick.a_h, tick.a_c, tick.scale, tick.R_root_d
+        first_tick = self._swing != side
+        if first_tick and cfg.swing_landing == "his_last_landing":
+            # The swing's progress and start are this swing's from its first tick. (With "his_foot_now" the first
+            # tick's progress is the last swing's, as that swing was built and measured: its target is then the
+            # full landing, and the start's blend below takes a stride back from there.)
+            self._swing_t0_s = state.time_s
+            self._liftoff_xy = a_c[side][:2].copy()
         target = tick.pelvis_d + scale * (a_h[side] - tick.p_h)
         if cfg.swing_placement == "capture_point":
             com_c = tick.com_c
-            from_stance = a_c[other] + scale * (a_h[side] - a_h[other])
             xi_c = com_c + tick.com_vel_c * np.sqrt(max(com_c[2], 0.1) / self.g)
             xi_h = self._operator_capture_point(tick)
-            land = R_root_d.T @ (scale * (a_h[side] - xi_h))  # heading frame, from the capture point
+            last = self._his_landing.get(side)
+            if cfg.swing_landing == "his_last_landing" and (last is not None or self._his_landing):
+                # his last landing on this side; if he has landed only the other foot yet, that one mirrored
+                land = last.copy() if last is not None else self._his_landing[other] * _MIRROR_Y
+            else:  # his swing foot's present offset (heading frame, from the capture point)
+                land = R_root_d.T @ (scale * (a_h[side] - xi_h))
+            start = (self._liftoff_xy if cfg.swing_landing == "his_last_landing"
+                     else (a_c[other] + scale * (a_h[side] - a_h[other]))[:2])
             land[0] = min(land[0], -cfg.step_behind_capture_point_m)
+            if cfg.swing_landing == "his_last_landing" and cfg.step_behind_capture_point_max_m is not None:
+                land[0] = max(land[0], -cfg.step_behind_capture_point_max_m)
             out = 1.0 if side == "left" else -1.0
             land[1] = out * min(max(out * land[1], cfg.step_outside_capture_point_m[0]),
                                 cfg.step_outside_capture_point_m[1])
@@ -746,7 +779,7 @@ class MotionOptimizer:
             landing = xi_c + R_root_d @ land
             if cfg.recovery_steps:
                 landing = self._stopping_landing(tick, state, side, xi_h, landing)
-            target[:2] = (from_stance + progress * (landing - from_stance))[:2]
+            target[:2] = start + progress * (landing[:2] - start)
         else:
             target[:2] = (state.root_pos_world + scale * (a_h[side] - tick.p_h))[:2]
         target[2] = min(max(target[2], ANKLE_HEIGHT_M), ANKLE_HEIGHT_M + cfg.max_swing_foot_lift_m)
@@ -765,7 +798,7 @@ class MotionOptimizer:
             target[:2] = a_c[other][:2] + step * (bound / dist)
         # The swing starts where the foot lifts off: the difference to the first target is taken up over
         # SWING_BLEND_S (a target jump would swing the leg hard enough to lift the stance foot).
-        if self._swing != side:
+        if first_tick:
             self._swing_offset = a_c[side][:2] - target[:2]
             self._swing_t0_s = state.time_s
         self._swing_offset *= self._swing_decay
