@@ -413,8 +413,8 @@ def test_targets_that_follow_the_operator_keep_the_walk_up_with_him():
     covered = {}
     for tau in (0.0, 0.5):
         opened = open_source("builtin:walk", seed=0, duration_s=7.0)
-        cfg = SessionConfig(duration_s=7.0, seed=0, motion=traced_motion(**TWIST_FREE, reference_follows_operator_s=tau),
-                            control=TRACED)
+        cfg = SessionConfig(duration_s=7.0, seed=0,
+                            motion=traced_motion(**TWIST_FREE, reference_follows_operator_s=tau), control=TRACED)
         session = Session(cfg, opened.source)
         start = {}
 
@@ -996,8 +996,8 @@ def test_a_recovery_step_that_reaches_the_ground_on_a_corner_has_landed():
                         resting.append(state.time_s)
             return on_tick
 
-        result = suite_run(spec, 3, traced_motion(recovery_landing_gap_m=gap, swing_within_reach=False), ControlConfig(),
-                           watch=watch)
+        result = suite_run(spec, 3, traced_motion(recovery_landing_gap_m=gap, swing_within_reach=False),
+                           ControlConfig(), watch=watch)
         return durations, resting, result
 
     durations, _, result = run(traced_motion().recovery_landing_gap_m)
