@@ -161,8 +161,7 @@ class MotionConfig:
     swing_placement: str = "capture_point"
     # With "capture_point", the landing's offset from the character's capture point is the one his foot had from his
     # when it last came down on that side ("his_last_landing"), and the swing goes from where the character's foot
-    # lifted off (forwards; sideways, where his stride from his stance foot puts it) to that landing as his swing
-    # proceeds; or ("his_foot_now") the offset his swing foot has from his
+    # lifted off to that landing as his swing proceeds; or ("his_foot_now") the offset his swing foot has from his
     # capture point now, from a start placed relative to the stance foot as his is to his. During his swing his foot
     # is far behind his capture point (0.7 m at his lift-off in the built-in walk): with "his_foot_now" the swing
     # went back by up to 0.4 m before it came forward, and the character walked backwards (docs/decisions.md, "A

@@ -738,8 +738,7 @@ class MotionOptimizer:
 
         Where the operator's foot is, scaled, relative to the character's body ("pelvis": from its pelvis as his
         is from his; no balance feedback, as Sec. 7.2's c_d = c_v = 0), or ("capture_point") on the way from
-        where the character's foot lifted off (forwards; sideways, from where his stride puts it relative to the
-        stance foot) to where it lands relative to the character's capture point
+        where the character's foot lifted off to where it lands relative to the character's capture point
         (COM + v / ω, ω = sqrt(g / h), the LIPM of Eq. 21) as his landed relative to his the last time on that side
         (``swing_landing``), within the landing limits: a character slower or faster than the operator steps
         shorter or further, as far as it needs to stop over its feet (a foot-position form of Eq. 12's feedback).
@@ -768,15 +767,8 @@ class MotionOptimizer:
                 land = last.copy() if last is not None else self._his_landing[other] * _MIRROR_Y
             else:  # his swing foot's present offset (heading frame, from the capture point)
                 land = R_root_d.T @ (scale * (a_h[side] - xi_h))
-            his_stride = (a_c[other] + scale * (a_h[side] - a_h[other]))[:2]  # from the stance foot as his
-            if cfg.swing_landing == "his_last_landing":
-                # forwards from the lift-off point; sideways his stride's (his style: a narrow, crossing or wide
-                # swing path)
-                r2, stance_xy = R_root_d[:2, :2], a_c[other][:2]
-                start = stance_xy + r2 @ np.array([float(r2[:, 0] @ (self._liftoff_xy - stance_xy)),
-                                                   float(r2[:, 1] @ (his_stride - stance_xy))])
-            else:
-                start = his_stride
+            start = (self._liftoff_xy if cfg.swing_landing == "his_last_landing"
+                     else (a_c[other] + scale * (a_h[side] - a_h[other]))[:2])
             land[0] = min(land[0], -cfg.step_behind_capture_point_m)
             if cfg.swing_landing == "his_last_landing" and cfg.step_behind_capture_point_max_m is not None:
                 land[0] = max(land[0], -cfg.step_behind_capture_point_max_m)
