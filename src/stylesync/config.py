@@ -160,12 +160,13 @@ class MotionConfig:
     # character's pelvis ("pelvis", no balance feedback, as Sec. 7.2's c_d = c_v = 0).
     swing_placement: str = "capture_point"
     # With "capture_point", the landing's offset from the character's capture point is the one his foot had from his
-    # when it last came down on that side ("his_last_landing"), and the swing goes from where the character's foot
-    # lifted off to that landing as his swing proceeds; or ("his_foot_now") the offset his swing foot has from his
-    # capture point now, from a start placed relative to the stance foot as his is to his. During his swing his foot
-    # is far behind his capture point (0.7 m at his lift-off in the built-in walk): with "his_foot_now" the swing
-    # went back by up to 0.4 m before it came forward, and the character walked backwards (docs/decisions.md, "A
-    # character that walked backwards").
+    # when it last came down on that side ("his_last_landing"; the other side's, mirrored, until he has landed on
+    # this one; before his first landing, the present offset of his swing foot), and the swing goes from where the
+    # character's foot lifted off to that landing as his swing proceeds; or ("his_foot_now") the offset his swing
+    # foot has from his capture point now, from a start placed relative to the stance foot as his is to his. During
+    # his swing his foot is far behind his capture point (0.7 m at his lift-off in the built-in walk): with
+    # "his_foot_now" the swing went back by up to 0.4 m before it came forward, and the character walked backwards
+    # (docs/decisions.md, "A character that walked backwards").
     swing_landing: str = "his_last_landing"
     # With "capture_point", where the swing foot lands relative to the character's capture point, in the heading
     # frame: at least this far behind it (a foot landing ahead of it stops the body and, once the rear foot
