@@ -236,6 +236,7 @@ class MotionOptimizer:
         # heading frame (x forwards, y to the left) [m]; the side he has just landed, to be recorded this tick
         self._his_landing: dict[str, np.ndarray] = {}
         self._his_landed_side: str | None = None
+        self._aim_at_his_landing = cfg.swing_landing == "his_last_landing"  # MotionConfig.swing_landing
         self._planted_yaw: dict[str, float] = {}  # each planted foot's yaw when it last pressed the ground [rad]
         self._op_swing_s = OPERATOR_SWING_S  # the operator's swing time, averaged over his swings [s]
         self._op_state: Stance | None = None
@@ -538,7 +539,7 @@ class MotionOptimizer:
         """On the tick the operator lands a foot: its offset from his capture point, scaled, in his heading frame
         (the landing the character's swing on that side aims for relative to its own, swing_landing)."""
         side, self._his_landed_side = self._his_landed_side, None
-        if side is not None:
+        if side is not None and self._aim_at_his_landing:
             ankle = tick.sample.pos[f"ANKLE_{_SIDE_UP[side]}"]
             self._his_landing[side] = tick.R_root_d.T @ (tick.scale * (ankle - self._operator_capture_point(tick)))
 
@@ -750,7 +751,7 @@ class MotionOptimizer:
         other = _OTHER_SIDE[side]
         a_h, a_c, scale, R_root_d = tick.a_h, tick.a_c, tick.scale, tick.R_root_d
         first_tick = self._swing != side
-        if first_tick and cfg.swing_landing == "his_last_landing":
+        if first_tick and self._aim_at_his_landing:
             # The swing's progress and start are this swing's from its first tick. (With "his_foot_now" the first
             # tick's progress is the last swing's, as that swing was built and measured: its target is then the
             # full landing, and the start's blend below takes a stride back from there.)
@@ -762,15 +763,15 @@ class MotionOptimizer:
             xi_c = com_c + tick.com_vel_c * np.sqrt(max(com_c[2], 0.1) / self.g)
             xi_h = self._operator_capture_point(tick)
             last = self._his_landing.get(side)
-            if cfg.swing_landing == "his_last_landing" and (last is not None or self._his_landing):
+            if self._aim_at_his_landing and (last is not None or self._his_landing):
                 # his last landing on this side; if he has landed only the other foot yet, that one mirrored
                 land = last.copy() if last is not None else self._his_landing[other] * _MIRROR_Y
             else:  # his swing foot's present offset (heading frame, from the capture point)
                 land = R_root_d.T @ (scale * (a_h[side] - xi_h))
-            start = (self._liftoff_xy if cfg.swing_landing == "his_last_landing"
+            start = (self._liftoff_xy if self._aim_at_his_landing
                      else (a_c[other] + scale * (a_h[side] - a_h[other]))[:2])
             land[0] = min(land[0], -cfg.step_behind_capture_point_m)
-            if cfg.swing_landing == "his_last_landing" and cfg.step_behind_capture_point_max_m is not None:
+            if self._aim_at_his_landing and cfg.step_behind_capture_point_max_m is not None:
                 land[0] = max(land[0], -cfg.step_behind_capture_point_max_m)
             out = 1.0 if side == "left" else -1.0
             land[1] = out * min(max(out * land[1], cfg.step_outside_capture_point_m[0]),
