@@ -94,6 +94,7 @@ class WholeBodyFormulation:
         self._limit_upper = np.array([lim.upper_rad for lim in limits])  # [rad]
         self.contact_velocity_gain = contact_velocity_gain  # [1/s]
         self.limit_horizon_s = limit_horizon_s  # [s]
+        self._templates: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}  # by the number of soles
 
     def add_task(self, task: T) -> T:
         self.tasks.append(task)
@@ -107,7 +108,8 @@ class WholeBodyFormulation:
 
     def build(self, model: CharacterModel, contacts: list[SoleContact]) -> QpProblem:
         nv = N_DOFS
-        n_f = FORCES_PER_SOLE * len(contacts)
+        n_c = len(contacts)
+        n_f = FORCES_PER_SOLE * n_c
         n = nv + n_f
         h_mat = np.zeros((n, n))
         g = np.zeros(n)
@@ -125,49 +127,57 @@ class WholeBodyFormulation:
             wj = r.weight[:, None] * r.jacobian
             h_mat[:nv, :nv] += r.jacobian.T @ wj
             g[:nv] -= wj.T @ r.target
-        gen = np.zeros((nv, n_f))  # B
+        # Equalities: the root's equations of motion, then each sole's 6 acceleration rows. Then the inequalities:
+        # joint torques, each sole's normal force, the pyramids' λ >= 0, the hinges' limits. What does not change
+        # from one tick to the next (the pyramids' and the hinges' unit rows, their bounds) comes from a template.
+        n_eq = ROOT_DOFS + 6 * n_c
+        n_tau = nv - ROOT_DOFS
+        template = self._templates.get(n_c)
+        if template is None:
+            template = self._templates[n_c] = self._template(n_c)
+        rows, lower, upper = (a.copy() for a in template)
+        m, h = model.mass_matrix, model.bias_forces
+        rows[:ROOT_DOFS, :nv] = m[:ROOT_DOFS]
+        lower[:ROOT_DOFS] = -h[:ROOT_DOFS]
+        tau_rows = slice(n_eq, n_eq + n_tau)
+        rows[tau_rows, :nv] = m[ROOT_DOFS:]
         for i, c in enumerate(contacts):
             c.update(model)
             sl = slice(nv + FORCES_PER_SOLE * i, nv + FORCES_PER_SOLE * (i + 1))
             h_mat.ravel()[sl.start * (n + 1):sl.stop * (n + 1):n + 1] = c.regularisation
-            gen[:, sl.start - nv:sl.stop - nv] = c.generator
-        m, h = model.mass_matrix, model.bias_forces
-        # Equalities: the root's equations of motion, then each sole's 6 acceleration rows. Then the inequalities:
-        # joint torques, each sole's normal force, the pyramids' λ >= 0, the hinges' limits.
-        n_eq = ROOT_DOFS + 6 * len(contacts)
-        n_tau = nv - ROOT_DOFS
-        n_in = n_tau + len(contacts) + n_f + len(self.limits)
-        rows = np.zeros((n_eq + n_in, n))
-        lower = np.empty(n_eq + n_in)
-        upper = np.empty(n_eq + n_in)
-        rows[:ROOT_DOFS, :nv] = m[:ROOT_DOFS]
-        rows[:ROOT_DOFS, nv:] = -gen[:ROOT_DOFS]
-        lower[:ROOT_DOFS] = -h[:ROOT_DOFS]
-        for i, c in enumerate(contacts):
+            rows[:ROOT_DOFS, sl] = -c.generator[:ROOT_DOFS]  # -B of the equations of motion
+            rows[tau_rows, sl] = -c.generator[ROOT_DOFS:]
             jac, acc = c.constraint_rows(self.contact_velocity_gain)
             rows[ROOT_DOFS + 6 * i:ROOT_DOFS + 6 * (i + 1), :nv] = jac
             lower[ROOT_DOFS + 6 * i:ROOT_DOFS + 6 * (i + 1)] = acc
+            normal = n_eq + n_tau + i
+            rows[normal, sl] = c.normal_row
+            upper[normal] = c.max_normal_force_n
         upper[:n_eq] = lower[:n_eq]
-        row = n_eq
-        rows[row:row + n_tau, :nv] = m[ROOT_DOFS:]
-        rows[row:row + n_tau, nv:] = -gen[ROOT_DOFS:]
-        lower[row:row + n_tau] = -self.torque_limit_nm - h[ROOT_DOFS:]
-        upper[row:row + n_tau] = self.torque_limit_nm - h[ROOT_DOFS:]
-        row += n_tau
-        for i, c in enumerate(contacts):
-            rows[row, nv + FORCES_PER_SOLE * i:nv + FORCES_PER_SOLE * (i + 1)] = c.normal_row
-            lower[row], upper[row] = 0.0, c.max_normal_force_n
-            row += 1
-        rows[row:row + n_f, nv:].flat[::n_f + 1] = 1.0
-        lower[row:row + n_f], upper[row:row + n_f] = 0.0, INFINITY
-        row += n_f
+        lower[tau_rows] = -self.torque_limit_nm - h[ROOT_DOFS:]
+        upper[tau_rows] = self.torque_limit_nm - h[ROOT_DOFS:]
         if self.limits:  # q + q̇ T + ½ q̈ T² within the limits
             t = self.limit_horizon_s
             q, qd = model.joint_positions(self._limit_dofs), model.v[self._limit_dofs]
-            rows[row + self._limit_rows, self._limit_dofs] = 1.0
-            lower[row:] = np.minimum(2.0 * (self._limit_lower - q - qd * t) / (t * t), 0.0)
-            upper[row:] = np.maximum(2.0 * (self._limit_upper - q - qd * t) / (t * t), 0.0)
+            first = len(rows) - len(self.limits)
+            lower[first:] = np.minimum(2.0 * (self._limit_lower - q - qd * t) / (t * t), 0.0)
+            upper[first:] = np.maximum(2.0 * (self._limit_upper - q - qd * t) / (t * t), 0.0)
         return QpProblem(h_mat, g, rows, lower, upper, n_eq, n_f)
+
+    def _template(self, n_contacts: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The constraint rows and bounds of a QP with ``n_contacts`` soles that are the same at every tick: the
+        pyramids' λ >= 0, the normal forces' lower bound 0 and the hinges' unit rows; the rest is zero."""
+        nv, n_f = N_DOFS, FORCES_PER_SOLE * n_contacts
+        n_eq = ROOT_DOFS + 6 * n_contacts
+        n_in = nv - ROOT_DOFS + n_contacts + n_f + len(self.limits)
+        rows = np.zeros((n_eq + n_in, nv + n_f))
+        lower, upper = np.zeros(n_eq + n_in), np.zeros(n_eq + n_in)
+        row = n_eq + nv - ROOT_DOFS + n_contacts  # the normal-force rows (lower bound 0) come before this
+        rows[row:row + n_f, nv:].flat[::n_f + 1] = 1.0
+        lower[row:row + n_f], upper[row:row + n_f] = 0.0, INFINITY
+        row += n_f
+        rows[row + self._limit_rows, self._limit_dofs] = 1.0
+        return rows, lower, upper
 
     def with_limits_opened(self, problem: QpProblem) -> QpProblem:
         """A copy of ``problem`` without its joint torque limits and its hinges' limit horizon (those rows bounded by

@@ -31,6 +31,14 @@ class Task(ABC):
 
     name: str = "task"
     active: bool = True
+    frame: str = ""  # the frame a task on one frame acts on
+    _frame_of: tuple[int, int] | None = None  # (id of the model, the frame's index in it), looked up once
+
+    def _frame_id(self, model: CharacterModel) -> int:
+        """The index of ``frame`` in ``model``."""
+        if self._frame_of is None or self._frame_of[0] != id(model):
+            self._frame_of = (id(model), model.frame_id(self.frame))
+        return self._frame_of[1]
 
     @abstractmethod
     def rows(self, model: CharacterModel) -> TaskRows:

@@ -28,7 +28,7 @@ class FramePositionTask(Task):
         self.target_vel_world = np.zeros(3)  # [m/s]
 
     def rows(self, model: CharacterModel) -> TaskRows:
-        f = model.frame_id(self.frame)
+        f = self._frame_id(model)
         jac = model.frame_jacobian(f)[self.axes]
         pos, vel = model.frame_placement(f).translation, model.frame_velocity(f)[:3]
         accel = self.kp * (self.target_world - pos) + self.kd * (self.target_vel_world - vel)
@@ -53,7 +53,7 @@ class FrameOrientationTask(Task):
         self._r_frame_canonical = rot.matrix_from_quat(q_frame_canonical_wxyz)
 
     def rows(self, model: CharacterModel) -> TaskRows:
-        f = model.frame_id(self.frame)
+        f = self._frame_id(model)
         r = model.frame_placement(f).rotation @ self._r_frame_canonical
         self.error_rotvec = pin.log3(rot.matrix_from_quat(self.target_quat_wxyz) @ r.T)
         omega = model.frame_velocity(f)[3:]
