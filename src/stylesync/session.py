@@ -273,8 +273,9 @@ class Session:
         self._place_character()
         run = _RunState(render_every_s)
         tick_steps = control_tick_steps(n_steps, dt, 1.0 / cfg.clocks.control_hz)
-        is_tick = np.zeros(n_steps, dtype=bool)
-        is_tick[tick_steps] = True
+        is_tick = [False] * n_steps  # Python bools: read at every physics step
+        for k in tick_steps:
+            is_tick[k] = True
         operator: OperatorInline | OperatorPrefetch = OperatorInline(self.source, self.processing)
         if self.prefetch_operator and OperatorPrefetch.usable(self.source, cfg.realtime, cfg.gui):
             operator = OperatorPrefetch(self.source, self.processing, [k * dt for k in tick_steps])
@@ -407,8 +408,10 @@ class Session:
         if state.non_foot_ground_contact:
             return "a link other than a foot touched the ground"
         # A run-away controller (or simulation) is a failure too, even while the body is in the air.
-        speed = float(np.sqrt(np.einsum("ij,ij->i", state.link_com_vel_world, state.link_com_vel_world).max()))
-        if speed > DIVERGED_LINK_SPEED_MPS or state.root_pos_world[2] > DIVERGED_ROOT_HEIGHT_M:
+        v = state.link_com_vel_world
+        speed_sq = float((v * v).sum(axis=1).max())  # the fastest link's squared speed [m²/s²]
+        if speed_sq > DIVERGED_LINK_SPEED_MPS ** 2 or state.root_pos_world[2] > DIVERGED_ROOT_HEIGHT_M:
+            speed = speed_sq ** 0.5
             return (f"the motion diverged (a link at {speed:.0f} m/s, pelvis at {state.root_pos_world[2]:.1f} m; "
                     f"limits {DIVERGED_LINK_SPEED_MPS:.0f} m/s, {DIVERGED_ROOT_HEIGHT_M:.1f} m)")
         return ""

@@ -25,7 +25,7 @@ class Stance(Enum):
 
 
 def swing_side(s: Stance) -> str | None:
-    return {Stance.LS: "right", Stance.RS: "left", Stance.DS: None}[s]
+    return "right" if s is Stance.LS else ("left" if s is Stance.RS else None)
 
 
 def stance_weights(s: Stance, ds_left_share: float) -> dict[str, float]:
