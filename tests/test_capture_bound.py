@@ -1,5 +1,7 @@
 """The bound on the COM target's capture point (motion/capture_bound.py)."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -15,7 +17,7 @@ from stylesync.model.sole import (
     sole_corners_world,
     sole_points_xy,
 )
-from stylesync.motion.capture_bound import bounded_com_target
+from stylesync.motion.capture_bound import bounded_com_target, landing_catch_region
 from stylesync.motion.recovery_step import capture_point
 
 IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
@@ -154,3 +156,54 @@ def test_a_lunge_the_character_cannot_stop_from_is_not_asked_for():
                                     recovery_ds_on_reach_limit=False, recovery_landing_gap_m=None,
                                     swing_landing="his_foot_now"))
     assert unbounded.fell and unbounded.fall_time_s < 6.0
+
+
+def test_a_capture_point_in_the_landing_catch_region_is_caught_by_the_landing_when_the_foot_lands():
+    """ξ̇ = ω (ξ - p): from a point of the region, a centre of pressure p held within the stance sole brings ξ within
+    the landing's sole (the stance sole moved by the landing's offset) when the foot lands; from a point beyond the
+    region, no corner of the stance sole does. A long remaining time draws the region onto the stance sole."""
+    rng = np.random.default_rng(3)
+    stance = sole_points_xy(np.array([0.1, -0.09, ANKLE_HEIGHT_M]), IDENTITY, sole_corner_points(0.8))
+    for _ in range(50):
+        offset = (float(rng.uniform(-0.1, 0.5)), float(rng.uniform(0.1, 0.35)))
+        k = float(np.exp(-OMEGA * rng.uniform(0.0, 0.6)))
+        region_pts = landing_catch_region(stance, offset, k)
+        region = convex_hull_points(region_pts)
+        landing = convex_hull_points([(x + offset[0], y + offset[1]) for x, y in stance])
+        for i in rng.integers(0, len(region_pts), size=5):  # a corner (1 - k) p + k q, p the stance corner held
+            xi, p = np.array(region_pts[i]), np.array(stance[i // len(stance)])
+            assert outside_distance_points(tuple(p + (xi - p) / k), landing)[0] <= 1e-9
+        beyond = np.array(region).mean(axis=0) + np.array([0.0, 0.3])
+        if outside_distance_points(tuple(beyond), region)[0] > 1e-3:
+            assert all(outside_distance_points(tuple(np.array(p) + (beyond - np.array(p)) / k), landing)[0] > 0.0
+                       for p in stance)
+    far = convex_hull_points(landing_catch_region(stance, (0.4, 0.2), float(np.exp(-OMEGA * 5.0))))
+    assert np.allclose(sorted(far), sorted(convex_hull_points(stance)), atol=1e-6)
+    assert np.allclose(sorted(convex_hull_points(landing_catch_region(stance, (0.4, 0.2), 1.0))),
+                       sorted((x + 0.4, y + 0.2) for x, y in stance))
+
+
+ZOMBIE = Path(__file__).resolve().parents[2] / "shared" / "mocap" / "deepmimic" / "humanoid3d_zombie_walk.txt"
+
+
+@pytest.mark.skipif(not ZOMBIE.exists(), reason="../shared/mocap/deepmimic/humanoid3d_zombie_walk.txt is not available")
+def test_a_long_single_stance_keeps_the_capture_point_where_the_landing_catches_it_when_opted_in():
+    """The zombie walk (seed 0): its operator holds each single stance about 0.8 s with his COM 0.13-0.20 m (scaled)
+    inwards of his stance ankle. The character's COM target follows it there, its COM falls inwards over the stance
+    foot faster than the swing (held to his timing) lands, and it falls at 5.75 s. With the single stance's bound
+    across the heading (MotionConfig.landing_capture_bound "sideways") the target's capture point stays where the
+    landing catches it, and the walk holds through its 12 s."""
+    from conftest import suite_run
+
+    from stylesync.config import ControlConfig
+
+    spec = f"deepmimic:{ZOMBIE}"
+    off = suite_run(spec, 0, MotionConfig(), ControlConfig())
+    sideways = suite_run(spec, 0, MotionConfig(landing_capture_bound="sideways"), ControlConfig())
+    assert off.fell and off.fall_time_s < 6.0
+    assert not sideways.fell
+
+
+def test_the_landing_bound_is_checked():
+    with pytest.raises(ConfigError):
+        MotionConfig(landing_capture_bound="forwards")

@@ -108,6 +108,7 @@ class FilterConfig:
 
 SWING_PLACEMENTS = ("capture_point", "pelvis")
 SWING_LANDINGS = ("his_last_landing", "his_foot_now")
+LANDING_CAPTURE_BOUNDS = ("all", "sideways", "off")
 
 
 @dataclass(frozen=True)
@@ -274,6 +275,11 @@ class MotionConfig:
     # of its length and width about its centre, in double stance, and in single stance while the operator balances
     # over his stance sole (motion/capture_bound.py; 0: off) [-]
     capture_bound_sole_share: float = 0.8
+    # Opt-in: in single stance (not the character's own step), the COM target's capture point is kept where the
+    # planned landing catches it when the swing foot lands (MotionOptimizer._landing_bounded_com_target): "all",
+    # only "sideways" (across the heading), or "off". Measured on the development suite, neither gains beyond the
+    # spread between seeds, and "all" halves the walks' progress along the operator's path (docs/decisions.md).
+    landing_capture_bound: str = "off"
 
     def __post_init__(self) -> None:
         lo, hi = self.step_outside_capture_point_m
@@ -287,6 +293,9 @@ class MotionConfig:
         if self.swing_landing not in SWING_LANDINGS:
             raise ConfigError(f"MotionConfig.swing_landing must be one of {', '.join(SWING_LANDINGS)}, "
                               f"got '{self.swing_landing}'")
+        if self.landing_capture_bound not in LANDING_CAPTURE_BOUNDS:
+            raise ConfigError(f"MotionConfig.landing_capture_bound must be one of "
+                              f"{', '.join(LANDING_CAPTURE_BOUNDS)}, got '{self.landing_capture_bound}'")
         if self.swing_placement not in SWING_PLACEMENTS:
             raise ConfigError(f"MotionConfig.swing_placement must be one of {', '.join(SWING_PLACEMENTS)}, "
                               f"got '{self.swing_placement}'")

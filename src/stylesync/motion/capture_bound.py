@@ -11,6 +11,9 @@ mid-stride. So the target's capture point is kept within the soles the character
 * in its single stance, while the operator's own capture point is within the soles he stands on (he balances on one
   leg, as in a kick, or has stopped while the character's foot is still in the air). Where his balance leans out of
   his support (a walk's single stance), the character's target is left as it is: the swing foot catches it.
+  Opt-in (MotionConfig.landing_capture_bound): there too, the target's capture point is kept within the stance sole
+  and the region the planned landing catches when the foot lands (:func:`landing_catch_region`), wholly or across
+  the heading only; a slow single stance (a styled step held long) then keeps it over the stance foot.
 
 Where ξ_d is outside, by d, the target's capture point becomes the nearest point ξ_d' of the (shrunk) support
 polygon, and its velocity is cut to ċ_d' = ċ_d max(0, 1 - d / BAND_M): c_d' = ξ_d' - ċ_d' / ω. With the
@@ -54,3 +57,17 @@ def bounded_com_target(com_d_world: np.ndarray, com_vel_d_world: np.ndarray, ome
     vel = np.array([vx * keep, vy * keep, float(com_vel_d_world[2])])
     com = np.array([nx - vel[0] / omega_1ps, ny - vel[1] / omega_1ps, float(com_d_world[2])])
     return com, vel
+
+
+def landing_catch_region(stance_xy: list[Point], landing_offset_xy: tuple[float, float],
+                         shrink: float) -> list[Point]:
+    """The capture points [m] that a landing catches, for a capture point bounded in single stance (corners of a
+    convex region): with the centre of pressure held at a point p of the stance sole (corners ``stance_xy``),
+    ξ(T) = p + (ξ - p) exp(ω T) after the swing's remaining time T, so the capture points now whose ξ(T) is within
+    the landing's sole (the stance sole moved by ``landing_offset_xy``, the landing ankle from the stance ankle) are
+    (1 - k) p + k q, q within the landing's sole, k = ``shrink`` = exp(-ω T): the region spanned by every pair of
+    the two soles' corners."""
+    dx, dy = landing_offset_xy
+    landing = [(x + dx, y + dy) for x, y in stance_xy]
+    return [((1.0 - shrink) * px + shrink * qx, (1.0 - shrink) * py + shrink * qy)
+            for px, py in stance_xy for qx, qy in landing]

@@ -44,7 +44,7 @@ from stylesync.model.sole import sole_corner_points, sole_outside_m, sole_points
 from stylesync.model.state import CharacterState, MassProperties
 from stylesync.motion.balance_strategy import stance_hip_blend, swing_hip_feedback
 from stylesync.motion.bounds import BoundsMonitor, step_length_bound_m
-from stylesync.motion.capture_bound import bounded_com_target
+from stylesync.motion.capture_bound import bounded_com_target, landing_catch_region
 from stylesync.motion.leg_ik import solve_leg
 from stylesync.motion.operator_analysis import UPPER_JOINTS, OperatorAnalysis, analyse_operator, upper_local
 from stylesync.motion.recovery_step import (
@@ -249,6 +249,7 @@ class MotionOptimizer:
         self._outside_since_s: float | None = None  # the character's capture point left its double support then [s]
         self._stopping_capture_side: str | None = None  # the swing whose landing _stopping_landing moved last tick
         self._sole_bound = sole_corner_points(cfg.capture_bound_sole_share)  # shrunk for capture_bound.py [m]
+        self._swing_landing_xy: np.ndarray | None = None  # this tick's planned landing of the swing ankle [m]
         self.reading: MotionReading | None = None  # the last tick's reading of the operator, besides the targets
 
     def prime_rates(self, com_vel_h_world: np.ndarray, com_vel_d_world: np.ndarray) -> None:
@@ -481,6 +482,7 @@ class MotionOptimizer:
         """A planted foot where it is, the swing foot where the operator's is (or where a recovery step lands); the
         pelvis lowered as far as a foot that must land needs."""
         self._record_his_landing(tick)
+        self._swing_landing_xy = None
         self._recovery_step(tick, state)
         self._land_overrun_swing(tick, state)
         tick.weights = stance_weights(tick.ch_state, self._ds_left_share(tick.com_c, tick.a_c))
@@ -577,6 +579,29 @@ class MotionOptimizer:
                  for s in soles_on_ground(state) if tick.weights[s] > 0.0]
         _, omega = capture_point(tick.com_c, tick.com_vel_c, self.g)
         return bounded_com_target(com_d, com_vel_d, omega, soles)
+
+    def _landing_bounded_com_target(self, tick: _Tick, state: CharacterState, com_d: np.ndarray,
+                                    com_vel_d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """In single stance, the COM target with its capture point where the planned landing catches it when the
+        swing foot lands (the divergent component of motion, ξ̇ = ω (ξ - p)): within the stance sole, or within the
+        landing's sole drawn towards the stance sole's centre by exp(-ω T), T the swing's remaining time at the
+        operator's usual swing time (capture_bound.py). A capture point further out diverges beyond the landing
+        before the foot is down: a long single stance (a slow, styled step) keeps it over the stance foot."""
+        other = _OTHER_SIDE[tick.swing]
+        stance = sole_points_xy(tick.a_c[other], state.link_quat_wxyz[_LINK[f"{other}_ankle"]], self._sole_bound)
+        _, omega = capture_point(tick.com_c, tick.com_vel_c, self.g)
+        remaining_s = max(self._op_swing_s - (state.time_s - self._swing_t0_s), 0.0)
+        assert self._swing_landing_xy is not None
+        offset = (float(self._swing_landing_xy[0] - tick.a_c[other][0]),
+                  float(self._swing_landing_xy[1] - tick.a_c[other][1]))
+        landing = landing_catch_region(stance, offset, math.exp(-omega * remaining_s))
+        bounded, bounded_vel = bounded_com_target(com_d, com_vel_d, omega, [stance, landing])
+        if self.cfg.landing_capture_bound == "sideways":  # only the change across the heading is taken
+            side_axis = np.array([tick.R_root_d[0, 1], tick.R_root_d[1, 1], 0.0])
+            side_axis /= max(float(np.linalg.norm(side_axis)), 1e-9)
+            bounded = com_d + float(side_axis @ (bounded - com_d)) * side_axis
+            bounded_vel = com_vel_d + float(side_axis @ (bounded_vel - com_vel_d)) * side_axis
+        return bounded, bounded_vel
 
     def _stopping_landing(self, tick: _Tick, state: CharacterState, side: str, xi_h: np.ndarray,
                           landing: np.ndarray) -> np.ndarray:
@@ -780,6 +805,7 @@ class MotionOptimizer:
             landing = xi_c + R_root_d @ land
             if cfg.recovery_steps:
                 landing = self._stopping_landing(tick, state, side, xi_h, landing)
+            self._swing_landing_xy = landing[:2].copy()
             target[:2] = start + progress * (landing[:2] - start)
         else:
             target[:2] = (state.root_pos_world + scale * (a_h[side] - tick.p_h))[:2]
@@ -896,6 +922,8 @@ class MotionOptimizer:
             com_vel_d = np.array([tick.com_vel_c[0], tick.com_vel_c[1], 0.0])
         elif self.cfg.capture_bound_sole_share > 0.0 and self._capture_bounded(tick):
             com_d, com_vel_d = self._bounded_com_target(tick, state, com_d, com_vel_d)
+        elif self.cfg.landing_capture_bound != "off" and tick.swing is not None and self._swing_landing_xy is not None:
+            com_d, com_vel_d = self._landing_bounded_com_target(tick, state, com_d, com_vel_d)
         self.reading = MotionReading(tick.op_state, tick.analysis.features, self.char_fsm.hold_reference, tick.scale,
                                      tick.step_exceeded)
         return ReferencePose(
