@@ -583,15 +583,15 @@ class MotionOptimizer:
     def _landing_bounded_com_target(self, tick: _Tick, state: CharacterState, com_d: np.ndarray,
                                     com_vel_d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """In single stance, the COM target with its capture point where the planned landing catches it when the
-        swing foot lands (the divergent component of motion, ξ̇ = ω (ξ - p)): within the stance sole, or within the
-        landing's sole drawn towards the stance sole's centre by exp(-ω T), T the swing's remaining time at the
-        operator's usual swing time (capture_bound.py). A capture point further out diverges beyond the landing
-        before the foot is down: a long single stance (a slow, styled step) keeps it over the stance foot."""
+        swing foot lands (the divergent component of motion, ξ̇ = ω (ξ - p)): within the stance sole, or within
+        capture_bound.landing_catch_region, T the swing's remaining time at the operator's usual swing time. A
+        capture point further out diverges beyond the landing before the foot is down: a long single stance (a slow,
+        styled step) keeps it over the stance foot. With "sideways", only the change across the heading is taken."""
+        assert tick.swing is not None and self._swing_landing_xy is not None
         other = _OTHER_SIDE[tick.swing]
         stance = sole_points_xy(tick.a_c[other], state.link_quat_wxyz[_LINK[f"{other}_ankle"]], self._sole_bound)
         _, omega = capture_point(tick.com_c, tick.com_vel_c, self.g)
         remaining_s = max(self._op_swing_s - (state.time_s - self._swing_t0_s), 0.0)
-        assert self._swing_landing_xy is not None
         offset = (float(self._swing_landing_xy[0] - tick.a_c[other][0]),
                   float(self._swing_landing_xy[1] - tick.a_c[other][1]))
         landing = landing_catch_region(stance, offset, math.exp(-omega * remaining_s))
