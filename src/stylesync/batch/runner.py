@@ -141,6 +141,10 @@ def _mean(values: list[float], fmt: str) -> str:
     return format(float(np.mean(values)), fmt) if values else "-"
 
 
+def _median(values: list[float], fmt: str) -> str:
+    return format(float(np.median(values)), fmt) if values else "-"
+
+
 def write_summary(out: Path, jobs: list[Job], settings: BatchSettings, counts: BatchCounts) -> dict:
     """batch.json, batch.md and report.html: per folder of clips, runs done and failed, completion (no fall),
     runs without a UHC termination, mean fall time, MPJPE, foot skating, how far along the operator's path."""
@@ -162,7 +166,7 @@ def write_summary(out: Path, jobs: list[Job], settings: BatchSettings, counts: B
                      f"{_share(no_uhc, len(ok))} | "
                      f"{_mean(falls, '.2f')} | {_mean(col['mpjpe_global_mm'], '.0f')} | "
                      f"{_mean(col['mpjpe_root_mm'], '.0f')} | {_mean(col['foot_skate_mm'], '.1f')} | "
-                     f"{format(float(np.median(col['path_progress'])), '.2f') if col['path_progress'] else '-'} |")
+                     f"{_median(col['path_progress'], '.2f')} |")
     failures = [f"- {r['name']}: {r['error']}" for r in results if r["status"] != "ok"]
     text = (f"# stylesync batch\n\n{len(results)} of {counts.total} runs have a result ({counts.failed} failed this "
             f"time, {counts.retried} retried, {counts.skipped} from an earlier run).\n\n" + "\n".join(lines) + "\n"

@@ -198,6 +198,7 @@ class _Tick:
     targets: dict[str, np.ndarray] = field(default_factory=dict)  # ankle targets
     foot_yaw: dict[str, float] = field(default_factory=dict)
     step_exceeded: bool = False
+    swing_landing_xy: np.ndarray | None = None  # where the swing ankle is planned to land (his swing) [m]
     # The operator's capture point and whether it is within the soles he stands on, computed once a tick
     xi_h: np.ndarray | None = None
     stands: dict[tuple[str, ...], bool] = field(default_factory=dict)
@@ -249,7 +250,6 @@ class MotionOptimizer:
         self._outside_since_s: float | None = None  # the character's capture point left its double support then [s]
         self._stopping_capture_side: str | None = None  # the swing whose landing _stopping_landing moved last tick
         self._sole_bound = sole_corner_points(cfg.capture_bound_sole_share)  # shrunk for capture_bound.py [m]
-        self._swing_landing_xy: np.ndarray | None = None  # this tick's planned landing of the swing ankle [m]
         self.reading: MotionReading | None = None  # the last tick's reading of the operator, besides the targets
 
     def prime_rates(self, com_vel_h_world: np.ndarray, com_vel_d_world: np.ndarray) -> None:
@@ -482,7 +482,6 @@ class MotionOptimizer:
         """A planted foot where it is, the swing foot where the operator's is (or where a recovery step lands); the
         pelvis lowered as far as a foot that must land needs."""
         self._record_his_landing(tick)
-        self._swing_landing_xy = None
         self._recovery_step(tick, state)
         self._land_overrun_swing(tick, state)
         tick.weights = stance_weights(tick.ch_state, self._ds_left_share(tick.com_c, tick.a_c))
@@ -587,13 +586,13 @@ class MotionOptimizer:
         capture_bound.landing_catch_region, T the swing's remaining time at the operator's usual swing time. A
         capture point further out diverges beyond the landing before the foot is down: a long single stance (a slow,
         styled step) keeps it over the stance foot. With "sideways", only the change across the heading is taken."""
-        assert tick.swing is not None and self._swing_landing_xy is not None
+        assert tick.swing is not None and tick.swing_landing_xy is not None
         other = _OTHER_SIDE[tick.swing]
         stance = sole_points_xy(tick.a_c[other], state.link_quat_wxyz[_LINK[f"{other}_ankle"]], self._sole_bound)
         _, omega = capture_point(tick.com_c, tick.com_vel_c, self.g)
         remaining_s = max(self._op_swing_s - (state.time_s - self._swing_t0_s), 0.0)
-        offset = (float(self._swing_landing_xy[0] - tick.a_c[other][0]),
-                  float(self._swing_landing_xy[1] - tick.a_c[other][1]))
+        offset = (float(tick.swing_landing_xy[0] - tick.a_c[other][0]),
+                  float(tick.swing_landing_xy[1] - tick.a_c[other][1]))
         landing = landing_catch_region(stance, offset, math.exp(-omega * remaining_s))
         bounded, bounded_vel = bounded_com_target(com_d, com_vel_d, omega, [stance, landing])
         if self.cfg.landing_capture_bound == "sideways":  # only the change across the heading is taken
@@ -805,7 +804,7 @@ class MotionOptimizer:
             landing = xi_c + R_root_d @ land
             if cfg.recovery_steps:
                 landing = self._stopping_landing(tick, state, side, xi_h, landing)
-            self._swing_landing_xy = landing[:2].copy()
+            tick.swing_landing_xy = landing[:2]
             target[:2] = start + progress * (landing[:2] - start)
         else:
             target[:2] = (state.root_pos_world + scale * (a_h[side] - tick.p_h))[:2]
@@ -922,7 +921,7 @@ class MotionOptimizer:
             com_vel_d = np.array([tick.com_vel_c[0], tick.com_vel_c[1], 0.0])
         elif self.cfg.capture_bound_sole_share > 0.0 and self._capture_bounded(tick):
             com_d, com_vel_d = self._bounded_com_target(tick, state, com_d, com_vel_d)
-        elif self.cfg.landing_capture_bound != "off" and tick.swing is not None and self._swing_landing_xy is not None:
+        elif self.cfg.landing_capture_bound != "off" and tick.swing is not None and tick.swing_landing_xy is not None:
             com_d, com_vel_d = self._landing_bounded_com_target(tick, state, com_d, com_vel_d)
         self.reading = MotionReading(tick.op_state, tick.analysis.features, self.char_fsm.hold_reference, tick.scale,
                                      tick.step_exceeded)
