@@ -401,6 +401,11 @@ class WholeBodyConfig:
     recovery_foot_task_kp: float = 400.0
     recovery_foot_task_kd: float = 40.0
     recovery_foot_task_weight: float = 100.0
+    # Once the step's landing is due (its target pressed below the ground, recovery_step.swing_target) and the foot has
+    # not touched yet, its task weighs this. Traced on the falls left in the development suite: most end in recovery
+    # steps whose foot hovers 3-4 cm above the ground for 0.2-0.5 s past its touchdown, while the body sinks onto the
+    # folding swing leg (docs/decisions.md, "A recovery step's landing that is due") [-]
+    recovery_foot_landing_weight: float = 1000.0
     # The posture task's weight on the hip, knee and ankle of each supporting leg, as a share of its weight elsewhere.
     # A supporting leg closes a chain through the ground: its joint angles are where the pelvis is over the foot,
     # which the momentum task (the COM), the pelvis height and the pelvis orientation already ask for. At full weight
@@ -426,7 +431,8 @@ class WholeBodyConfig:
         for n in ("momentum_com_kp", "momentum_com_kd", "momentum_root_kp", "momentum_root_kd",
                   "contact_velocity_gain", "sole_contact_gap_m", "joint_tracking_weight", "hand_task_kp",
                   "hand_task_kd", "hand_task_weight", "stance_leg_tracking_share", "single_stance_pelvis_share",
-                  "recovery_foot_task_kp", "recovery_foot_task_kd", "recovery_foot_task_weight"):
+                  "recovery_foot_task_kp", "recovery_foot_task_kd", "recovery_foot_task_weight",
+                  "recovery_foot_landing_weight"):
             _non_negative(f"WholeBodyConfig.{n}", getattr(self, n))
 
 

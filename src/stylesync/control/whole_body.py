@@ -85,6 +85,9 @@ JOINT_ACCEL_TORQUE_SHARE = 0.1
 # Each DOF's tracking weight M_ii is taken as at least this [kg·m²]: with the feet's own inertia, a swing foot's
 # tracking was the cheapest term to trade for the wrench, and it swung tilted by 20-100° and landed on an edge.
 MIN_TRACKING_INERTIA_KGM2 = 0.05
+# A recovery step's target this far or further below the foot's height on the ground means its landing is due: the
+# motion stage aims the foot below the ground once the swing's touchdown share is over (recovery_step.swing_target) [m]
+LANDING_DUE_BELOW_M = 0.005
 # The hinges' limits are kept over this horizon: q + q̇ T + ½ q̈ T² stays within them [s].
 JOINT_LIMIT_HORIZON_S = 0.05
 # A hand target is kept within this share of the arm's length from its shoulder (a straight arm reaches it).
@@ -202,6 +205,9 @@ class WholeBodyController(ControllerBase):
                 self._recovery_target.pop(s, None)
                 continue
             self._move_target(task, self._recovery_target, s, target, np.zeros(3))  # at rest on the step's first tick
+            # A target below the ground: the landing is due and the foot has not touched (the step ends when it does)
+            due = target[2] < ANKLE_HEIGHT_M - LANDING_DUE_BELOW_M
+            task.weight = wb.recovery_foot_landing_weight if due else wb.recovery_foot_task_weight
         for s, task in self.hands.items():
             task.active = ref.hand_world is not None
             if ref.hand_world is not None:

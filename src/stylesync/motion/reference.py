@@ -38,7 +38,8 @@ class ReferencePose:
     press_swing_foot: bool
     # The operator's wrists relative to his pelvis (world axes), scaled, placed at the character's pelvis [m]
     hand_world: dict[str, np.ndarray] | None = None
-    # The swing ankle's target during a step the character takes on its own (recovery_step.py) [m]
+    # The swing ankle's target during a step the character takes on its own (recovery_step.py); below the ground once
+    # its landing is due [m]
     recovery_ankle_world: dict[str, np.ndarray] | None = None
 
 
