@@ -404,7 +404,8 @@ class WholeBodyConfig:
     # Once the step's landing is due (its target pressed below the ground, recovery_step.swing_target) and the foot has
     # not touched yet, its task weighs this. Traced on the falls left in the development suite: most end in recovery
     # steps whose foot hovers 3-4 cm above the ground for 0.2-0.5 s past its touchdown, while the body sinks onto the
-    # folding swing leg (docs/decisions.md, "A recovery step's landing that is due") [-]
+    # folding swing leg (docs/decisions.md, "A recovery step's landing that is due"). The weight of the press on a
+    # stance foot that has not touched yet (whole_body.FOOT_TASK_WEIGHT) [-]
     recovery_foot_landing_weight: float = 1000.0
     # The posture task's weight on the hip, knee and ankle of each supporting leg, as a share of its weight elsewhere.
     # A supporting leg closes a chain through the ground: its joint angles are where the pelvis is over the foot,
