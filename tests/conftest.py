@@ -3,8 +3,13 @@ import dataclasses
 import numpy as np
 
 from stylesync import rotations as rot
-from stylesync.config import ControlConfig, MotionConfig
+from stylesync.config import ControlConfig, MotionConfig, WholeBodyConfig
 from stylesync.model.character import JOINTS, JointKind
+
+# Scenarios traced before a recovery step's due landing weighed more than its swing (WholeBodyConfig.
+# recovery_foot_landing_weight): with it, the contrast runs of some of them no longer fall.
+TRACED_BEFORE_LANDING_WEIGHT = ControlConfig(whole_body=WholeBodyConfig(
+    recovery_foot_landing_weight=WholeBodyConfig().recovery_foot_task_weight))
 
 
 def random_pose(seed: int, ball_sigma_rad: float = 0.3, hinge_rad: float = 0.6) -> np.ndarray:

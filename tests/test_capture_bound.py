@@ -4,8 +4,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import TRACED_BEFORE_LANDING_WEIGHT
 
-from stylesync.config import ConfigError, ControlConfig, MotionConfig, OperatorConfig, SessionConfig, WholeBodyConfig
+from stylesync.config import ConfigError, ControlConfig, MotionConfig, OperatorConfig, SessionConfig
 from stylesync.model.character import ANKLE_HEIGHT_M
 from stylesync.model.sole import (
     convex_hull_points,
@@ -124,11 +125,9 @@ def test_a_lunge_the_character_cannot_stop_from_is_not_asked_for():
 
     def run(motion: MotionConfig):
         opened = open_source("builtin:punch", seed=1, duration_s=12.0)
-        # Traced before a recovery step's due landing weighed more than its swing (WholeBodyConfig.
-        # recovery_foot_landing_weight): with it the unbounded run holds too.
-        control = ControlConfig(whole_body=WholeBodyConfig(
-            recovery_foot_landing_weight=WholeBodyConfig().recovery_foot_task_weight))
-        cfg = SessionConfig(duration_s=12.0, seed=1, operator=OperatorConfig(), motion=motion, control=control)
+        # Traced before a recovery step's due landing weighed more than its swing: with it the unbounded run holds too
+        cfg = SessionConfig(duration_s=12.0, seed=1, operator=OperatorConfig(), motion=motion,
+                            control=TRACED_BEFORE_LANDING_WEIGHT)
         session = Session(cfg, opened.source)
         worst = [-np.inf]
 
@@ -198,7 +197,6 @@ def test_a_long_single_stance_keeps_the_capture_point_where_the_landing_catches_
     across the heading (MotionConfig.landing_capture_bound "sideways") the target's capture point stays where the
     landing catches it, and the walk holds through its 12 s."""
     from conftest import suite_run
-
 
     spec = f"deepmimic:{ZOMBIE}"
     off = suite_run(spec, 0, MotionConfig(), ControlConfig())

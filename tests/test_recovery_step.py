@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import suite_run
+from conftest import TRACED_BEFORE_LANDING_WEIGHT, suite_run
 
 from stylesync.config import ControlConfig, MotionConfig, OperatorConfig, SessionConfig, WholeBodyConfig
 from stylesync.errors import ConfigError
@@ -41,12 +41,6 @@ def traced_motion(**kwargs) -> MotionConfig:
     from his capture point (MotionConfig.swing_landing "his_foot_now", the swing as it was then): their motion
     configurations start from it."""
     return MotionConfig(**{"swing_landing": "his_foot_now", **kwargs})
-
-
-# Scenarios traced before a recovery step's due landing weighed more than its swing (WholeBodyConfig.
-# recovery_foot_landing_weight): with it, the contrast runs of some of them no longer fall.
-TRACED_CONTROL = ControlConfig(whole_body=WholeBodyConfig(
-    recovery_foot_landing_weight=WholeBodyConfig().recovery_foot_task_weight))
 
 
 def test_support_polygon_distance_is_signed_and_finds_the_nearest_point():
@@ -685,7 +679,7 @@ def test_a_double_stance_that_would_wait_out_of_reach_steps_at_once():
         # traced without crossing, and with the touchdown at the swing's end
         motion = traced_motion(recovery_ds_on_reach_limit=on, recovery_cross_clear_m=None, recovery_touchdown_share=1.0,
                               recovery_landing_gap_m=None)
-        result = suite_run(spec, 1, motion, TRACED_CONTROL, watch=watch)
+        result = suite_run(spec, 1, motion, TRACED_BEFORE_LANDING_WEIGHT, watch=watch)
         return starts, result
 
     at_once, result = run(True)
@@ -956,7 +950,7 @@ def test_recovery_steps_that_touch_down_on_time_stop_a_walk():
                 durations.append(state.time_s - started.pop())
 
         result = suite_run(spec, 2, traced_motion(recovery_touchdown_share=share, recovery_landing_gap_m=None),
-                           TRACED_CONTROL, on_tick)
+                           TRACED_BEFORE_LANDING_WEIGHT, on_tick)
         return durations, result
 
     durations, result = run(0.9)
@@ -1003,7 +997,7 @@ def test_a_recovery_step_that_reaches_the_ground_on_a_corner_has_landed():
             return on_tick
 
         result = suite_run(spec, 3, traced_motion(recovery_landing_gap_m=gap, swing_within_reach=False),
-                           TRACED_CONTROL, watch=watch)
+                           TRACED_BEFORE_LANDING_WEIGHT, watch=watch)
         return durations, resting, result
 
     durations, _, result = run(traced_motion().recovery_landing_gap_m)
@@ -1029,6 +1023,7 @@ def test_a_recovery_step_whose_landing_is_due_is_pressed_onto_the_ground():
         at the run's end (or fall) included, and the result."""
         waits: list[float] = []
         due_since: list[float] = []
+        last_tick_s = [0.0]
 
         def on_tick(state, ref):
             due = any(t[2] < ANKLE_HEIGHT_M - 0.005 for t in (ref.recovery_ankle_world or {}).values())
@@ -1036,15 +1031,13 @@ def test_a_recovery_step_whose_landing_is_due_is_pressed_onto_the_ground():
                 due_since.append(state.time_s)
             elif not due and due_since:
                 waits.append(state.time_s - due_since.pop())
-            elif due:
-                last_tick[0] = state.time_s
+            last_tick_s[0] = state.time_s
 
-        last_tick = [0.0]
         result = suite_run(spec, 1, MotionConfig(),
                            ControlConfig(whole_body=WholeBodyConfig(recovery_foot_landing_weight=landing_weight)),
                            on_tick=on_tick)
         if due_since:
-            waits.append(last_tick[0] - due_since[0])
+            waits.append(last_tick_s[0] - due_since[0])
         return waits, result
 
     swing_weight = WholeBodyConfig().recovery_foot_task_weight
