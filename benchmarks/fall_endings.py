@@ -24,9 +24,8 @@ import json
 import logging
 from concurrent.futures import ProcessPoolExecutor
 
-from stylesync.control.whole_body import LANDING_DUE_BELOW_M
+from stylesync.control.whole_body import recovery_landing_due
 from stylesync.metrics.dev_suite import suite_config
-from stylesync.model.character import ANKLE_HEIGHT_M
 from stylesync.session import Session
 from stylesync.sources.registry import open_source
 
@@ -48,7 +47,7 @@ def trace_fall(job: tuple[str, str, int, float, float]) -> dict:
         if targets and not in_step[0]:
             steps[0] += 1
         in_step[0] = bool(targets)
-        due = any(t[2] < ANKLE_HEIGHT_M - LANDING_DUE_BELOW_M for t in targets.values())
+        due = any(recovery_landing_due(t) for t in targets.values())
         if due and not due_since:
             due_since.append(state.time_s)
         elif not due and due_since:

@@ -11,6 +11,7 @@ import pytest
 from conftest import TRACED_BEFORE_LANDING_WEIGHT, suite_run
 
 from stylesync.config import ControlConfig, MotionConfig, OperatorConfig, SessionConfig, WholeBodyConfig
+from stylesync.control.whole_body import recovery_landing_due
 from stylesync.errors import ConfigError
 from stylesync.model.character import ANKLE_HEIGHT_M, FOOT_CENTER_AHEAD_OF_ANKLE_M, FOOT_LENGTH_M, LINK_NAMES
 from stylesync.model.sole import convex_hull_xy, outside_distance_m, sole_corners_world
@@ -1026,7 +1027,7 @@ def test_a_recovery_step_whose_landing_is_due_is_pressed_onto_the_ground():
         last_tick_s = [0.0]
 
         def on_tick(state, ref):
-            due = any(t[2] < ANKLE_HEIGHT_M - 0.005 for t in (ref.recovery_ankle_world or {}).values())
+            due = any(recovery_landing_due(t) for t in (ref.recovery_ankle_world or {}).values())
             if due and not due_since:
                 due_since.append(state.time_s)
             elif not due and due_since:

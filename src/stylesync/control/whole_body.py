@@ -95,6 +95,11 @@ HAND_REACH_SHARE = 1.0
 _TORQUE_LIMIT_FLAT = flatten_joint_values(np.repeat(TORQUE_LIMIT, 3, axis=1))
 
 
+def recovery_landing_due(target_world: np.ndarray) -> bool:
+    """Whether a recovery step's ankle target (3,) [m] is below the ground, i.e. its landing is due."""
+    return bool(target_world[2] < ANKLE_HEIGHT_M - LANDING_DUE_BELOW_M)
+
+
 class WholeBodyController(ControllerBase):
     needs_joint_feedback = False
 
@@ -206,7 +211,7 @@ class WholeBodyController(ControllerBase):
                 continue
             self._move_target(task, self._recovery_target, s, target, np.zeros(3))  # at rest on the step's first tick
             # A target below the ground: the landing is due and the foot has not touched (the step ends when it does)
-            due = target[2] < ANKLE_HEIGHT_M - LANDING_DUE_BELOW_M
+            due = recovery_landing_due(target)
             task.weight = wb.recovery_foot_landing_weight if due else wb.recovery_foot_task_weight
         for s, task in self.hands.items():
             task.active = ref.hand_world is not None
