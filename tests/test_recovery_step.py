@@ -14,7 +14,7 @@ from stylesync.config import ControlConfig, MotionConfig, OperatorConfig, Sessio
 from stylesync.control.whole_body import recovery_landing_due
 from stylesync.errors import ConfigError
 from stylesync.model.character import ANKLE_HEIGHT_M, FOOT_CENTER_AHEAD_OF_ANKLE_M, FOOT_LENGTH_M, LINK_NAMES
-from stylesync.model.sole import convex_hull_xy, outside_distance_m, sole_corners_world
+from stylesync.model.sole import convex_hull_xy, outside_distance_m, sole_corners_world, sole_outside_m
 from stylesync.motion.pose_optimization import CHAR_LEG_LENGTH_M, LANDING_REACH
 from stylesync.motion.recovery_step import (
     MIN_FOOT_SEPARATION_M,
@@ -879,6 +879,44 @@ def test_a_swing_that_would_land_out_of_reach_is_landed_by_the_balance():
     assert not any(t < 2.5 for t in taken_old)
     assert sink < 0.05 and sink_old > 0.1  # measured: 0.007 m against 0.136 m
     assert fall > fall_old + 1.0  # measured: 4.3 s against 2.9 s
+
+
+@pytest.mark.skipif(not (MOCAP / "cmu-dev" / "09_01.bvh").exists(),
+                    reason="../shared/mocap/cmu-dev/09_01.bvh is not available")
+def test_a_swing_past_its_usual_time_is_landed_before_the_capture_point_runs_out_of_reach():
+    """CMU-dev 09_01 (a run), seed 7: the clip ends at 1.20 s with the operator on his right foot, his left foot
+    raised and then lowered slowly (the held last frame). His usual swing time is past from about 1.27 s, and his
+    landing is predicted for now: the capture point is not yet beyond a recovery step's reach from the stance ankle,
+    so the swing waited until 1.385 s, with the capture point 0.49 m outside the stance sole, and the run fell in the
+    rest at 2.25 s (measured). Predicted a recovery swing ahead (``recovery_overdue_swing_horizon``), the swing is
+    taken over at 1.323 s, 0.38 m outside, and the run comes to rest."""
+    spec = f"bvh:{MOCAP / 'cmu-dev' / '09_01.bvh'}"
+
+    def run(flag: bool):
+        """The take-overs after the clip's end (start time [s], capture point outside the stance sole [m]) and the
+        result."""
+        taken: list[tuple[float, float]] = []
+
+        def watch(session):
+            def on_tick(state, ref):
+                step = session.motion.recovery.step
+                if step is None or not step.taken_over or step.start_s < 1.2 or step.start_s in dict(taken):
+                    return
+                xi, _ = capture_point(session.mass.com(state), session.mass.com_velocity(state), 9.81)
+                stance = LINK_NAMES.index(f"{'left' if step.side == 'right' else 'right'}_ankle")
+                taken.append((step.start_s, sole_outside_m(xi, state.link_origin_world[stance],
+                                                           state.link_quat_wxyz[stance])))
+            return on_tick
+
+        return taken, suite_run(spec, 7, MotionConfig(recovery_overdue_swing_horizon=flag), ControlConfig(),
+                                watch=watch)
+
+    taken, result = run(True)
+    taken_old, result_old = run(False)
+    assert 1.30 <= taken[0][0] <= 1.35 and taken[0][1] < 0.42  # measured: 1.323 s, 0.376 m
+    assert taken_old[0][0] >= 1.37 and taken_old[0][1] > 0.45  # measured: 1.385 s, 0.490 m
+    assert not result.fell
+    assert result_old.fell and result_old.fall_time_s < 3.0  # measured: 2.25 s
 
 
 @pytest.mark.skipif(not (MOCAP / "deepmimic" / "humanoid3d_stealthy_walk.txt").exists(),

@@ -231,6 +231,12 @@ class MotionConfig:
     # vaulted over its stance foot and sank while his slower swing went on (docs/decisions.md, "Landing before the
     # capture point is out of reach")
     recovery_on_reach_limit: bool = True
+    # ... where his swing has outlasted his usual swing time (a pose on one leg, a clip's held last frame, his raised
+    # foot lowered slowly), that prediction is made a recovery step's swing time (recovery_swing_s) ahead, not for
+    # now: his landing is no longer due at any known time, and the soonest the balance itself can land the foot is
+    # a recovery step's swing from now. Predicted for now, the capture point ran out of reach in the single stance
+    # before the rule fired (docs/decisions.md, "A swing past its usual time: when it can land")
+    recovery_overdue_swing_horizon: bool = True
     # ... and in the character's double stance, whatever the operator does: once its capture point has been outside
     # the support polygon of its soles (by more than the margin) for this many times his usual double stance, a
     # recovery step (he walks on, or stands on one foot, while the character waits for a lift-off of his that

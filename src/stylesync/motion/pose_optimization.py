@@ -749,12 +749,16 @@ class MotionOptimizer:
 
     def _capture_beyond_reach_at_his_landing(self, tick: _Tick, state: CharacterState, side: str,
                                             stance_quat_wxyz: np.ndarray) -> bool:
-        """Whether the capture point, at the end of the operator's usual swing time from the swing's start (now, if
-        that is past), will be further from the stance ankle than a recovery step reaches: the balance has to land
-        the swing of ``side`` before he would (recovery_step.capture_point_after, as a recovery step's landing
-        predicts it)."""
+        """Whether the capture point, at the end of the operator's usual swing time from the swing's start, will be
+        further from the stance ankle than a recovery step reaches: the balance has to land the swing of ``side``
+        before he would (recovery_step.capture_point_after, as a recovery step's landing predicts it). Past his
+        usual swing time the landing is predicted a recovery swing from now with ``recovery_overdue_swing_horizon``
+        (the soonest any landing can come), and now without."""
         ankle = tick.a_c[_OTHER_SIDE[side]]
-        remaining_s = max(self._op_swing_s - (state.time_s - self._swing_t0_s), 0.0)
+        elapsed_s = state.time_s - self._swing_t0_s
+        remaining_s = max(self._op_swing_s - elapsed_s, 0.0)
+        if self.cfg.recovery_overdue_swing_horizon and elapsed_s >= self._op_swing_s:
+            remaining_s = self.cfg.recovery_swing_s
         x, y = capture_point_after(tick.com_c, tick.com_vel_c, self.g, ankle, stance_quat_wxyz, remaining_s)
         return math.hypot(x - float(ankle[0]), y - float(ankle[1])) > self.recovery.max_step_m
 
