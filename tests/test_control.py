@@ -138,7 +138,9 @@ def test_default_walk_over_sensor_noise_seeds_mostly_completes_and_follows_the_o
     # paper's figure), but one: with the supporting legs' posture at 0.1 of its weight, seed 6 has one transition
     # of 13 at 0.188 s (the others of all 12 seeds within 0.097 s); one run is allowed up to 0.2 s. A run the
     # balance saves with a step of its own (MotionConfig.recovery_step_behind_cos: seed 6, which otherwise falls at
-    # 5.3 s) follows the operator late there (0.68 s): the delays are judged on the runs without one, at most two.
+    # 5.3 s) follows the operator late there (0.68 s): the delays are judged on the runs without one, at most three
+    # (with MotionConfig.recovery_overdue_swing_horizon seeds 7 and 11 take one too, where a swing of the operator's
+    # outlasts his usual swing time; all 12 complete, their largest delays 0.105 and 0.113 s).
     from stylesync.metrics.summary import summarize
 
     fall_times, completed, own_steps = [], [], 0
@@ -152,7 +154,7 @@ def test_default_walk_over_sensor_noise_seeds_mostly_completes_and_follows_the_o
             own_steps += 1
         elif not result.fell:
             completed.append(summarize(result))
-    assert len(completed) + own_steps >= 8 and own_steps <= 2, (fall_times, own_steps)
+    assert len(completed) + own_steps >= 8 and own_steps <= 3, (fall_times, own_steps)
     for m in completed:
         assert m["operator_steps"] >= 8
         assert m["character_steps"] >= 0.8 * m["operator_steps"]

@@ -39,9 +39,10 @@ MOCAP = Path(__file__).resolve().parents[2] / "shared" / "mocap"
 
 def traced_motion(**kwargs) -> MotionConfig:
     """The scenarios of this module were traced with the swing aimed at the operator's swing foot's present offset
-    from his capture point (MotionConfig.swing_landing "his_foot_now", the swing as it was then): their motion
+    from his capture point (MotionConfig.swing_landing "his_foot_now", the swing as it was then), and with the reach
+    rule predicting for now once his usual swing time is past (``recovery_overdue_swing_horizon`` off): their motion
     configurations start from it."""
-    return MotionConfig(**{"swing_landing": "his_foot_now", **kwargs})
+    return MotionConfig(**{"swing_landing": "his_foot_now", "recovery_overdue_swing_horizon": False, **kwargs})
 
 
 def test_support_polygon_distance_is_signed_and_finds_the_nearest_point():
