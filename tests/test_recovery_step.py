@@ -903,7 +903,8 @@ def test_a_swing_past_its_usual_time_is_landed_before_the_capture_point_runs_out
                 step = session.motion.recovery.step
                 if step is None or not step.taken_over or step.start_s < 1.2 or step.start_s in dict(taken):
                     return
-                xi, _ = capture_point(session.mass.com(state), session.mass.com_velocity(state), 9.81)
+                xi, _ = capture_point(session.mass.com(state), session.mass.com_velocity(state),
+                                      session.motion.g)
                 stance = LINK_NAMES.index(f"{'left' if step.side == 'right' else 'right'}_ankle")
                 taken.append((step.start_s, sole_outside_m(xi, state.link_origin_world[stance],
                                                            state.link_quat_wxyz[stance])))
