@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from conftest import TRACED_BEFORE_LANDING_WEIGHT, suite_run
 
+from stylesync import rotations as rot
 from stylesync.config import ControlConfig, MotionConfig, OperatorConfig, SessionConfig, WholeBodyConfig
 from stylesync.control.whole_body import recovery_landing_due
 from stylesync.errors import ConfigError
@@ -27,6 +28,7 @@ from stylesync.motion.recovery_step import (
     soles_on_ground,
     stands_on,
     support_outside_along,
+    support_outside_m,
 )
 from stylesync.motion.stance_fsm import CharacterStanceFsm, Stance
 
@@ -40,9 +42,11 @@ MOCAP = Path(__file__).resolve().parents[2] / "shared" / "mocap"
 def traced_motion(**kwargs) -> MotionConfig:
     """The scenarios of this module were traced with the swing aimed at the operator's swing foot's present offset
     from his capture point (MotionConfig.swing_landing "his_foot_now", the swing as it was then), and with the reach
-    rule predicting for now once his usual swing time is past (``recovery_overdue_swing_horizon`` off): their motion
-    configurations start from it."""
-    return MotionConfig(**{"swing_landing": "his_foot_now", "recovery_overdue_swing_horizon": False, **kwargs})
+    rule predicting for now once his usual swing time is past (``recovery_overdue_swing_horizon`` off), and a
+    recovery step's landing short of the crossover clearance always moved outwards (``recovery_cross_nearest`` off):
+    their motion configurations start from it."""
+    return MotionConfig(**{"swing_landing": "his_foot_now", "recovery_overdue_swing_horizon": False,
+                           "recovery_cross_nearest": False, **kwargs})
 
 
 def test_support_polygon_distance_is_signed_and_finds_the_nearest_point():
@@ -134,6 +138,28 @@ def test_a_crossover_landing_needs_its_clearance_ahead_or_behind():
     # the left foot swinging over a right stance: mirrored
     np.testing.assert_allclose(not_across(-across_beside * [1, 1, -1], stance, np.eye(3), "left", 0.15)[1],
                                MIN_FOOT_SEPARATION_M)
+
+
+def test_a_landing_just_short_of_the_crossover_clearance_goes_to_the_nearer_place_off_the_stance_foot():
+    """The right foot swings over a left stance foot at the origin (heading frame x forward, y left). A landing 12 cm
+    ahead and 25 cm across (a capture point ahead on the stance foot's far side) was moved 35 cm outwards, to the
+    other side of the stance foot; with ``nearest`` it goes 3 cm forward, to the clearance. Just across beside the
+    stance ankle, outwards is the nearer and is kept; behind, the clearance is behind."""
+    stance, h = np.array([0.0, 0.0, ANKLE_HEIGHT_M]), ANKLE_HEIGHT_M
+    short = np.array([0.12, 0.25, h])
+    np.testing.assert_allclose(not_across(short, stance, np.eye(3), "right", 0.15), [0.12, -MIN_FOOT_SEPARATION_M, h])
+    np.testing.assert_allclose(not_across(short, stance, np.eye(3), "right", 0.15, nearest=True), [0.15, 0.25, h])
+    np.testing.assert_allclose(not_across(short * [-1, 1, 1], stance, np.eye(3), "right", 0.15, nearest=True),
+                               [-0.15, 0.25, h])
+    beside = np.array([0.01, -0.05, h])  # 5 cm from MIN_FOOT_SEPARATION_M, 14 cm from the clearance
+    np.testing.assert_allclose(not_across(beside, stance, np.eye(3), "right", 0.15, nearest=True),
+                               [0.01, -MIN_FOOT_SEPARATION_M, h])
+    np.testing.assert_allclose(not_across(short, stance, np.eye(3), "right", None, nearest=True),
+                               [0.12, -MIN_FOOT_SEPARATION_M, h])  # never across: always outwards
+    # In a turned heading frame the same, turned.
+    R = rot.matrix_from_quat(rot.quat_from_yaw(0.7))
+    turned = not_across(stance + R @ (short - stance), stance, R, "right", 0.15, nearest=True)
+    np.testing.assert_allclose(R.T @ (turned - stance), [0.15, 0.25, 0.0], atol=1e-12)
 
 
 def test_recovery_steps_can_be_switched_off():
@@ -921,6 +947,44 @@ def test_a_swing_past_its_usual_time_is_landed_before_the_capture_point_runs_out
     assert result_old.fell and result_old.fall_time_s < 3.0  # measured: 2.25 s
 
 
+def test_a_recovery_step_just_short_of_its_crossover_clearance_lands_on_the_capture_points_side():
+    """The built-in spin, seed 0: the operator leaps forward and to the right while he turns. At 2.51 s the
+    character stands on its right foot with the capture point ahead of it and to its right, and its left foot steps.
+    The landing was planned 12 cm ahead of the right ankle in the turning heading frame, 3 cm short of the crossover
+    clearance, and so was moved outwards, to the left: the foot went back to (-0.12, -0.07) m, and when it landed at
+    2.72 s the capture point was 0.19 m outside both soles (measured). Moved to the nearer place off the stance foot
+    (``recovery_cross_nearest``), the clearance ahead, the foot crosses in front of the right one to (0.46, -0.26) m
+    and the landing catches the capture point (0.05 m inside at 2.78 s). The spin still falls later, when the
+    operator's turning leaps outrun the character's steps."""
+
+    def run(nearest: bool):
+        """(the first recovery step begun between 2.4 and 2.6 s: its side, its foot's horizontal position at its end
+        [m], how far the capture point is then outside the soles on the ground [m])."""
+        found: dict = {}
+
+        def watch(session):
+            def on_tick(state, ref):
+                step = session.motion.recovery.step
+                if step is not None and "side" not in found and 2.4 <= step.start_s <= 2.6:
+                    found["side"] = step.side
+                elif step is None and "side" in found and "xi_out_m" not in found:
+                    ankles = {s: state.link_origin_world[LINK_NAMES.index(f"{s}_ankle")] for s in ("left", "right")}
+                    quats = {s: state.link_quat_wxyz[LINK_NAMES.index(f"{s}_ankle")] for s in ("left", "right")}
+                    xi, _ = capture_point(session.mass.com(state), session.mass.com_velocity(state),
+                                          session.motion.g)
+                    found["foot_xy"] = ankles[found["side"]][:2].copy()
+                    found["xi_out_m"] = support_outside_m(xi, ankles, quats, soles_on_ground(state) or ["left"])
+            return on_tick
+
+        suite_run("builtin:spin", 0, MotionConfig(recovery_cross_nearest=nearest), ControlConfig(), watch=watch)
+        return found
+
+    new, old = run(True), run(False)
+    assert new["side"] == old["side"] == "left"
+    assert new["foot_xy"][0] > 0.3 and old["foot_xy"][0] < 0.0  # measured: 0.46 m ahead; 0.12 m behind
+    assert new["xi_out_m"] < 0.0 < 0.1 < old["xi_out_m"]  # measured: -0.05 m; 0.19 m
+
+
 @pytest.mark.skipif(not (MOCAP / "deepmimic" / "humanoid3d_stealthy_walk.txt").exists(),
                     reason="../shared/mocap/deepmimic/humanoid3d_stealthy_walk.txt is not available")
 def test_the_next_recovery_step_begins_while_both_soles_are_down():
@@ -1056,7 +1120,8 @@ def test_a_recovery_step_whose_landing_is_due_is_pressed_onto_the_ground():
     landing is due (its target below the ground), a step's foot hovered above the ground from 2.83 s while the body
     sank onto the folding swing leg, and the run fell at 3.11 s (measured: waits of 0.11, 0.16 and then 0.28 s).
     Weighed WholeBodyConfig.recovery_foot_landing_weight once due, every landing touches within 0.1 s (0.06 and
-    0.08 s) and the run stands."""
+    0.08 s) and the run stands. Traced with landings short of the crossover clearance moved outwards
+    (MotionConfig.recovery_cross_nearest off; with it, one of three landings waits 0.29 s, and the run stands)."""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '08_08.bvh'}"
 
     def run(landing_weight: float):
@@ -1074,7 +1139,7 @@ def test_a_recovery_step_whose_landing_is_due_is_pressed_onto_the_ground():
                 waits.append(state.time_s - due_since.pop())
             last_tick_s[0] = state.time_s
 
-        result = suite_run(spec, 1, MotionConfig(),
+        result = suite_run(spec, 1, MotionConfig(recovery_cross_nearest=False),
                            ControlConfig(whole_body=WholeBodyConfig(recovery_foot_landing_weight=landing_weight)),
                            on_tick=on_tick)
         if due_since:

@@ -214,6 +214,11 @@ class MotionConfig:
     # left the stance sole on the far side, and the other foot's step out came too late (docs/decisions.md,
     # "Crossover recovery steps") [m]
     recovery_cross_clear_m: float | None = 0.15
+    # A recovery step's landing across the stance foot but not clear of it goes to the nearer of the two places off
+    # it: outwards beside the stance foot, or the crossover clearance ahead of or behind it. Always outwards, a
+    # landing planned just short of the clearance (a capture point ahead on the stance foot's far side) went to the
+    # wrong side of the stance foot (docs/decisions.md, "A crossover step just short of its clearance")
+    recovery_cross_nearest: bool = True
     # ... also while the operator is on one foot but the character, its step for his counted as taken (early
     # contact), stands on both and waits for his next change
     recovery_while_step_counted: bool = True

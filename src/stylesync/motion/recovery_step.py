@@ -24,9 +24,10 @@ own:
   would otherwise move the landing with the foot;
 * within the leg's reach (``MotionConfig.recovery_step_reach_share`` of its length from the stance ankle) and
   across the stance foot only as a crossover step, landing at least ``MotionConfig.recovery_cross_clear_m`` ahead of
-  or behind the stance ankle, and otherwise at least ``MIN_FOOT_SEPARATION_M`` outwards of it (heading frame): a
-  capture point that leaves the stance sole on the side away from the swing foot is caught by one step, as the
-  operator's own crossing steps catch it;
+  or behind the stance ankle, and otherwise moved to the nearer of ``MIN_FOOT_SEPARATION_M`` outwards of it and
+  that clearance ahead or behind (heading frame; ``MotionConfig.recovery_cross_nearest``): a capture point that
+  leaves the stance sole on the side away from the swing foot is caught by one step, as the operator's own crossing
+  steps catch it;
 * the foot rises ``recovery_step_height_m`` at mid-swing, follows a smooth step from its lift-off point to the
   landing, is back at the ground at ``recovery_touchdown_share`` of ``recovery_swing_s`` (it trails its target: so
   it touches down near the swing's end, when its landing is planned for) and is then lowered below the ground until
@@ -198,16 +199,23 @@ def stands_on(xi_world: np.ndarray, stance_ankle_world: np.ndarray, stance_foot_
 
 
 def not_across(landing_world: np.ndarray, stance_ankle_world: np.ndarray, heading_world: np.ndarray,
-               side: str, cross_clear_m: float | None = None) -> np.ndarray:
-    """(3,) a swing ankle's landing moved sideways, if needed, to at least ``MIN_FOOT_SEPARATION_M`` outwards of
-    the stance ankle in the heading frame (``heading_world``: (3, 3), x forward, y left), unless it lands at least
-    ``cross_clear_m`` ahead of or behind the stance ankle (a crossover step, its foot clear of the stance foot; None:
-    never across). A foot landing across the stance foot beside it would land on it."""
+               side: str, cross_clear_m: float | None = None, nearest: bool = False) -> np.ndarray:
+    """(3,) a swing ankle's landing moved, if needed, off the stance foot (heading frame, ``heading_world``: (3, 3),
+    x forward, y left). A landing across the stance ankle, or less than ``MIN_FOOT_SEPARATION_M`` outwards of it, is
+    kept where it is if it lies at least ``cross_clear_m`` ahead of or behind the stance ankle (a crossover step, its
+    foot clear of the stance foot; None: never across). Otherwise it is moved sideways to ``MIN_FOOT_SEPARATION_M``
+    outwards, or, with ``nearest``, to whichever of that and the crossover clearance ahead or behind (on the side it
+    already is) is the nearer. A foot landing across the stance foot beside it would land on it."""
     base = np.array([stance_ankle_world[0], stance_ankle_world[1], 0.0])
     rel = heading_world.T @ (np.array([landing_world[0], landing_world[1], 0.0]) - base)
     out = _OUT[side]
     if cross_clear_m is None or abs(rel[0]) < cross_clear_m:
-        rel[1] = out * max(out * rel[1], MIN_FOOT_SEPARATION_M)
+        sideways_m = MIN_FOOT_SEPARATION_M - out * rel[1]  # > 0: the landing is not far enough outwards
+        if sideways_m > 0.0:
+            if nearest and cross_clear_m is not None and cross_clear_m - abs(rel[0]) < sideways_m:
+                rel[0] = cross_clear_m if rel[0] >= 0.0 else -cross_clear_m
+            else:
+                rel[1] = out * MIN_FOOT_SEPARATION_M
     landing = base + heading_world @ rel
     landing[2] = landing_world[2]
     return landing
@@ -318,7 +326,8 @@ class RecoveryStepper:
         length = float(np.linalg.norm(rel[:2]))
         if length > self.max_step_m:
             rel[:2] *= self.max_step_m / length
-        landing = not_across(base + R @ rel, stance_ankle_world, R, side, self.cfg.recovery_cross_clear_m)
+        landing = not_across(base + R @ rel, stance_ankle_world, R, side, self.cfg.recovery_cross_clear_m,
+                             self.cfg.recovery_cross_nearest)
         landing[2] = ANKLE_HEIGHT_M
         return landing, xi_land
 
