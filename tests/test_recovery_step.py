@@ -43,10 +43,11 @@ def traced_motion(**kwargs) -> MotionConfig:
     """The scenarios of this module were traced with the swing aimed at the operator's swing foot's present offset
     from his capture point (MotionConfig.swing_landing "his_foot_now", the swing as it was then), and with the reach
     rule predicting for now once his usual swing time is past (``recovery_overdue_swing_horizon`` off), and a
-    recovery step's landing short of the crossover clearance always moved outwards (``recovery_cross_nearest`` off):
-    their motion configurations start from it."""
+    recovery step's landing short of the crossover clearance always moved outwards, in the heading frame
+    (``recovery_cross_nearest`` and ``recovery_cross_stance_frame`` off): their motion configurations start from
+    it."""
     return MotionConfig(**{"swing_landing": "his_foot_now", "recovery_overdue_swing_horizon": False,
-                           "recovery_cross_nearest": False, **kwargs})
+                           "recovery_cross_nearest": False, "recovery_cross_stance_frame": False, **kwargs})
 
 
 def test_support_polygon_distance_is_signed_and_finds_the_nearest_point():
@@ -950,14 +951,15 @@ def test_a_swing_past_its_usual_time_is_landed_before_the_capture_point_runs_out
 def test_a_recovery_step_just_short_of_its_crossover_clearance_lands_on_the_capture_points_side():
     """The built-in spin, seed 0: the operator leaps forward and to the right while he turns. At 2.51 s the
     character stands on its right foot with the capture point ahead of it and to its right, and its left foot steps.
-    The landing was planned 12 cm ahead of the right ankle in the turning heading frame, 3 cm short of the crossover
-    clearance, and so was moved outwards, to the left: the foot went back to (-0.12, -0.07) m, and when it landed at
-    2.72 s the capture point was 0.19 m outside both soles (measured). Moved to the nearer place off the stance foot
-    (``recovery_cross_nearest``), the clearance ahead, the foot crosses in front of the right one to (0.46, -0.26) m
-    and the landing catches the capture point (0.05 m inside at 2.78 s). The spin still falls later, when the
-    operator's turning leaps outrun the character's steps."""
+    The landing was planned 12 cm ahead of the right ankle in the heading frame, which turns with the operator's root
+    (35° then, the right sole 17°), 3 cm short of the crossover clearance, and so was moved outwards, to the left: the
+    foot went back to (-0.12, -0.07) m, and when it landed at 2.72 s the capture point was 0.19 m outside both soles
+    (measured). With the clearance taken in the stance sole's own frame (``recovery_cross_stance_frame``) and a
+    landing short of it moved to the nearer place off the stance foot (``recovery_cross_nearest``), the foot crosses
+    in front of the right one to (0.42, -0.27) m and the landing catches the capture point (0.05 m inside). The spin
+    still falls later, when the operator's turning leaps outrun the character's steps."""
 
-    def run(nearest: bool):
+    def run(motion: MotionConfig):
         """(the first recovery step begun between 2.4 and 2.6 s: its side, its foot's horizontal position at its end
         [m], how far the capture point is then outside the soles on the ground [m])."""
         found: dict = {}
@@ -976,12 +978,13 @@ def test_a_recovery_step_just_short_of_its_crossover_clearance_lands_on_the_capt
                     found["xi_out_m"] = support_outside_m(xi, ankles, quats, soles_on_ground(state) or ["left"])
             return on_tick
 
-        suite_run("builtin:spin", 0, MotionConfig(recovery_cross_nearest=nearest), ControlConfig(), watch=watch)
+        suite_run("builtin:spin", 0, motion, ControlConfig(), watch=watch)
         return found
 
-    new, old = run(True), run(False)
+    new = run(MotionConfig())
+    old = run(MotionConfig(recovery_cross_nearest=False, recovery_cross_stance_frame=False))
     assert new["side"] == old["side"] == "left"
-    assert new["foot_xy"][0] > 0.3 and old["foot_xy"][0] < 0.0  # measured: 0.46 m ahead; 0.12 m behind
+    assert new["foot_xy"][0] > 0.3 and old["foot_xy"][0] < 0.0  # measured: 0.42 m ahead; 0.12 m behind
     assert new["xi_out_m"] < 0.0 < 0.1 < old["xi_out_m"]  # measured: -0.05 m; 0.19 m
 
 
@@ -1120,8 +1123,9 @@ def test_a_recovery_step_whose_landing_is_due_is_pressed_onto_the_ground():
     landing is due (its target below the ground), a step's foot hovered above the ground from 2.83 s while the body
     sank onto the folding swing leg, and the run fell at 3.11 s (measured: waits of 0.11, 0.16 and then 0.28 s).
     Weighed WholeBodyConfig.recovery_foot_landing_weight once due, every landing touches within 0.1 s (0.06 and
-    0.08 s) and the run stands. Traced with landings short of the crossover clearance moved outwards
-    (MotionConfig.recovery_cross_nearest off; with it, one of three landings waits 0.29 s, and the run stands)."""
+    0.08 s) and the run stands. Traced with landings short of the crossover clearance moved outwards in the heading
+    frame (MotionConfig.recovery_cross_nearest and recovery_cross_stance_frame off; with the first, one of three
+    landings waits 0.29 s, and the run stands)."""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '08_08.bvh'}"
 
     def run(landing_weight: float):
@@ -1139,7 +1143,7 @@ def test_a_recovery_step_whose_landing_is_due_is_pressed_onto_the_ground():
                 waits.append(state.time_s - due_since.pop())
             last_tick_s[0] = state.time_s
 
-        result = suite_run(spec, 1, MotionConfig(recovery_cross_nearest=False),
+        result = suite_run(spec, 1, MotionConfig(recovery_cross_nearest=False, recovery_cross_stance_frame=False),
                            ControlConfig(whole_body=WholeBodyConfig(recovery_foot_landing_weight=landing_weight)),
                            on_tick=on_tick)
         if due_since:

@@ -82,6 +82,7 @@ _SOLE_POINTS = sole_corner_points()  # the character's sole relative to its ankl
 _OTHER = {"left": "right", "right": "left"}
 _ANKLE = {s: LINK_NAMES.index(f"{s}_ankle") for s in ("left", "right")}
 _OUT = {"left": 1.0, "right": -1.0}
+_UP = np.array([0.0, 0.0, 1.0])  # world up (Z)
 
 
 def capture_point(com_world: np.ndarray, com_vel_world: np.ndarray, gravity_mps2: float) -> tuple[np.ndarray, float]:
@@ -318,15 +319,17 @@ class RecoveryStepper:
         half_extent = abs(u_heading[0]) * FOOT_LENGTH_M / 2 + abs(u_heading[1]) * FOOT_WIDTH_M / 2
         centre = np.array([xi_land[0], xi_land[1], 0.0]) + half_extent * u
         ankle = centre - R @ np.array([FOOT_CENTER_AHEAD_OF_ANKLE_M, 0.0, 0.0])
-        # Within reach, and across the stance foot only as a crossover step (heading frame, relative to the stance
-        # ankle).
+        # Within reach, and across the stance foot only as a crossover step (relative to the stance ankle, in the
+        # stance sole's own yaw frame or the heading frame).
         base = np.array([stance_ankle_world[0], stance_ankle_world[1], 0.0])
         rel = R.T @ (ankle - base)
         rel[2] = 0.0
         length = float(np.linalg.norm(rel[:2]))
         if length > self.max_step_m:
             rel[:2] *= self.max_step_m / length
-        landing = not_across(base + R @ rel, stance_ankle_world, R, side, self.cfg.recovery_cross_clear_m,
+        R_clear = (rot.matrix_from_quat(rot.quat_from_yaw(rot.twist_angle(stance_foot_quat_wxyz, _UP)))
+                   if self.cfg.recovery_cross_stance_frame else R)
+        landing = not_across(base + R @ rel, stance_ankle_world, R_clear, side, self.cfg.recovery_cross_clear_m,
                              self.cfg.recovery_cross_nearest)
         landing[2] = ANKLE_HEIGHT_M
         return landing, xi_land
