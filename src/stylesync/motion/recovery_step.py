@@ -25,7 +25,8 @@ own:
 * within the leg's reach (``MotionConfig.recovery_step_reach_share`` of its length from the stance ankle) and
   across the stance foot only as a crossover step, landing at least ``MotionConfig.recovery_cross_clear_m`` ahead of
   or behind the stance ankle, and otherwise moved to the nearer of ``MIN_FOOT_SEPARATION_M`` outwards of it and
-  that clearance ahead or behind (heading frame; ``MotionConfig.recovery_cross_nearest``): a capture point that
+  that clearance ahead or behind (``MotionConfig.recovery_cross_nearest``), in the stance sole's own yaw frame
+  (``MotionConfig.recovery_cross_stance_frame``; otherwise the heading frame): a capture point that
   leaves the stance sole on the side away from the swing foot is caught by one step, as the operator's own crossing
   steps catch it;
 * the foot rises ``recovery_step_height_m`` at mid-swing, follows a smooth step from its lift-off point to the
@@ -201,12 +202,13 @@ def stands_on(xi_world: np.ndarray, stance_ankle_world: np.ndarray, stance_foot_
 
 def not_across(landing_world: np.ndarray, stance_ankle_world: np.ndarray, heading_world: np.ndarray,
                side: str, cross_clear_m: float | None = None, nearest: bool = False) -> np.ndarray:
-    """(3,) a swing ankle's landing moved, if needed, off the stance foot (heading frame, ``heading_world``: (3, 3),
-    x forward, y left). A landing across the stance ankle, or less than ``MIN_FOOT_SEPARATION_M`` outwards of it, is
-    kept where it is if it lies at least ``cross_clear_m`` ahead of or behind the stance ankle (a crossover step, its
-    foot clear of the stance foot; None: never across). Otherwise it is moved sideways to ``MIN_FOOT_SEPARATION_M``
-    outwards, or, with ``nearest``, to whichever of that and the crossover clearance ahead or behind (on the side it
-    already is) is the nearer. A foot landing across the stance foot beside it would land on it."""
+    """(3,) a swing ankle's landing moved, if needed, off the stance foot, in the frame ``heading_world`` ((3, 3),
+    x forward, y left: the heading's or the stance sole's yaw). A landing across the stance ankle, or less than
+    ``MIN_FOOT_SEPARATION_M`` outwards of it, is kept where it is if it lies at least ``cross_clear_m`` ahead of or
+    behind the stance ankle (a crossover step, its foot clear of the stance foot; None: never across). Otherwise it
+    is moved sideways to ``MIN_FOOT_SEPARATION_M`` outwards, or, with ``nearest``, to whichever of that and the
+    crossover clearance ahead or behind (on the side it already is) is the nearer. A foot landing across the stance
+    foot beside it would land on it."""
     base = np.array([stance_ankle_world[0], stance_ankle_world[1], 0.0])
     rel = heading_world.T @ (np.array([landing_world[0], landing_world[1], 0.0]) - base)
     out = _OUT[side]
