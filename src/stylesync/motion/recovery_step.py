@@ -200,9 +200,9 @@ def stands_on(xi_world: np.ndarray, stance_ankle_world: np.ndarray, stance_foot_
                           heading_world) <= 0.0
 
 
-def not_across(landing_world: np.ndarray, stance_ankle_world: np.ndarray, heading_world: np.ndarray,
+def not_across(landing_world: np.ndarray, stance_ankle_world: np.ndarray, frame_world: np.ndarray,
                side: str, cross_clear_m: float | None = None, nearest: bool = False) -> np.ndarray:
-    """(3,) a swing ankle's landing moved, if needed, off the stance foot, in the frame ``heading_world`` ((3, 3),
+    """(3,) a swing ankle's landing moved, if needed, off the stance foot, in the frame ``frame_world`` ((3, 3),
     x forward, y left: the heading's or the stance sole's yaw). A landing across the stance ankle, or less than
     ``MIN_FOOT_SEPARATION_M`` outwards of it, is kept where it is if it lies at least ``cross_clear_m`` ahead of or
     behind the stance ankle (a crossover step, its foot clear of the stance foot; None: never across). Otherwise it
@@ -210,7 +210,7 @@ def not_across(landing_world: np.ndarray, stance_ankle_world: np.ndarray, headin
     crossover clearance ahead or behind (on the side it already is) is the nearer. A foot landing across the stance
     foot beside it would land on it."""
     base = np.array([stance_ankle_world[0], stance_ankle_world[1], 0.0])
-    rel = heading_world.T @ (np.array([landing_world[0], landing_world[1], 0.0]) - base)
+    rel = frame_world.T @ (np.array([landing_world[0], landing_world[1], 0.0]) - base)
     out = _OUT[side]
     if cross_clear_m is None or abs(rel[0]) < cross_clear_m:
         sideways_m = MIN_FOOT_SEPARATION_M - out * rel[1]  # > 0: the landing is not far enough outwards
@@ -219,7 +219,7 @@ def not_across(landing_world: np.ndarray, stance_ankle_world: np.ndarray, headin
                 rel[0] = cross_clear_m if rel[0] >= 0.0 else -cross_clear_m
             else:
                 rel[1] = out * MIN_FOOT_SEPARATION_M
-    landing = base + heading_world @ rel
+    landing = base + frame_world @ rel
     landing[2] = landing_world[2]
     return landing
 
