@@ -89,6 +89,9 @@ _LINK = {n: i for i, n in enumerate(LINK_NAMES)}
 _ROOT_LINK = _LINK["root"]
 CHAR_LEG_LENGTH_M = THIGH_LENGTH_M + SHANK_LENGTH_M
 _LANDING_REACH_M = LANDING_REACH * CHAR_LEG_LENGTH_M  # hip-ankle distance at which a landing foot is aimed [m]
+# How fast the operator's floor (the lowest his ankles have been) rises towards his lower ankle: faster than a
+# climb of stairs (a 0.17 m step in about 0.6 s), slower than a leap's feet (the built-in spin's rise 3 m/s) [m/s]
+OPERATOR_FLOOR_RISE_MPS = 0.5
 OPERATOR_VELOCITY_SETTLE_S = 0.2  # the operator's filtered COM velocity is taken as settled from then on [s]
 HEEL_AHEAD_OF_ANKLE_M = FOOT_CENTER_AHEAD_OF_ANKLE_M - FOOT_LENGTH_M / 2  # < 0: the heel is behind the ankle [m]
 
@@ -226,6 +229,8 @@ class MotionOptimizer:
         self._anchor_decay = np.exp(-self.dt_s / ANCHOR_BLEND_S)  # per tick
         self._swing_decay = np.exp(-self.dt_s / SWING_BLEND_S)  # per tick
         self._last_xy: np.ndarray | None = None
+        self._op_ankle_floor_z: float | None = None  # the operator's floor under his ankles [m]
+        self._op_ankle_ground_z: dict[str, float] = {}  # per side, his ankle's height when it last could bear weight
         self._hold_velocity: np.ndarray | None = None  # the desired COM velocity a late-contact hold began with
         self._hold_shift = np.zeros(2)  # the held targets' travel since the hold began [m]
         self._ref_xy: np.ndarray | None = None  # (pelvis, COM) x (x, y) targets that follow the operator [m]
@@ -414,6 +419,7 @@ class MotionOptimizer:
         # (Sec. 5.1) the character is in double stance while the operator still swings a foot, whose position
         # says nothing of where his body is over the ground.
         anchor = tick.ch_state if self.char_fsm.hold_reference else tick.op_state
+        ground_z = self._ground_ankle_height_m(a_h, op_leg_m)
         if anchor is Stance.DS:
             pelvis_xy = _heading_frame_fraction(p_h, a_hs["left"], a_hs["right"], a_c["left"], a_c["right"],
                                                 scale, R_root_d)
@@ -424,7 +430,7 @@ class MotionOptimizer:
             st = "left" if anchor is Stance.LS else "right"
             pelvis_xy = a_c[st] + scale * (p_h - a_hs[st])
             com_xy = a_c[st] + scale * (com_h - a_hs[st])
-            ankle_h_z = a_h[st][2]
+            ankle_h_z = ground_z[st]
         tick.ankle_h_z = ankle_h_z
         # A change of stance changes the anchor of Eq. 10 (the fraction between the feet, or the stance foot); the
         # operator's and the character's feet are never placed exactly alike, so the targets would jump. The jump
@@ -476,6 +482,23 @@ class MotionOptimizer:
         com_vel_d[2] = 0.0
         tick.com_vel_d = com_vel_d
         tick.com_vel_h = self._com_h_rate(com_h)
+
+    def _ground_ankle_height_m(self, ankle_h: dict[str, np.ndarray], op_leg_m: float) -> dict[str, float]:
+        """Per side, the height of the operator's ankle the pelvis height of Eq. 9 is measured from [m]: the ankle's
+        own while it can bear weight; the one it had when it left the ground while it is higher than
+        ``MotionConfig.airborne_ankle_height_leg`` of his leg above his floor (he is in the air: his pelvis's height
+        above that foot is not a stance leg's). His floor is the lowest his ankles have been, rising towards his
+        lower ankle at most at OPERATOR_FLOOR_RISE_MPS (stairs up; a low glitch of the sensor is forgotten)."""
+        share = self.cfg.airborne_ankle_height_leg
+        floor = min(ankle_h["left"][2], ankle_h["right"][2])
+        if self._op_ankle_floor_z is not None:
+            floor = min(floor, self._op_ankle_floor_z + OPERATOR_FLOOR_RISE_MPS * self.dt_s)
+        self._op_ankle_floor_z = floor
+        for side in ("left", "right"):
+            z = float(ankle_h[side][2])
+            if share is None or z - floor <= share * op_leg_m or side not in self._op_ankle_ground_z:
+                self._op_ankle_ground_z[side] = z
+        return self._op_ankle_ground_z
 
     # ---- 3. foot targets: planted feet, swing-foot planning (Eq. 28) -----------------------------------------
     def _plan_feet(self, tick: _Tick, state: CharacterState, mass: MassProperties) -> None:
