@@ -295,12 +295,13 @@ class MotionConfig:
     # only "sideways" (across the heading), or "off". Measured on the development suite, neither gains beyond the
     # spread between seeds, and "all" halves the walks' progress along the operator's path (docs/decisions.md).
     landing_capture_bound: str = "off"
-    # An operator's ankle higher than this share of his leg above the lowest his ankles have been bears no weight
-    # (on the ball of his foot an ankle rises by at most its distance to the ball, about 0.15 m for a 0.9 m leg): on
-    # a stance foot that high he is in the air, and the pelvis height of Eq. 9 is measured from the height that
-    # ankle had when it left the ground, not from the foot in the air. Measured from it, the built-in spin's leap
-    # (his feet 1.6 m up, above his head) put the character's pelvis target below the ground, and the stance leg
-    # folded (docs/decisions.md, "An operator in the air"; None: from the foot wherever it is) [-]
+    # An operator's ankle higher than this share of his leg above his floor (the lowest his ankles have been, rising
+    # slowly) bears no weight (on the ball of his foot an ankle rises by at most its distance to the ball, about
+    # 0.15 m for a 0.9 m leg): on a stance foot that high he is in the air, and the pelvis height of Eq. 9 is
+    # measured from the height that ankle had when it left the ground, not from the foot in the air. Measured from
+    # it, the built-in spin's leap (his feet 1.6 m up, above his head) put the character's pelvis target below the
+    # ground, and the stance leg folded (docs/decisions.md, "An operator in the air"; None: from the foot wherever
+    # it is) [-]
     airborne_ankle_height_leg: float | None = 0.2
 
     def __post_init__(self) -> None:

@@ -90,7 +90,7 @@ _ROOT_LINK = _LINK["root"]
 CHAR_LEG_LENGTH_M = THIGH_LENGTH_M + SHANK_LENGTH_M
 _LANDING_REACH_M = LANDING_REACH * CHAR_LEG_LENGTH_M  # hip-ankle distance at which a landing foot is aimed [m]
 # How fast the operator's floor (the lowest his ankles have been) rises towards his lower ankle: faster than a
-# climb of stairs (a 0.17 m step in about 0.6 s), slower than a leap's feet (the built-in spin's rise 3 m/s) [m/s]
+# climb of stairs (a 0.17 m step in about 0.6 s), slower than a leap's feet (the built-in spin's rise at 4-6 m/s) [m/s]
 OPERATOR_FLOOR_RISE_MPS = 0.5
 OPERATOR_VELOCITY_SETTLE_S = 0.2  # the operator's filtered COM velocity is taken as settled from then on [s]
 HEEL_AHEAD_OF_ANKLE_M = FOOT_CENTER_AHEAD_OF_ANKLE_M - FOOT_LENGTH_M / 2  # < 0: the heel is behind the ankle [m]
