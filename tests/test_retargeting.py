@@ -3,6 +3,8 @@ while the operator is in the air."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from conftest import suite_run
@@ -12,6 +14,7 @@ from stylesync.errors import ConfigError
 from stylesync.motion.pose_optimization import OPERATOR_FLOOR_RISE_MPS, MotionOptimizer
 
 OPERATOR_LEG_M = 0.9
+MOCAP = Path(__file__).resolve().parents[2] / "shared" / "mocap"
 
 
 def _ankles(left_z: float, right_z: float) -> dict[str, np.ndarray]:
@@ -77,3 +80,32 @@ def test_the_spins_leap_does_not_fold_the_stance_leg():
     assert low_old["pelvis"] < 0.0 and low_old["com"] < 0.7  # measured: -0.25 m, 0.65 m
     assert not result.fell
     assert result_old.fell and result_old.fall_time_s < 3.5  # measured: 3.25 s
+
+
+@pytest.mark.skipif(not (MOCAP / "cmu-dev" / "03_01.bvh").exists(),
+                    reason="../shared/mocap/cmu-dev/03_01.bvh is not available")
+def test_a_walk_up_uneven_ground_is_never_taken_for_a_flight(monkeypatch):
+    """CMU-dev 03_01, seed 0: the operator walks over uneven ground, down from 0.39 m (his lower ankle's height) to
+    0.12 m, up to 0.28 m and down to 0.06 m. His floor follows him up (within 1.5 cm, measured), and no ankle that
+    can bear weight is taken for one in the air: Eq. 9 is measured from his own ankles throughout, as without the
+    rule."""
+    seen = {"ticks": 0, "held": 0, "lower_above_floor_m": 0.0, "lower_rise_m": 0.0, "lowest_m": np.inf}
+    original = MotionOptimizer._ground_ankle_height_m
+
+    def recorded(self, ankle_h, op_leg_m):
+        out = original(self, ankle_h, op_leg_m)
+        lower = min(ankle_h["left"][2], ankle_h["right"][2])
+        seen["ticks"] += 1
+        seen["held"] += sum(out[s] != ankle_h[s][2] for s in ("left", "right")
+                            if ankle_h[s][2] - self._op_ankle_floor_z <= 0.2 * op_leg_m)
+        seen["lower_above_floor_m"] = max(seen["lower_above_floor_m"], lower - self._op_ankle_floor_z)
+        seen["lowest_m"] = min(seen["lowest_m"], lower)
+        seen["lower_rise_m"] = max(seen["lower_rise_m"], lower - seen["lowest_m"])  # a climb from the lowest so far
+        return out
+
+    monkeypatch.setattr(MotionOptimizer, "_ground_ankle_height_m", recorded)
+    result = suite_run(f"bvh:{MOCAP / 'cmu-dev' / '03_01.bvh'}", 0, MotionConfig(), ControlConfig())
+    assert seen["ticks"] > 800 and not result.fell
+    assert seen["lower_rise_m"] > 0.12  # measured: 0.16 m up
+    assert seen["lower_above_floor_m"] < 0.05  # measured: 0.015 m
+    assert seen["held"] == 0
