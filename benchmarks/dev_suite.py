@@ -64,7 +64,7 @@ if "path_progress" not in m:  # a version before metrics/imitation.path_progress
     length = float(np.hypot(dr[0], dr[1]))
     m["path_progress"] = float(dc @ dr) / length**2 if length >= 0.5 else None
 keys = ("fell", "fall_time_s", "sim_duration_s", "operator_steps", "character_steps", "state_transition_delay_s",
-        "mpjpe_global_mm", "mpjpe_root_mm", "uhc_fall_time_s", "path_progress", "realtime_factor")
+        "mpjpe_global_mm", "mpjpe_root_mm", "uhc_fall_time_s", "path_progress", "realtime_factor", "fall_reason")
 print(json.dumps({"clip_end_s": clip_end, **{k: m.get(k) for k in keys}}))
 '''
 

@@ -3,7 +3,7 @@
 import json
 
 from stylesync.cli import main as cli_main
-from stylesync.metrics.dev_suite import CATEGORIES, clip_specs, table
+from stylesync.metrics.dev_suite import CATEGORIES, clip_specs, fall_endings, table
 
 
 def test_every_shared_clip_has_a_category(tmp_path):
@@ -36,3 +36,19 @@ def test_an_unknown_category_is_one_line(tmp_path, capsys):
     assert cli_main(["bench", "--suite", "dev", "--only", "swimming", "--out", str(tmp_path / "d")]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith("stylesync: error:") and "swimming" in err and "\n" not in err
+
+
+def test_falls_are_counted_by_how_they_ended():
+    """The table's fall endings come from the session's fall reasons; its rows have the header's columns."""
+    base = {"category": "run", "version": "v", "clip_end_s": 5.0, "uhc_fall_time_s": None, "mpjpe_global_mm": 1.0,
+            "mpjpe_root_mm": 1.0, "character_steps": 1, "operator_steps": 1, "path_progress": None,
+            "state_transition_delay_s": {"count": 0}}
+    reasons = ["pelvis at 0.49 m < 0.5 m", "pelvis at 0.50 m < 0.5 m", "a link other than a foot touched the ground",
+               "the motion diverged (a link at 60 m/s, pelvis at 0.8 m; limits 25 m/s, 2.5 m)"]
+    rows = [{**base, "fell": True, "fall_time_s": 1.0, "fall_reason": r} for r in reasons]
+    rows += [{**base, "fell": False, "fall_time_s": None, "fall_reason": ""},
+             {**base, "fell": True, "fall_time_s": 2.0}]  # a version that did not record the reason
+    assert fall_endings(rows) == "2/1/1"
+    header, rule, row = table(rows, ["v"]).splitlines()
+    assert header.count("|") == rule.count("|") == row.count("|")
+    assert "| 2/1/1 |" in row

@@ -94,7 +94,7 @@ def run_clip(spec: str, seed: int, duration_s: float, controller: str) -> dict:
     m = summarize(result)
     keys = ("fell", "fall_time_s", "sim_duration_s", "operator_steps", "character_steps",
             "state_transition_delay_s", "mpjpe_global_mm", "mpjpe_root_mm", "uhc_fall_time_s", "path_progress",
-            "realtime_factor")
+            "realtime_factor", "fall_reason")
     return {"clip_end_s": clip_end, **{k: m.get(k) for k in keys}}
 
 
@@ -116,6 +116,18 @@ def _median(values: list[float], fmt: str) -> str:
     return format(float(np.median(values)), fmt) if values else "-"
 
 
+# How a fall ended, from the session's fall reason (Session._fall_reason): the pelvis low, a link other than a foot
+# on the ground, or the motion diverged (a link faster than any motion of the body, the pelvis thrown up).
+FALL_ENDINGS = (("low", "pelvis at"), ("touched", "a link other than a foot"), ("diverged", "the motion diverged"))
+
+
+def fall_endings(rs: list[dict]) -> str:
+    """The falls of ``rs`` counted by how they ended (FALL_ENDINGS), as ``low/touched/diverged``; a fall whose
+    reason was not recorded (a version before the reason was kept) is counted nowhere."""
+    reasons = [str(r.get("fall_reason") or "") for r in rs if r.get("fell")]
+    return "/".join(str(sum(reason.startswith(prefix) for reason in reasons)) for _, prefix in FALL_ENDINGS)
+
+
 def category_row(cat: str, version: str, rs: list[dict]) -> str:
     """One row of the per-category table (runs that could not be opened are counted, not averaged)."""
     ok = [r for r in rs if "error" not in r]
@@ -126,7 +138,7 @@ def category_row(cat: str, version: str, rs: list[dict]) -> str:
     falls = [r["fall_time_s"] for r in ok if r["fell"]]
     delays = [r["state_transition_delay_s"]["max"] for r in ok if r["state_transition_delay_s"]["count"]]
     cells = [cat, version, str(len(rs)), str(n), _share(complete, n), _share(through_clip, n), _share(no_uhc, n),
-             _mean(falls, ".2f"),
+             _mean(falls, ".2f"), fall_endings(ok),
              _mean([r["mpjpe_global_mm"] for r in ok if r.get("mpjpe_global_mm") is not None], ".0f"),
              _mean([r["mpjpe_root_mm"] for r in ok if r.get("mpjpe_root_mm") is not None], ".0f"),
              f"{sum(r['character_steps'] for r in ok)}/{sum(r['operator_steps'] for r in ok)}",
@@ -138,9 +150,10 @@ def category_row(cat: str, version: str, rs: list[dict]) -> str:
 def table(rows: list[dict], versions: list[str]) -> str:
     """The per-category Markdown table, one row per category and version (controller or code version)."""
     lines = ["| category | version | runs | opened | complete (no fall) | through the clip (no fall before its end) | "
-             "no UHC termination | mean fall time [s] | MPJPE global [mm] | MPJPE root-rel. [mm] | steps char/op | "
+             "no UHC termination | mean fall time [s] | falls: pelvis low / other link down / diverged | "
+             "MPJPE global [mm] | MPJPE root-rel. [mm] | steps char/op | "
              "along his path, median | max delay median [s] |",
-             "|" + "---|" * 13]
+             "|" + "---|" * 14]
     for cat in ORDER:
         for v in versions:
             rs = [r for r in rows if r["category"] == cat and r["version"] == v]
