@@ -250,3 +250,34 @@ def test_hand_tasks_bring_the_hands_to_the_operators():
     without, _ = _hand_error(False)
     assert not fell
     assert with_tasks < 0.7 * without, (with_tasks, without)
+
+
+def test_a_joint_past_its_no_load_speed_gets_no_torque_along_its_motion():
+    """limit_joint_speed: the torque along a fast joint's motion is removed where it would speed it up; a torque
+    that brakes it or turns it across its motion is kept, and slower joints are untouched."""
+    from stylesync.control.joint_speed_limit import limit_joint_speed
+
+    vel = np.array([[40.0, 0.0, 0.0],   # fast, torque along: removed
+                    [0.0, -50.0, 0.0],  # fast, torque against: kept (it brakes)
+                    [20.0, 0.0, 0.0],   # slow: kept
+                    [-35.0, 0.0, 0.0]])  # a hinge (column 0), fast, torque along its motion: removed
+    tau = np.array([[10.0, 3.0, -2.0], [1.0, 5.0, 0.0], [10.0, 0.0, 0.0], [-7.0, 0.0, 0.0]])
+    limited = tau.copy()
+    assert limit_joint_speed(limited, vel, 30.0) == 2
+    np.testing.assert_allclose(limited[0], [0.0, 3.0, -2.0])
+    np.testing.assert_array_equal(limited[1:3], tau[1:3])
+    np.testing.assert_allclose(limited[3], [0.0, 0.0, 0.0])
+    assert limit_joint_speed(limited, vel, 60.0) == 0  # nothing over a higher limit
+
+
+def test_a_light_link_does_not_spin_up_within_a_control_tick():
+    """The built-in dance_a, seed 2 (the development suite's settings): at 3.45-3.54 s a reference jump's torques,
+    held over the control tick, spun the feet and hands to 26 m/s with the pelvis at 0.8 m: "the motion diverged"
+    at 3.54 s (measured). With the joints' no-load speed the run completes its 12 s."""
+    def run(limit):
+        control = ControlConfig(whole_body=WholeBodyConfig(joint_speed_limit_rad_s=limit))
+        return suite_run("builtin:dance_a", 2, MotionConfig(), control)
+
+    unlimited, limited = run(None), run(30.0)
+    assert unlimited.fell and "diverged" in unlimited.fall_reason and unlimited.fall_time_s < 4.0
+    assert not limited.fell

@@ -432,6 +432,11 @@ class WholeBodyConfig:
     # folding swing leg (docs/decisions.md, "A recovery step's landing that is due"). The weight of the press on a
     # stance foot that has not touched yet (whole_body.FOOT_TASK_WEIGHT) [-]
     recovery_foot_landing_weight: float = 1000.0
+    # The joints' no-load speed (control/joint_speed_limit.py): a joint turning faster than this gets no torque along
+    # its motion. Human joints peak at about 20-30 rad/s (a kick's knee); the held torques of a control tick spun
+    # light links (a lifting stance foot, a hand) to the engine's 100 rad/s within a tick (docs/decisions.md, "The
+    # joints' no-load speed"); None: unlimited [rad/s].
+    joint_speed_limit_rad_s: float | None = 30.0
     # The posture task's weight on the hip, knee and ankle of each supporting leg, as a share of its weight elsewhere.
     # A supporting leg closes a chain through the ground: its joint angles are where the pelvis is over the foot,
     # which the momentum task (the COM), the pelvis height and the pelvis orientation already ask for. At full weight
@@ -460,6 +465,8 @@ class WholeBodyConfig:
                   "recovery_foot_task_kp", "recovery_foot_task_kd", "recovery_foot_task_weight",
                   "recovery_foot_landing_weight"):
             _non_negative(f"WholeBodyConfig.{n}", getattr(self, n))
+        if self.joint_speed_limit_rad_s is not None:
+            _positive("WholeBodyConfig.joint_speed_limit_rad_s", self.joint_speed_limit_rad_s)
 
 
 @dataclass(frozen=True)
