@@ -174,8 +174,9 @@ def test_a_qp_with_no_feasible_point_does_not_throw_the_limbs():
             sessions.append(session)
             return None
 
-        control = ControlConfig(whole_body=WholeBodyConfig(relax_limits_when_infeasible=relax))
-        # traced before the crossover steps, the earlier touchdown of a recovery step's foot and the swing aimed at
+        control = ControlConfig(whole_body=WholeBodyConfig(relax_limits_when_infeasible=relax,
+                                                           joint_speed_limit_rad_s=None))
+        # traced before the joints' no-load speed, the crossover steps, the earlier touchdown of a recovery step's foot and the swing aimed at
         # the operator's last landing
         motion = MotionConfig(recovery_cross_clear_m=None, recovery_touchdown_share=1.0, recovery_landing_gap_m=None,
                               swing_landing="his_foot_now")
