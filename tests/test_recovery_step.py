@@ -937,8 +937,9 @@ def test_a_swing_past_its_usual_time_is_landed_before_the_capture_point_runs_out
                                                            state.link_quat_wxyz[stance])))
             return on_tick
 
-        return taken, suite_run(spec, 7, MotionConfig(recovery_overdue_swing_horizon=flag), ControlConfig(),
-                                watch=watch)
+        # traced before the joints' no-load speed (with it, the late swing's run also comes to rest)
+        control = ControlConfig(whole_body=WholeBodyConfig(joint_speed_limit_rad_s=None))
+        return taken, suite_run(spec, 7, MotionConfig(recovery_overdue_swing_horizon=flag), control, watch=watch)
 
     taken, result = run(True)
     taken_old, result_old = run(False)
@@ -1125,7 +1126,8 @@ def test_a_recovery_step_whose_landing_is_due_is_pressed_onto_the_ground():
     Weighed WholeBodyConfig.recovery_foot_landing_weight once due, every landing touches within 0.1 s (0.06 and
     0.08 s) and the run stands. Traced with landings short of the crossover clearance moved outwards in the heading
     frame (MotionConfig.recovery_cross_nearest and recovery_cross_stance_frame off; with the first, one of three
-    landings waits 0.29 s, and the run stands)."""
+    landings waits 0.29 s, and the run stands), before the joints' no-load speed (with it, no recovery step of this
+    run has a landing falling due)."""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '08_08.bvh'}"
 
     def run(landing_weight: float):
@@ -1144,7 +1146,8 @@ def test_a_recovery_step_whose_landing_is_due_is_pressed_onto_the_ground():
             last_tick_s[0] = state.time_s
 
         result = suite_run(spec, 1, MotionConfig(recovery_cross_nearest=False, recovery_cross_stance_frame=False),
-                           ControlConfig(whole_body=WholeBodyConfig(recovery_foot_landing_weight=landing_weight)),
+                           ControlConfig(whole_body=WholeBodyConfig(recovery_foot_landing_weight=landing_weight,
+                                                                    joint_speed_limit_rad_s=None)),
                            on_tick=on_tick)
         if due_since:
             waits.append(last_tick_s[0] - due_since[0])

@@ -176,8 +176,8 @@ def test_a_qp_with_no_feasible_point_does_not_throw_the_limbs():
 
         control = ControlConfig(whole_body=WholeBodyConfig(relax_limits_when_infeasible=relax,
                                                            joint_speed_limit_rad_s=None))
-        # traced before the joints' no-load speed, the crossover steps, the earlier touchdown of a recovery step's foot and the swing aimed at
-        # the operator's last landing
+        # traced before the joints' no-load speed, the crossover steps, the earlier touchdown of a recovery step's
+        # foot and the swing aimed at the operator's last landing
         motion = MotionConfig(recovery_cross_clear_m=None, recovery_touchdown_share=1.0, recovery_landing_gap_m=None,
                               swing_landing="his_foot_now")
         result = suite_run(spec, 2, motion, control, watch=watch)
