@@ -53,6 +53,9 @@ FALL_ROOT_HEIGHT_M = 0.5  # a fall: pelvis below this height, or a non-foot link
 # about 15-20 m/s), or the pelvis higher than a jump can lift it (0.88 m standing).
 DIVERGED_LINK_SPEED_MPS = 25.0
 DIVERGED_ROOT_HEIGHT_M = 2.5
+# How a fall reason begins, per kind of fall (Session._fall_reason): the pelvis low, a link other than a foot on the
+# ground, the motion diverged. The development suite counts falls by these (metrics/dev_suite.fall_endings).
+FALL_REASON_PREFIXES = ("pelvis at", "a link other than a foot", "the motion diverged")
 FIRST_FRAME_TIMEOUT_S = 10.0
 
 
@@ -404,15 +407,15 @@ class Session:
     @staticmethod
     def _fall_reason(state: CharacterState) -> str:
         if state.root_pos_world[2] < FALL_ROOT_HEIGHT_M:
-            return f"pelvis at {state.root_pos_world[2]:.2f} m < {FALL_ROOT_HEIGHT_M} m"
+            return f"{FALL_REASON_PREFIXES[0]} {state.root_pos_world[2]:.2f} m < {FALL_ROOT_HEIGHT_M} m"
         if state.non_foot_ground_contact:
-            return "a link other than a foot touched the ground"
+            return f"{FALL_REASON_PREFIXES[1]} touched the ground"
         # A run-away controller (or simulation) is a failure too, even while the body is in the air.
         v = state.link_com_vel_world
         speed_sq = float((v * v).sum(axis=1).max())  # the fastest link's squared speed [m²/s²]
         if speed_sq > DIVERGED_LINK_SPEED_MPS ** 2 or state.root_pos_world[2] > DIVERGED_ROOT_HEIGHT_M:
             speed = speed_sq ** 0.5
-            return (f"the motion diverged (a link at {speed:.0f} m/s, pelvis at {state.root_pos_world[2]:.1f} m; "
+            return (f"{FALL_REASON_PREFIXES[2]} (a link at {speed:.0f} m/s, pelvis at {state.root_pos_world[2]:.1f} m; "
                     f"limits {DIVERGED_LINK_SPEED_MPS:.0f} m/s, {DIVERGED_ROOT_HEIGHT_M:.1f} m)")
         return ""
 

@@ -112,7 +112,6 @@ class WholeBodyController(ControllerBase):
         self.model = model
         self._tau = Torques.zeros()  # held from one control tick to the next [N·m]
         self.relaxed_solves = 0  # QPs with no feasible point solved again with their limits opened
-        self.speed_limited_joints = 0  # joint-ticks whose torque the no-load speed limited (joint_speed_limit.py)
         omega, zeta = wb.joint_tracking_omega_rad_s, wb.joint_tracking_damping_ratio
         self.kp, self.kd = omega * omega, 2.0 * zeta * omega
         self.formulation = WholeBodyFormulation(_TORQUE_LIMIT_FLAT, hinge_limits(model.joint_limits_rad),
@@ -244,7 +243,7 @@ class WholeBodyController(ControllerBase):
         tau = unflatten_joint_values(self.formulation.torques(model, problem, result.x))
         tau[~IS_BALL, 1:] = 0.0
         if wb.joint_speed_limit_rad_s is not None:  # the joints' no-load speed
-            self.speed_limited_joints += limit_joint_speed(tau, state.joint_vel, wb.joint_speed_limit_rad_s)
+            limit_joint_speed(tau, state.joint_vel, wb.joint_speed_limit_rad_s)
         self._tau = Torques(np.minimum(np.maximum(tau, -TORQUE_LIMIT), TORQUE_LIMIT))
         self.telemetry = ControlTelemetry(force, f_lipm, moment)
 

@@ -27,6 +27,7 @@ from stylesync.config import OperatorConfig, SessionConfig
 from stylesync.errors import StylesyncError
 from stylesync.metrics.bench import CONTROLLERS
 from stylesync.metrics.summary import summarize
+from stylesync.session import FALL_REASON_PREFIXES
 
 if TYPE_CHECKING:
     from stylesync.sources.registry import OpenedSource
@@ -116,16 +117,12 @@ def _median(values: list[float], fmt: str) -> str:
     return format(float(np.median(values)), fmt) if values else "-"
 
 
-# How a fall ended, from the session's fall reason (Session._fall_reason): the pelvis low, a link other than a foot
-# on the ground, or the motion diverged (a link faster than any motion of the body, the pelvis thrown up).
-FALL_ENDINGS = (("low", "pelvis at"), ("touched", "a link other than a foot"), ("diverged", "the motion diverged"))
-
-
 def fall_endings(rs: list[dict]) -> str:
-    """The falls of ``rs`` counted by how they ended (FALL_ENDINGS), as ``low/touched/diverged``; a fall whose
-    reason was not recorded (a version before the reason was kept) is counted nowhere."""
+    """The falls of ``rs`` counted by how their reason begins (session.FALL_REASON_PREFIXES), as
+    ``low/touched/diverged``; a fall whose reason was not recorded (a version before it was kept) is counted
+    nowhere."""
     reasons = [str(r.get("fall_reason") or "") for r in rs if r.get("fell")]
-    return "/".join(str(sum(reason.startswith(prefix) for reason in reasons)) for _, prefix in FALL_ENDINGS)
+    return "/".join(str(sum(reason.startswith(prefix) for reason in reasons)) for prefix in FALL_REASON_PREFIXES)
 
 
 def category_row(cat: str, version: str, rs: list[dict]) -> str:
