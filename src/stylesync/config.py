@@ -295,6 +295,13 @@ class MotionConfig:
     # only "sideways" (across the heading), or "off". Measured on the development suite, neither gains beyond the
     # spread between seeds, and "all" halves the walks' progress along the operator's path (docs/decisions.md).
     landing_capture_bound: str = "off"
+    # In the operator's double stance, the desired COM velocity along his scaled COM velocity is not below the
+    # character's own, up to his (motion/double_stance_momentum.py): a character slower than its operator is not
+    # braked at each double stance of a walk. Only while his COM moves from one of his feet towards the other
+    # (pose_optimization.GAIT_AXIS_DEG), and while the character's capture point is within this distance
+    # outside the support polygon of its feet on the ground: a body already beyond what its feet can stop is braked
+    # as before (docs/decisions.md, "Momentum kept through a double stance"); None: off [m].
+    double_stance_keeps_momentum_m: float | None = 0.1
     # An operator's ankle higher than this share of his leg above his floor (the lowest his ankles have been, rising
     # slowly) bears no weight (on the ball of his foot an ankle rises by at most its distance to the ball, about
     # 0.15 m for a 0.9 m leg): on a stance foot that high he is in the air, and the pelvis height of Eq. 9 is
@@ -326,6 +333,8 @@ class MotionConfig:
         if self.airborne_ankle_height_leg is not None:
             _positive("MotionConfig.airborne_ankle_height_leg", self.airborne_ankle_height_leg)
         _non_negative("MotionConfig.recovery_step_margin_m", self.recovery_step_margin_m)
+        if self.double_stance_keeps_momentum_m is not None:
+            _non_negative("MotionConfig.double_stance_keeps_momentum_m", self.double_stance_keeps_momentum_m)
         if self.recovery_cross_clear_m is not None:
             _non_negative("MotionConfig.recovery_cross_clear_m", self.recovery_cross_clear_m)
         if not 0.0 <= self.capture_bound_sole_share <= 1.0:
