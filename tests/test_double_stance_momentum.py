@@ -28,12 +28,13 @@ def test_along_an_oblique_walk_only_the_component_along_it_changes():
     np.testing.assert_allclose(out, [0.3, 0.4, 0.0], atol=1e-12)
 
 
-def test_the_built_in_walk_goes_further_along_the_operators_path():
+def test_the_built_in_walk_goes_further_along_the_operators_path_when_opted_in():
     """The built-in walk (seed 0, the development suite's run): without the kept momentum the double stances brake
-    the character, which then covers less of its operator's way; with it, no fall and a longer way."""
+    the character, which then covers less of its operator's way (0.39 measured); with it (0.1 m, the measured
+    setting), no fall and a longer way (0.54)."""
     progress = {}
-    for keep in (None, MotionConfig().double_stance_keeps_momentum_m):
+    for keep in (None, 0.1):
         result = suite_run("builtin:walk", 0, MotionConfig(double_stance_keeps_momentum_m=keep), ControlConfig())
         assert not result.fell, keep
         progress[keep] = imitation_metrics(result)["path_progress"]
-    assert progress[MotionConfig().double_stance_keeps_momentum_m] > progress[None] + 0.08, progress
+    assert progress[0.1] > progress[None] + 0.08, progress

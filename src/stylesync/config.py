@@ -295,13 +295,15 @@ class MotionConfig:
     # only "sideways" (across the heading), or "off". Measured on the development suite, neither gains beyond the
     # spread between seeds, and "all" halves the walks' progress along the operator's path (docs/decisions.md).
     landing_capture_bound: str = "off"
-    # In the operator's double stance, the desired COM velocity along his scaled COM velocity is not below the
-    # character's own, up to his (motion/double_stance_momentum.py): a character slower than its operator is not
+    # Opt-in: in the operator's double stance, the desired COM velocity along his scaled COM velocity is not below
+    # the character's own, up to his (motion/double_stance_momentum.py): a character slower than its operator is not
     # braked at each double stance of a walk. Only while his COM moves from one of his feet towards the other
-    # (pose_optimization.GAIT_AXIS_DEG), and while the character's capture point is within this distance
-    # outside the support polygon of its feet on the ground: a body already beyond what its feet can stop is braked
-    # as before (docs/decisions.md, "Momentum kept through a double stance"); None: off [m].
-    double_stance_keeps_momentum_m: float | None = 0.1
+    # (pose_optimization.GAIT_AXIS_DEG), and while the character's capture point is within this distance outside
+    # the support polygon of its feet on the ground: a body already beyond what its feet can stop is braked as before.
+    # The walks then cover more of his way with as many runs completing, but the built-in walk's character steps on
+    # its own and falls out of step with him (docs/decisions.md, "Momentum kept through a double stance"). 0.1 m
+    # is the measured setting; None: off [m].
+    double_stance_keeps_momentum_m: float | None = None
     # An operator's ankle higher than this share of his leg above his floor (the lowest his ankles have been, rising
     # slowly) bears no weight (on the ball of his foot an ankle rises by at most its distance to the ball, about
     # 0.15 m for a 0.9 m leg): on a stance foot that high he is in the air, and the pelvis height of Eq. 9 is
