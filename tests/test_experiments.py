@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from stylesync.config import JacobianTransposeConfig, PidGains
-from stylesync.experiments import push, squat_jump, tune
+from stylesync.experiments import kick, push, squat_jump, tune
 from stylesync.experiments.scripted_operator import sagittal_leg, standing_ankles
 from stylesync.sources.deepmimic_clip import DeepMimicClip
 from stylesync.sources.frame import JOINT_INDEX
@@ -58,3 +58,13 @@ def test_tuning_ramp_error_falls_with_stiffer_gains():
     stiff = tune.ramp_error("knee", PidGains(base.kp * 2, 0.0, base.kd * 2), slope, height, axis)
     assert stiff[0] < soft[0]
     assert stiff[1] < np.radians(5.0)
+
+
+def test_the_kick_claim_needs_the_walk_to_reach_the_ball_and_the_kick_to_move_it():
+    walk = {"reached": True, "kicked": False, "fell": False}
+    kicked = {"reached": True, "kicked": True, "fell": False}
+    assert kick.claim_holds({"walk-to-ball": walk, "kick": kicked})  # the walk need not push the ball
+    assert not kick.claim_holds({"walk-to-ball": {**walk, "reached": False}, "kick": kicked})
+    assert not kick.claim_holds({"walk-to-ball": walk, "kick": {**kicked, "kicked": False}})
+    assert not kick.claim_holds({"walk-to-ball": {**walk, "fell": True}, "kick": kicked})
+    assert not kick.claim_holds({"walk-to-ball": walk, "kick": {**kicked, "fell": True}})

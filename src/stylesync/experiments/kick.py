@@ -7,7 +7,8 @@ Two runs, both on recorded operators of pybullet_data played by the built-in ope
   character (h_C / h_H, Eq. 9) about the starting pelvis.
 
 Kicked = the ball moved more than ``KICKED_M``. The claim checked (the paper's: the character reaches the ball
-and kicks it, keeping its balance): in both runs the ball is reached and kicked with no fall. Exit status 0 only
+and kicks it, keeping its balance): the walk reaches the ball and the kick moves it, both with no fall. The walk
+clip has no kick in it: whether its steps happen to push the ball is recorded, not required. Exit status 0 only
 when it holds.
 """
 
@@ -91,6 +92,13 @@ def run_one(scenario: str, seed: int):
                     "fall_time_s": result.fall_time_s}, path
 
 
+def claim_holds(scenarios: dict[str, dict]) -> bool:
+    """The walk reaches the ball and the kick moves it, neither falling (``scenarios``: run_one's metrics by
+    scenario name)."""
+    walk, kick = scenarios["walk-to-ball"], scenarios["kick"]
+    return bool(walk["reached"] and not walk["fell"] and kick["kicked"] and not kick["fell"])
+
+
 def run(out: Path, duration_s: float = 0.0, seed: int = 0) -> tuple[bool, dict]:
     """``duration_s`` is unused (each scenario fixes its own)."""
     out.mkdir(parents=True, exist_ok=True)
@@ -106,7 +114,7 @@ def run(out: Path, duration_s: float = 0.0, seed: int = 0) -> tuple[bool, dict]:
         ax.set_title(f"{name}: " + ("fell" if m["fell"] else "no fall") + (", kicked" if m["kicked"] else ""))
         plan_view(ax)
     save_figure(fig, out / "fig15_kick.png")
-    holds = all(m["reached"] and m["kicked"] and not m["fell"] for m in scenarios.values())
+    holds = claim_holds(scenarios)
     summary = {"experiment": "kick", "claim_holds": holds, "reach_m": REACH_M, "kicked_m": KICKED_M,
                "scenarios": scenarios}
     (out / "metrics.json").write_text(json.dumps(summary, indent=2))
