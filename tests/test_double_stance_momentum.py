@@ -3,7 +3,7 @@ from conftest import suite_run
 
 from stylesync.config import ControlConfig, MotionConfig
 from stylesync.metrics.summary import imitation_metrics
-from stylesync.motion.double_stance_momentum import kept_com_velocity
+from stylesync.motion.double_stance_momentum import kept_com_velocity, moves_between_feet
 
 
 def test_a_slower_character_keeps_its_speed_up_to_the_operators():
@@ -38,3 +38,14 @@ def test_the_built_in_walk_goes_further_along_the_operators_path_when_opted_in()
         assert not result.fell, keep
         progress[keep] = imitation_metrics(result)["path_progress"]
     assert progress[0.1] > progress[None] + 0.08, progress
+
+
+def test_a_gaits_double_stance_moves_from_one_foot_towards_the_other():
+    left, right = np.array([0.3, 0.1, 0.05]), np.array([-0.3, -0.1, 0.05])  # a step along x
+    assert moves_between_feet(np.array([1.0, 0.0, 0.0]), left, right)  # forward, onto the front foot
+    assert moves_between_feet(np.array([-0.5, -0.2, 0.0]), left, right)  # backwards, either way
+    assert not moves_between_feet(np.array([0.0, 1.0, 0.0]), left, right)  # across the feet: a sway
+    # their line is at 18.4° to x: 40° off it is within, 50° off it beyond
+    assert moves_between_feet(np.array([np.cos(np.radians(58.4)), np.sin(np.radians(58.4)), 0.0]), left, right)
+    assert not moves_between_feet(np.array([np.cos(np.radians(68.4)), np.sin(np.radians(68.4)), 0.0]), left, right)
+    assert not moves_between_feet(np.zeros(3), left, right)  # standing still

@@ -298,8 +298,9 @@ class MotionConfig:
     # Opt-in: in the operator's double stance, the desired COM velocity along his scaled COM velocity is not below
     # the character's own, up to his (motion/double_stance_momentum.py): a character slower than its operator is not
     # braked at each double stance of a walk. Only while his COM moves from one of his feet towards the other
-    # (pose_optimization.GAIT_AXIS_DEG), and while the character's capture point is within this distance outside
-    # the support polygon of its feet on the ground: a body already beyond what its feet can stop is braked as before.
+    # (double_stance_momentum.GAIT_AXIS_DEG), and while the character's capture point is within this distance
+    # outside the support polygon of its feet on the ground: a body already beyond what its feet can stop is braked
+    # as before.
     # The walks then cover more of his way with as many runs completing, but the built-in walk's character steps on
     # its own and falls out of step with him (docs/decisions.md, "Momentum kept through a double stance"). 0.1 m
     # is the measured setting; None: off [m].

@@ -45,7 +45,7 @@ from stylesync.model.state import CharacterState, MassProperties
 from stylesync.motion.balance_strategy import stance_hip_blend, swing_hip_feedback
 from stylesync.motion.bounds import BoundsMonitor, step_length_bound_m
 from stylesync.motion.capture_bound import bounded_com_target, landing_catch_region
-from stylesync.motion.double_stance_momentum import kept_com_velocity
+from stylesync.motion.double_stance_momentum import kept_com_velocity, moves_between_feet
 from stylesync.motion.leg_ik import solve_leg
 from stylesync.motion.operator_analysis import UPPER_JOINTS, OperatorAnalysis, analyse_operator, upper_local
 from stylesync.motion.recovery_step import (
@@ -96,10 +96,6 @@ _LANDING_REACH_M = LANDING_REACH * CHAR_LEG_LENGTH_M  # hip-ankle distance at wh
 OPERATOR_FLOOR_RISE_MPS = 0.5
 OPERATOR_VELOCITY_SETTLE_S = 0.2  # the operator's filtered COM velocity is taken as settled from then on [s]
 HEEL_AHEAD_OF_ANKLE_M = FOOT_CENTER_AHEAD_OF_ANKLE_M - FOOT_LENGTH_M / 2  # < 0: the heel is behind the ankle [m]
-# A double stance in which the operator's COM moves within this angle of the line through his ankles is a gait's:
-# the character's momentum is kept through it (MotionConfig.double_stance_keeps_momentum_m) [deg]
-GAIT_AXIS_DEG = 45.0
-_GAIT_AXIS_COS = math.cos(math.radians(GAIT_AXIS_DEG))
 
 
 def _heading_frame_fraction(p_h, al_h, ar_h, al_c, ar_c, scale: float, R: np.ndarray) -> np.ndarray:
@@ -489,18 +485,9 @@ class MotionOptimizer:
         tick.com_vel_h = self._com_h_rate(com_h)
         keep_m = self.cfg.double_stance_keeps_momentum_m
         if (keep_m is not None and anchor is Stance.DS and self._capture_near_support(tick, state, keep_m)
-                and self._moves_between_his_feet(tick, a_hs)):
+                and moves_between_feet(tick.com_vel_h, a_hs["left"], a_hs["right"])):
             com_vel_d = kept_com_velocity(com_vel_d, scale * tick.com_vel_h, tick.com_vel_c)
         tick.com_vel_d = com_vel_d
-
-    def _moves_between_his_feet(self, tick: _Tick, ankles_h: dict[str, np.ndarray]) -> bool:
-        """Whether the operator's COM moves from one of his feet towards the other, as in a walk's double stance:
-        his horizontal COM velocity within GAIT_AXIS_DEG of the line through his ankles, either way (not across it,
-        as in a crouch or a sway on both feet, nor while he stands still)."""
-        v = tick.com_vel_h[:2]
-        d = ankles_h["left"][:2] - ankles_h["right"][:2]
-        nv, nd = float(np.hypot(v[0], v[1])), float(np.hypot(d[0], d[1]))
-        return nv > 1e-6 and nd > 1e-6 and abs(float(v @ d)) >= _GAIT_AXIS_COS * nv * nd
 
     def _capture_near_support(self, tick: _Tick, state: CharacterState, within_m: float) -> bool:
         """Whether the character's capture point is within ``within_m`` outside the support polygon of its soles on
