@@ -484,8 +484,9 @@ class MotionOptimizer:
         com_vel_d[2] = 0.0
         tick.com_vel_h = self._com_h_rate(com_h)
         keep_m = self.cfg.double_stance_keeps_momentum_m
-        if (keep_m is not None and anchor is Stance.DS and self._capture_near_support(tick, state, keep_m)
-                and moves_between_feet(tick.com_vel_h, a_hs["left"], a_hs["right"])):
+        if (keep_m is not None and anchor is Stance.DS
+                and moves_between_feet(tick.com_vel_h, a_hs["left"], a_hs["right"])
+                and self._capture_near_support(tick, state, keep_m)):
             com_vel_d = kept_com_velocity(com_vel_d, scale * tick.com_vel_h, tick.com_vel_c)
         tick.com_vel_d = com_vel_d
 
