@@ -300,10 +300,9 @@ class MotionConfig:
     # braked at each double stance of a walk. Only while his COM moves from one of his feet towards the other
     # (double_stance_momentum.GAIT_AXIS_DEG), and while the character's capture point is within this distance
     # outside the support polygon of its feet on the ground: a body already beyond what its feet can stop is braked
-    # as before.
-    # The walks then cover more of his way with as many runs completing, but the built-in walk's character steps on
-    # its own and falls out of step with him (docs/decisions.md, "Momentum kept through a double stance"). 0.1 m
-    # is the measured setting; None: off [m].
+    # as before. The walks then cover more of his way with as many runs completing, but the built-in walk's
+    # character steps on its own and falls out of step with him (docs/decisions.md, "Momentum kept through a double
+    # stance"). 0.1 m is the measured setting; None: off [m].
     double_stance_keeps_momentum_m: float | None = None
     # An operator's ankle higher than this share of his leg above his floor (the lowest his ankles have been, rising
     # slowly) bears no weight (on the ball of his foot an ankle rises by at most its distance to the ball, about
