@@ -44,10 +44,12 @@ def traced_motion(**kwargs) -> MotionConfig:
     from his capture point (MotionConfig.swing_landing "his_foot_now", the swing as it was then), and with the reach
     rule predicting for now once his usual swing time is past (``recovery_overdue_swing_horizon`` off), and a
     recovery step's landing short of the crossover clearance always moved outwards, in the heading frame
-    (``recovery_cross_nearest`` and ``recovery_cross_stance_frame`` off): their motion configurations start from
+    (``recovery_cross_nearest`` and ``recovery_cross_stance_frame`` off), and a foot in the air stepping whatever
+    its distance to the capture point (``recovery_landing_foot_waits`` off): their motion configurations start from
     it."""
     return MotionConfig(**{"swing_landing": "his_foot_now", "recovery_overdue_swing_horizon": False,
-                           "recovery_cross_nearest": False, "recovery_cross_stance_frame": False, **kwargs})
+                           "recovery_cross_nearest": False, "recovery_cross_stance_frame": False,
+                           "recovery_landing_foot_waits": False, **kwargs})
 
 
 def test_support_polygon_distance_is_signed_and_finds_the_nearest_point():
@@ -121,6 +123,27 @@ def test_a_capture_point_beyond_the_left_foot_lifts_the_right_foot_and_lands_it_
     wait_s = stepper.cfg.recovery_min_stance_s
     assert stepper.trigger(1.4 + 0.5 * wait_s, com, vel, ANKLES, QUATS, ["left", "right"]) is None
     assert stepper.trigger(1.4 + 1.5 * wait_s, com, vel, ANKLES, QUATS, ["left", "right"]) is not None
+
+
+def test_a_foot_in_the_air_that_a_step_would_take_back_from_the_capture_point_is_left_to_land():
+    # A stride (CMU-dev 07_01 started at its speed, traced): the left foot 0.7 m ahead of the right, just landed and
+    # bounced (not on the ground), the body moving forward over it at 1.3 m/s. Its step, within reach of the right
+    # sole far behind, would land it further from the capture point than it is: it is left to land.
+    stepper = RecoveryStepper(traced_motion(recovery_landing_foot_waits=True), CHAR_LEG_LENGTH_M, G)
+    ankles = {"left": np.array([0.7, 0.1, ANKLE_HEIGHT_M + 0.03]), "right": np.array([0.0, -0.1, ANKLE_HEIGHT_M])}
+    com, vel = np.array([0.45, 0.0, 0.8]), np.array([1.3, 0.0, 0.0])
+    landing, xi_land = stepper.capture_landing(stepper.cfg.recovery_swing_s, com, vel, ankles["right"], IDENTITY,
+                                               np.eye(3), "left")
+    assert landing[0] < ankles["left"][0]  # within reach of the right sole: back from where the foot is
+    assert stepper.trigger(1.0, com, vel, ankles, QUATS, ["right"], np.eye(3)) is None and stepper.count == 0
+    free = RecoveryStepper(traced_motion(), CHAR_LEG_LENGTH_M, G)
+    assert free.trigger(1.0, com, vel, ankles, QUATS, ["right"], np.eye(3)).side == "left"  # as it was traced
+    # A foot in the air short of a capture point that runs away behind the body (CMU-dev 03_01, seed 5): its step,
+    # beyond the capture point, is better than landing it where it is, and it steps.
+    behind = {"left": np.array([-0.35, 0.1, ANKLE_HEIGHT_M + 0.03]), "right": ankles["right"]}
+    step = stepper.trigger(1.0, np.array([-0.1, 0.0, 0.8]), np.array([-0.8, 0.0, 0.0]), behind, QUATS, ["right"],
+                           np.eye(3))
+    assert step is not None and step.side == "left"
 
 
 def test_a_crossover_landing_needs_its_clearance_ahead_or_behind():
@@ -982,8 +1005,11 @@ def test_a_recovery_step_just_short_of_its_crossover_clearance_lands_on_the_capt
         suite_run("builtin:spin", 0, motion, ControlConfig(), watch=watch)
         return found
 
-    new = run(MotionConfig())
-    old = run(MotionConfig(recovery_cross_nearest=False, recovery_cross_stance_frame=False))
+    # Traced before a foot in the air nearer the capture point was left to land (recovery_landing_foot_waits): the
+    # left foot, over the right sole and a centimetre nearer the capture point, now lands first and the right steps.
+    new = run(MotionConfig(recovery_landing_foot_waits=False))
+    old = run(MotionConfig(recovery_landing_foot_waits=False, recovery_cross_nearest=False,
+                           recovery_cross_stance_frame=False))
     assert new["side"] == old["side"] == "left"
     assert new["foot_xy"][0] > 0.3 and old["foot_xy"][0] < 0.0  # measured: 0.42 m ahead; 0.12 m behind
     assert new["xi_out_m"] < 0.0 < 0.1 < old["xi_out_m"]  # measured: -0.05 m; 0.19 m

@@ -262,6 +262,19 @@ class RecoveryStepper:
             return None
         dist = {s: sole_outside_m(xi, ankles_world[s], feet_quat_wxyz[s]) for s in on_ground}
         stance = min(dist, key=lambda s: dist[s])
+        if len(on_ground) == 1 and cfg.recovery_landing_foot_waits and heading_world is not None:
+            # The other foot is in the air (a step just landed that bounced; the controller presses it down). If
+            # landed where it is it would leave the predicted capture point no further outside the support than its
+            # step would, within reach of the sole on the ground, it is landing where the body goes: a step would
+            # take it back from there.
+            up = _OTHER[stance]
+            landing, xi_land = self.capture_landing(cfg.recovery_swing_s, com_world, com_vel_world,
+                                                    ankles_world[stance], feet_quat_wxyz[stance], heading_world, up)
+            stepped = outside_step_m(xi_land, ankles_world[stance], feet_quat_wxyz[stance], landing, heading_world)
+            as_it_is = outside_step_m(xi_land, ankles_world[stance], feet_quat_wxyz[stance], ankles_world[up],
+                                      heading_world)
+            if as_it_is <= stepped:
+                return None
         if heading_world is not None and len(on_ground) == 2:
             residual = {s: self.capture_residual_m(com_world, com_vel_world, ankles_world[s], feet_quat_wxyz[s],
                                                    heading_world, _OTHER[s]) for s in on_ground}
