@@ -219,15 +219,15 @@ class MotionConfig:
     # landing planned just short of the clearance (a capture point ahead on the stance foot's far side) went to the
     # wrong side of the stance foot (docs/decisions.md, "A crossover step just short of its clearance")
     recovery_cross_nearest: bool = True
+    # ... and the crossover clearance and the outward side are taken in the stance sole's own yaw frame, where the
+    # sole is, instead of the heading frame, which turns with the operator's root (by 40° in 0.2 s in a spin) while the
+    # planted sole does not
+    recovery_cross_stance_frame: bool = True
     # With one sole on the ground, no recovery step of the other foot while it is in the air where, landed as it is,
     # it leaves the predicted capture point no further outside the support than its step would: it is landing where
     # the body goes, and its step, within reach of the sole on the ground, took it back from there
     # (docs/decisions.md, "A landing foot is left to land")
     recovery_landing_foot_waits: bool = True
-    # ... and the crossover clearance and the outward side are taken in the stance sole's own yaw frame, where the
-    # sole is, instead of the heading frame, which turns with the operator's root (by 40° in 0.2 s in a spin) while the
-    # planted sole does not
-    recovery_cross_stance_frame: bool = True
     # ... also while the operator is on one foot but the character, its step for his counted as taken (early
     # contact), stands on both and waits for his next change
     recovery_while_step_counted: bool = True

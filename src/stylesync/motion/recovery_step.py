@@ -253,7 +253,9 @@ class RecoveryStepper:
         than the margin (and the last recovery step ended at least ``recovery_min_stance_s`` ago). The stance
         foot is the one on the ground whose sole is nearer the capture point; with ``heading_world`` ((3, 3),
         x forward) and both feet on the ground, the foot whose step leaves the predicted capture point least
-        outside the new support (:meth:`capture_residual_m`), the nearer sole on a tie."""
+        outside the new support (:meth:`capture_residual_m`), the nearer sole on a tie. With one sole on the ground
+        and ``recovery_landing_foot_waits``, none while the foot in the air, landed where it is, would leave the
+        capture point predicted a recovery swing ahead no further outside than its step would."""
         cfg = self.cfg
         if not cfg.recovery_steps or not on_ground or time_s - self._last_end_s < cfg.recovery_min_stance_s:
             return None
