@@ -11,7 +11,7 @@ from conftest import suite_run
 
 from stylesync.config import ControlConfig, MotionConfig, WholeBodyConfig
 from stylesync.errors import ConfigError
-from stylesync.motion.pose_optimization import OPERATOR_FLOOR_RISE_MPS, MotionOptimizer
+from stylesync.motion.pose_optimization import OPERATOR_FLOOR_RISE_MPS, MotionOptimizer, _heading_frame_fraction
 
 OPERATOR_LEG_M = 0.9
 MOCAP = Path(__file__).resolve().parents[2] / "shared" / "mocap"
@@ -110,3 +110,35 @@ def test_a_walk_up_uneven_ground_is_never_taken_for_a_flight(monkeypatch):
     assert seen["lower_rise_m"] > 0.12  # measured: 0.16 m up
     assert seen["lower_above_floor_m"] < 0.05  # measured: 0.015 m
     assert seen["held"] == 0
+
+
+def test_the_fraction_between_the_feet_needs_them_in_his_order_where_asked():
+    """Eq. 10 along the heading (x forward): his left foot ahead of his right, his COM over it. The character's own
+    step has put its right foot 0.8 m ahead of its left. In order, his front foot is its front foot."""
+    his_left, his_right, com_h = np.array([0.0, 0.1, 0.0]), np.array([-0.5, -0.1, 0.0]), np.array([0.0, 0.0, 0.9])
+    its_left, its_right = np.array([0.0, 0.1, 0.0]), np.array([0.8, -0.1, 0.0])
+    by_side = _heading_frame_fraction(com_h, his_left, his_right, its_left, its_right, 1.0, np.eye(3))
+    assert by_side[0] == pytest.approx(0.0)  # over the character's left foot, now its rear one
+    in_order = _heading_frame_fraction(com_h, his_left, his_right, its_left, its_right, 1.0, np.eye(3), True)
+    assert in_order[0] == pytest.approx(0.8)  # over its front foot, as his COM is over his
+    his_mid = 0.5 * (his_left + his_right)  # his COM a fifth of the way from his front foot to his rear one
+    fifth = _heading_frame_fraction(his_mid + [0.15, 0.0, 0.9], his_left, his_right, its_left, its_right, 1.0,
+                                    np.eye(3), True)
+    assert fifth[0] == pytest.approx(0.8 - 0.2 * 0.8)
+    assert in_order[1] == pytest.approx(by_side[1])  # across, the feet are in the same order: the fraction
+    # The feet in the same order along both axes: the fraction, as before.
+    ahead = np.array([0.5, 0.1, 0.0])
+    np.testing.assert_allclose(
+        _heading_frame_fraction(com_h, his_left, his_right, ahead, its_left * [1, -1, 1], 1.0, np.eye(3), True),
+        _heading_frame_fraction(com_h, his_left, his_right, ahead, its_left * [1, -1, 1], 1.0, np.eye(3)))
+
+
+@pytest.mark.skipif(not (MOCAP / "cmu-dev" / "09_11.bvh").exists(),
+                    reason="needs ../shared/mocap/cmu-dev/09_11.bvh (not in the repository)")
+def test_a_recovery_step_that_puts_the_other_foot_ahead_does_not_pull_the_body_back_over_the_rear_one():
+    # CMU-dev 09_11 (a run, seed 0), traced: in the rest after the clip the character stands on its left foot, his
+    # COM over his left (front) foot; its recovery step puts its right foot 0.84 m ahead. By side, Eq. 10 then put
+    # the COM target over its left foot, now the rear one: the body was pulled back and sank in the split (4.1 s).
+    spec = f"bvh:{MOCAP / 'cmu-dev' / '09_11.bvh'}"
+    assert suite_run(spec, 0, MotionConfig(fraction_needs_feet_in_his_order=False), ControlConfig()).fell
+    assert not suite_run(spec, 0, MotionConfig(fraction_needs_feet_in_his_order=True), ControlConfig()).fell

@@ -121,6 +121,9 @@ class MotionConfig:
     # While a late contact holds the reference (Sec. 5.1), the pelvis and COM targets go on over the ground at the
     # desired COM velocity the hold began with (off: they stop where the operator was, braking the character)
     late_contact_keeps_momentum: bool = True
+    # After the character's own step (a recovery step), Eq. 10's fraction along the heading from his rear foot to his
+    # front one, on its rear and front feet, rather than from his left foot to his right on its left and right ones
+    fraction_needs_feet_in_his_order: bool = True
     # Opt-in (0: off): the pelvis and COM targets advance at the operator's scaled COM velocity and are pulled towards
     # the feet-anchored targets of Eq. 10 with this time constant [s]. The character then keeps up with the operator
     # over the ground (about twice the distance on the walk set) but falls more often (docs/decisions.md).

@@ -98,13 +98,18 @@ OPERATOR_VELOCITY_SETTLE_S = 0.2  # the operator's filtered COM velocity is take
 HEEL_AHEAD_OF_ANKLE_M = FOOT_CENTER_AHEAD_OF_ANKLE_M - FOOT_LENGTH_M / 2  # < 0: the heel is behind the ankle [m]
 
 
-def _heading_frame_fraction(p_h, al_h, ar_h, al_c, ar_c, scale: float, R: np.ndarray) -> np.ndarray:
+def _heading_frame_fraction(p_h, al_h, ar_h, al_c, ar_c, scale: float, R: np.ndarray,
+                            same_order: bool = False) -> np.ndarray:
     """Eq. 10 (fraction reading) in the heading frame (world rotation ``R``), horizontal components only.
 
     Along an axis where the feet are close together the fraction is ill-defined; there the operator's offset from
     the ankle midpoint, scaled, is used. The two are blended by how far apart the feet are (the lesser of the
     operator's and the character's spread, from _MIN_AXIS_SPREAD_M / 2 to _MIN_AXIS_SPREAD_M * 1.5), so that the
-    target does not jump when a swing foot passes the stance foot.
+    target does not jump when a swing foot passes the stance foot. With ``same_order`` the fraction goes from his
+    rear foot to his front one along the heading (x), and so it does on the character's feet: where the character's
+    own step has put its other foot ahead (his left foot ahead of his right, its right ahead of its left), his COM over
+    his front foot is its COM over its front foot, not over its left one, now behind. The order can only change
+    where one of the spreads passes zero, where the blend is the midpoint's offset: the target does not jump.
     """
     ph, lh, rh, lc, rc = (R.T @ np.array([p_h, al_h, ar_h, al_c, ar_c]).T).T.tolist()  # heading-frame coordinates
     out = [0.0, 0.0, 0.0]
@@ -112,9 +117,12 @@ def _heading_frame_fraction(p_h, al_h, ar_h, al_c, ar_c, scale: float, R: np.nda
         spread_h, spread_c = rh[ax] - lh[ax], rc[ax] - lc[ax]
         offset = 0.5 * (lc[ax] + rc[ax]) + scale * (ph[ax] - 0.5 * (lh[ax] + rh[ax]))
         w = min(max(min(abs(spread_h), abs(spread_c)) / _MIN_AXIS_SPREAD_M - 0.5, 0.0), 1.0)
+        near = lc[ax]
+        if same_order and ax == 0 and spread_h * spread_c < 0.0:
+            near, spread_c = rc[ax], -spread_c
         out[ax] = offset
         if w > 0.0:
-            out[ax] += w * (lc[ax] + spread_c * (ph[ax] - lh[ax]) / spread_h - offset)
+            out[ax] += w * (near + spread_c * (ph[ax] - lh[ax]) / spread_h - offset)
     return R @ np.array(out)
 
 
@@ -237,6 +245,7 @@ class MotionOptimizer:
         self._hold_shift = np.zeros(2)  # the held targets' travel since the hold began [m]
         self._ref_xy: np.ndarray | None = None  # (pelvis, COM) x (x, y) targets that follow the operator [m]
         self._swing: str | None = None
+        self._feet_by_own_step = False  # the character's last step was its own (a recovery step), not one of his
         self._swing_offset = np.zeros(2)  # lift-off foot position minus the first swing target, decaying [m]
         self._swing_t0_s = 0.0  # when the character's current swing began [s]
         self._liftoff_xy = np.zeros(2)  # where the current swing's foot lifted off [m]
@@ -377,6 +386,10 @@ class MotionOptimizer:
         lifting = op_state is not Stance.DS and self.char_fsm.state is Stance.DS
         can_lift = self._can_lift(sample, state, mass) if lifting else None
         ch_state = self.char_fsm.update(op_state, contact, state.time_s, can_lift, self.cfg.liftoff_weight_shift_s)
+        if self.char_fsm.recovery_step:
+            self._feet_by_own_step = True
+        elif ch_state is not Stance.DS:
+            self._feet_by_own_step = False  # a swing of his
         if op_state is not self._op_state:  # the operator's swing time, for the swing's progress
             if self._op_state is Stance.DS:
                 self._op_last_ds_s = state.time_s - self._op_state_t0_s
@@ -423,10 +436,11 @@ class MotionOptimizer:
         anchor = tick.ch_state if self.char_fsm.hold_reference else tick.op_state
         ground_z = self._ground_ankle_height_m(a_h, op_leg_m)
         if anchor is Stance.DS:
+            order = self.cfg.fraction_needs_feet_in_his_order and self._feet_by_own_step
             pelvis_xy = _heading_frame_fraction(p_h, a_hs["left"], a_hs["right"], a_c["left"], a_c["right"],
-                                                scale, R_root_d)
+                                                scale, R_root_d, order)
             com_xy = _heading_frame_fraction(com_h, a_hs["left"], a_hs["right"], a_c["left"], a_c["right"],
-                                             scale, R_root_d)
+                                             scale, R_root_d, order)
             ankle_h_z = 0.5 * (a_h["left"][2] + a_h["right"][2])
         else:
             st = "left" if anchor is Stance.LS else "right"
