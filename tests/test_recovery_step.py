@@ -44,12 +44,14 @@ def traced_motion(**kwargs) -> MotionConfig:
     from his capture point (MotionConfig.swing_landing "his_foot_now", the swing as it was then), and with the reach
     rule predicting for now once his usual swing time is past (``recovery_overdue_swing_horizon`` off), and a
     recovery step's landing short of the crossover clearance always moved outwards, in the heading frame
-    (``recovery_cross_nearest`` and ``recovery_cross_stance_frame`` off), and a foot in the air stepping whatever
-    its distance to the capture point (``recovery_landing_foot_waits`` off): their motion configurations start from
+    (``recovery_cross_nearest`` and ``recovery_cross_stance_frame`` off), a foot in the air stepping whatever
+    its distance to the capture point (``recovery_landing_foot_waits`` off), and Eq. 10's fraction by side after a
+    step of the character's own (``fraction_needs_feet_in_his_order`` off): their motion configurations start from
     it."""
     return MotionConfig(**{"swing_landing": "his_foot_now", "recovery_overdue_swing_horizon": False,
                            "recovery_cross_nearest": False, "recovery_cross_stance_frame": False,
-                           "recovery_landing_foot_waits": False, **kwargs})
+                           "recovery_landing_foot_waits": False, "fraction_needs_feet_in_his_order": False,
+                           **kwargs})
 
 
 def test_support_polygon_distance_is_signed_and_finds_the_nearest_point():
@@ -960,9 +962,11 @@ def test_a_swing_past_its_usual_time_is_landed_before_the_capture_point_runs_out
                                                            state.link_quat_wxyz[stance])))
             return on_tick
 
-        # traced before the joints' no-load speed (with it, the late swing's run also comes to rest)
+        # traced before the joints' no-load speed (with it, the late swing's run also comes to rest) and before Eq.
+        # 10's fraction from the rear foot to the front one after the character's own step (so does it with that)
         control = ControlConfig(whole_body=WholeBodyConfig(joint_speed_limit_rad_s=None))
-        return taken, suite_run(spec, 7, MotionConfig(recovery_overdue_swing_horizon=flag), control, watch=watch)
+        motion = MotionConfig(recovery_overdue_swing_horizon=flag, fraction_needs_feet_in_his_order=False)
+        return taken, suite_run(spec, 7, motion, control, watch=watch)
 
     taken, result = run(True)
     taken_old, result_old = run(False)
@@ -1153,7 +1157,8 @@ def test_a_recovery_step_whose_landing_is_due_is_pressed_onto_the_ground():
     0.08 s) and the run stands. Traced with landings short of the crossover clearance moved outwards in the heading
     frame (MotionConfig.recovery_cross_nearest and recovery_cross_stance_frame off; with the first, one of three
     landings waits 0.29 s, and the run stands), before the joints' no-load speed (with it, no recovery step of this
-    run has a landing falling due)."""
+    run has a landing falling due) and with Eq. 10's fraction by side after a step of the character's own
+    (MotionConfig.fraction_needs_feet_in_his_order off)."""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '08_08.bvh'}"
 
     def run(landing_weight: float):
@@ -1171,7 +1176,8 @@ def test_a_recovery_step_whose_landing_is_due_is_pressed_onto_the_ground():
                 waits.append(state.time_s - due_since.pop())
             last_tick_s[0] = state.time_s
 
-        result = suite_run(spec, 1, MotionConfig(recovery_cross_nearest=False, recovery_cross_stance_frame=False),
+        result = suite_run(spec, 1, MotionConfig(recovery_cross_nearest=False, recovery_cross_stance_frame=False,
+                                                 fraction_needs_feet_in_his_order=False),
                            ControlConfig(whole_body=WholeBodyConfig(recovery_foot_landing_weight=landing_weight,
                                                                     joint_speed_limit_rad_s=None)),
                            on_tick=on_tick)
