@@ -99,13 +99,13 @@ HEEL_AHEAD_OF_ANKLE_M = FOOT_CENTER_AHEAD_OF_ANKLE_M - FOOT_LENGTH_M / 2  # < 0:
 
 
 def _heading_frame_fraction(p_h, al_h, ar_h, al_c, ar_c, scale: float, R: np.ndarray,
-                            same_order: bool = False) -> np.ndarray:
+                            rear_to_front: bool = False) -> np.ndarray:
     """Eq. 10 (fraction reading) in the heading frame (world rotation ``R``), horizontal components only.
 
     Along an axis where the feet are close together the fraction is ill-defined; there the operator's offset from
     the ankle midpoint, scaled, is used. The two are blended by how far apart the feet are (the lesser of the
     operator's and the character's spread, from _MIN_AXIS_SPREAD_M / 2 to _MIN_AXIS_SPREAD_M * 1.5), so that the
-    target does not jump when a swing foot passes the stance foot. With ``same_order`` the fraction goes from his
+    target does not jump when a swing foot passes the stance foot. With ``rear_to_front`` the fraction goes from his
     rear foot to his front one along the heading (x), and so it does on the character's feet: where the character's
     own step has put its other foot ahead (his left foot ahead of his right, its right ahead of its left), his COM over
     his front foot is its COM over its front foot, not over its left one, now behind. The order can only change
@@ -118,7 +118,7 @@ def _heading_frame_fraction(p_h, al_h, ar_h, al_c, ar_c, scale: float, R: np.nda
         offset = 0.5 * (lc[ax] + rc[ax]) + scale * (ph[ax] - 0.5 * (lh[ax] + rh[ax]))
         w = min(max(min(abs(spread_h), abs(spread_c)) / _MIN_AXIS_SPREAD_M - 0.5, 0.0), 1.0)
         near = lc[ax]
-        if same_order and ax == 0 and spread_h * spread_c < 0.0:
+        if rear_to_front and ax == 0 and spread_h * spread_c < 0.0:
             near, spread_c = rc[ax], -spread_c
         out[ax] = offset
         if w > 0.0:
