@@ -963,7 +963,7 @@ def test_a_swing_past_its_usual_time_is_landed_before_the_capture_point_runs_out
             return on_tick
 
         # traced before the joints' no-load speed (with it, the late swing's run also comes to rest) and before Eq.
-        # 10's fraction from the rear foot to the front one after the character's own step (so does it with that)
+        # 10's fraction from the rear foot to the front one after the character's own step (with it, too)
         control = ControlConfig(whole_body=WholeBodyConfig(joint_speed_limit_rad_s=None))
         motion = MotionConfig(recovery_overdue_swing_horizon=flag, fraction_needs_feet_in_his_order=False)
         return taken, suite_run(spec, 7, motion, control, watch=watch)
