@@ -312,6 +312,16 @@ class MotionConfig:
     # character steps on its own and falls out of step with him (docs/decisions.md, "Momentum kept through a double
     # stance"). 0.1 m is the measured setting; None: off [m].
     double_stance_keeps_momentum_m: float | None = None
+    # In the character's double stance the COM target's capture point is kept within its soles
+    # (capture_bound_sole_share); False: not while the operator walks from one foot onto the other
+    # (double_stance_momentum.moves_between_feet), whose capture point runs ahead of his front foot.
+    capture_bound_in_his_gait: bool = True
+    # Following the operator over the ground (motion/path_feedback.py): the swing's landing relative to the
+    # character's capture point is moved so that a step removes this share of the capture point's error from his,
+    # scaled onto the character's path from where both started (the divergent component of motion: 1 removes it
+    # in one step, above 2 it grows), the move at most path_feedback_max_m. 0: off [-], [m].
+    path_feedback_share: float = 0.0
+    path_feedback_max_m: float = 0.2
     # An operator's ankle higher than this share of his leg above his floor (the lowest his ankles have been, rising
     # slowly) bears no weight (on the ball of his foot an ankle rises by at most its distance to the ball, about
     # 0.15 m for a 0.9 m leg): on a stance foot that high he is in the air, and the pelvis height of Eq. 9 is
@@ -368,6 +378,8 @@ class MotionConfig:
             raise ConfigError("MotionConfig.recovery_step_behind_cos must be within [-1, 1] or None, "
                               f"got {self.recovery_step_behind_cos}")
         _non_negative("MotionConfig.reference_follows_operator_s", self.reference_follows_operator_s)
+        _non_negative("MotionConfig.path_feedback_share", self.path_feedback_share)
+        _non_negative("MotionConfig.path_feedback_max_m", self.path_feedback_max_m)
         for n in ("liftoff_weight_shift_s", "liftoff_after_stand_s", "liftoff_margin_m"):
             _non_negative(f"MotionConfig.{n}", getattr(self, n))
         if self.liftoff_shift_tolerance_m is not None:

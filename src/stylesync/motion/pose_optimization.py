@@ -48,6 +48,7 @@ from stylesync.motion.capture_bound import bounded_com_target, landing_catch_reg
 from stylesync.motion.double_stance_momentum import kept_com_velocity, moves_between_feet
 from stylesync.motion.leg_ik import solve_leg
 from stylesync.motion.operator_analysis import UPPER_JOINTS, OperatorAnalysis, analyse_operator, upper_local
+from stylesync.motion.path_feedback import PathReference
 from stylesync.motion.recovery_step import (
     RecoveryStepper,
     beyond_sole_towards_m,
@@ -246,6 +247,7 @@ class MotionOptimizer:
         self._ref_xy: np.ndarray | None = None  # (pelvis, COM) x (x, y) targets that follow the operator [m]
         self._swing: str | None = None
         self._feet_by_own_step = False  # the character's last step was its own (a recovery step), not one of his
+        self.path = PathReference(cfg.path_feedback_share, cfg.path_feedback_max_m)  # path_feedback.py
         self._swing_offset = np.zeros(2)  # lift-off foot position minus the first swing target, decaying [m]
         self._swing_t0_s = 0.0  # when the character's current swing began [s]
         self._liftoff_xy = np.zeros(2)  # where the current swing's foot lifted off [m]
@@ -503,6 +505,9 @@ class MotionOptimizer:
                 and self._capture_near_support(tick, state, keep_m)):
             com_vel_d = kept_com_velocity(com_vel_d, scale * tick.com_vel_h, tick.com_vel_c)
         tick.com_vel_d = com_vel_d
+        if self.path.enabled:
+            xi_c = com_c + tick.com_vel_c * np.sqrt(max(com_c[2], 0.1) / self.g)
+            self.path.update(state.root_pos_world, p_h, xi_c, self._operator_capture_point(tick), scale)
 
     def _capture_near_support(self, tick: _Tick, state: CharacterState, within_m: float) -> bool:
         """Whether the character's capture point is within ``within_m`` outside the support polygon of its soles on
@@ -621,7 +626,11 @@ class MotionOptimizer:
         soles he stands on (he balances on one leg, as in a kick, or he has stopped while the character's foot is
         still in the air)."""
         if tick.ch_state is Stance.DS:
-            return True
+            # Opt-out: not while he walks from one foot onto the other (his gait's capture point runs ahead of his
+            # front foot, and the character's, bounded within its soles, was braked at every double stance).
+            return (self.cfg.capture_bound_in_his_gait or tick.op_state is not Stance.DS
+                    or not moves_between_feet(tick.com_vel_h, tick.sample.support_ankle_world["left"],
+                                              tick.sample.support_ankle_world["right"]))
         sides = tuple(s for s in _SIDE_UP if tick.op_state is Stance.DS or swing_side(tick.op_state) != s)
         return self._operator_stands(tick, sides)
 
@@ -852,12 +861,18 @@ class MotionOptimizer:
                 land = R_root_d.T @ (scale * (a_h[side] - xi_h))
             start = (self._liftoff_xy if self._aim_at_his_landing
                      else (a_c[other] + scale * (a_h[side] - a_h[other]))[:2])
+            path_shift = np.zeros(2)
+            if self.path.enabled:
+                omega = float(np.sqrt(self.g / max(com_c[2], 0.1)))
+                path_shift = R_root_d.T[:2, :2] @ self.path.landing_shift_xy(omega, self._op_swing_s + self._op_ds_s)
+            land[0] += path_shift[0]  # following him over the ground (path_feedback.py), within the bounds below
             land[0] = min(land[0], -cfg.step_behind_capture_point_m)
             if self._aim_at_his_landing and cfg.step_behind_capture_point_max_m is not None:
                 land[0] = max(land[0], -cfg.step_behind_capture_point_max_m)
             out = 1.0 if side == "left" else -1.0
             land[1] = out * min(max(out * land[1], cfg.step_outside_capture_point_m[0]),
                                 cfg.step_outside_capture_point_m[1])
+            land[1] += path_shift[1]
             progress = smooth_step((state.time_s - self._swing_t0_s) / self._op_swing_s)
             landing = xi_c + R_root_d @ land
             if cfg.recovery_steps:

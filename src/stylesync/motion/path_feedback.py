@@ -1,0 +1,63 @@
+"""Following the operator over the ground by step placement.
+
+Eq. 10 retargets the operator's COM onto the character's own feet, and the swing lands relative to the character's
+capture point as his landed relative to his: every quantity is relative to the character's body, so a character
+that falls behind its operator stays behind. This module keeps the one global quantity that relates the two: the
+operator's path scaled onto the character's, from where both started (as the imitation metrics scale it,
+``metrics/imitation.scale_operator_to_character``).
+
+With the divergent component of motion (the capture point) of the linear inverted pendulum, ξ̇ = ω (ξ - p), and the
+operator's, scaled, ξ̇_ref = ω (ξ_ref - p_ref), the error δ = ξ - ξ_ref obeys δ̇ = ω (δ - (p - p_ref)). A landing
+placed relative to the character's capture point as his was relative to his (p - ξ = p_ref - ξ_ref at the landing)
+keeps δ over the stance that follows. Moved by k δ, the foot stays there for the step's time T while δ evolves:
+δ(T) = δ (1 - k (e^(ωT) - 1)). The step removes the share s = k (e^(ωT) - 1) of the error; s = 1 removes it in one
+step (deadbeat), s > 2 makes it grow with alternating sign. The gain is set as that share (Englsberger et al.'s DCM
+tracking, in its footstep form), k = s / (e^(ωT) - 1), T the operator's usual step (his swing and double stance).
+The correction is bounded: a character far behind catches up over several steps, not one.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+class PathReference:
+    """The operator's capture point scaled onto the character's path, and the landing correction it gives."""
+
+    def __init__(self, share: float, max_m: float):
+        self.share = share  # s, the share of the error a step removes [-]
+        self.max_m = max_m  # the correction's largest horizontal length [m]
+        self._char_origin_xy: np.ndarray | None = None  # the character's pelvis over the ground at the start [m]
+        self._op_origin_xy: np.ndarray | None = None  # the operator's [m]
+        self.error_xy = np.zeros(2)  # δ = ξ_c - ξ_ref of the last update, world frame [m]
+
+    @property
+    def enabled(self) -> bool:
+        return self.share > 0.0
+
+    def update(self, char_pelvis_world: np.ndarray, op_pelvis_world: np.ndarray, xi_c_world: np.ndarray,
+               xi_h_world: np.ndarray, scale: float) -> np.ndarray:
+        """δ = ξ_c - ξ_ref (2,) [m], world frame: the character's capture point ``xi_c_world`` against the
+        operator's ``xi_h_world`` scaled by ``scale`` about his first pelvis ground point, moved onto the
+        character's first pelvis ground point. The first call fixes both origins."""
+        if self._char_origin_xy is None or self._op_origin_xy is None:
+            self._char_origin_xy = np.asarray(char_pelvis_world, dtype=float)[:2].copy()
+            self._op_origin_xy = np.asarray(op_pelvis_world, dtype=float)[:2].copy()
+        xi_ref = self._char_origin_xy + scale * (np.asarray(xi_h_world, dtype=float)[:2] - self._op_origin_xy)
+        self.error_xy = np.asarray(xi_c_world, dtype=float)[:2] - xi_ref
+        return self.error_xy
+
+    def landing_shift_xy(self, omega_per_s: float, step_s: float) -> np.ndarray:
+        """k δ (2,) [m], world frame, k = share / (e^(ω T) - 1) for ``omega_per_s`` = ω [1/s] and ``step_s`` = T [s],
+        bounded to ``max_m``: what the landing moves by."""
+        shift = deadbeat_gain(omega_per_s, step_s) * self.share * self.error_xy
+        n = float(np.linalg.norm(shift))
+        return shift * (self.max_m / n) if n > self.max_m else shift
+
+
+def deadbeat_gain(omega_per_s: float, step_s: float) -> float:
+    """k = 1 / (e^(ω T) - 1) [-]: the landing shift per metre of capture-point error that removes the error
+    over one step of ``step_s`` = T [s] (ω = ``omega_per_s`` [1/s])."""
+    return 1.0 / max(math.expm1(omega_per_s * step_s), 1e-6)

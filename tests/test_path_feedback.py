@@ -1,0 +1,69 @@
+"""Following the operator over the ground by step placement (motion/path_feedback.py)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from stylesync.config import ConfigError, MotionConfig
+from stylesync.motion.path_feedback import PathReference, deadbeat_gain
+
+OMEGA = 3.4  # the character's pendulum at a 0.85 m COM height [1/s]
+STEP_S = 0.55  # a walking step: swing and double stance [s]
+
+
+def _stance(xi: float, p: float, t_s: float) -> float:
+    """The capture point after ``t_s`` on a foot at ``p`` (ξ̇ = ω (ξ - p)), along the walk [m]."""
+    return p + (xi - p) * math.exp(OMEGA * t_s)
+
+
+def test_the_reference_is_his_capture_point_scaled_about_both_starts():
+    path = PathReference(share=0.5, max_m=1.0)
+    # first tick: the character stands at (2, 1), he at (10, -3); both capture points over their pelvises
+    d = path.update(np.array([2.0, 1.0, 0.9]), np.array([10.0, -3.0, 1.0]), np.array([2.0, 1.0, 0.0]),
+                    np.array([10.0, -3.0, 0.0]), scale=0.8)
+    assert d == pytest.approx([0.0, 0.0])
+    # he has gone 1 m along x; scaled, 0.8 m; the character has gone 0.5 m: 0.3 m behind
+    d = path.update(np.array([9.0, 9.0, 0.9]), np.array([0.0, 0.0, 1.0]), np.array([2.5, 1.0, 0.0]),
+                    np.array([11.0, -3.0, 0.0]), scale=0.8)
+    assert d == pytest.approx([-0.3, 0.0])  # the origins stay those of the first tick
+
+
+@pytest.mark.parametrize("share", [0.0, 0.5, 1.0])
+def test_a_step_removes_the_share_of_the_error(share):
+    """A walker at steady pace (his landing 0.1 m behind his capture point, the pendulum's steady gait) and a
+    character 0.3 m behind him: over one step with the landing moved by the feedback, the error becomes
+    (1 - share) of what it was."""
+    land = -0.1  # his landing relative to his capture point [m]
+    xi_ref, xi_c = 1.0, 0.7
+    path = PathReference(share=share, max_m=1.0)
+    path.update(np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), scale=1.0)  # both start at the origin
+    delta = path.update(np.zeros(3), np.zeros(3), np.array([xi_c, 0.0, 0.0]), np.array([xi_ref, 0.0, 0.0]), 1.0)
+    shift = path.landing_shift_xy(OMEGA, STEP_S)
+    p_ref, p_c = xi_ref + land, xi_c + land + shift[0]
+    after = _stance(xi_c, p_c, STEP_S) - _stance(xi_ref, p_ref, STEP_S)
+    assert after == pytest.approx((1.0 - share) * delta[0], abs=1e-9)
+    assert shift[1] == 0.0
+
+
+def test_the_gain_is_the_pendulums_deadbeat_gain():
+    assert deadbeat_gain(OMEGA, STEP_S) == pytest.approx(1.0 / (math.exp(OMEGA * STEP_S) - 1.0))
+    assert deadbeat_gain(OMEGA, 0.0) > 1e5  # no step time: no finite landing removes the error
+
+
+def test_the_landing_shift_is_bounded():
+    path = PathReference(share=1.0, max_m=0.15)
+    path.update(np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), scale=1.0)
+    path.update(np.zeros(3), np.zeros(3), np.array([-3.0, 4.0, 0.0]), np.zeros(3), scale=1.0)
+    shift = path.landing_shift_xy(OMEGA, STEP_S)
+    assert np.linalg.norm(shift) == pytest.approx(0.15)
+    assert shift / np.linalg.norm(shift) == pytest.approx([-0.6, 0.8])  # along the error: behind, it lands behind
+
+
+def test_off_by_default_and_validated():
+    assert MotionConfig().path_feedback_share == 0.0
+    assert not PathReference(MotionConfig().path_feedback_share, 0.2).enabled
+    with pytest.raises(ConfigError, match="path_feedback_share"):
+        MotionConfig(path_feedback_share=-0.1)
