@@ -127,6 +127,19 @@ def test_a_capture_point_beyond_the_left_foot_lifts_the_right_foot_and_lands_it_
     assert stepper.trigger(1.4 + 1.5 * wait_s, com, vel, ANKLES, QUATS, ["left", "right"]) is not None
 
 
+def test_a_step_that_walks_on_lands_behind_the_capture_point():
+    """MotionConfig.recovery_walk_on_m: the ankle that far behind the capture point at the landing, along its
+    divergence from the stance sole, where a step that stops the body puts the sole's trailing edge on it."""
+    stepper = RecoveryStepper(traced_motion(), CHAR_LEG_LENGTH_M, G)
+    com, vel = np.array([0.1, 0.1, 0.8]), np.array([0.6, 0.0, 0.0])  # walking forwards over the left foot
+    stop, xi_land = stepper.capture_landing(0.2, com, vel, ANKLES["left"], IDENTITY, np.eye(3), "right")
+    walk, xi_walk = stepper.capture_landing(0.2, com, vel, ANKLES["left"], IDENTITY, np.eye(3), "right", 0.1)
+    assert xi_walk == pytest.approx(xi_land)
+    assert walk[0] == pytest.approx(xi_land[0] - 0.1, abs=1e-9)  # the ankle 0.1 m behind the capture point
+    assert stop[0] > xi_land[0]  # the stopping step's ankle beyond it (the sole's trailing edge on it)
+    assert walk[1] == pytest.approx(stop[1])  # sideways, the same clearance from the stance foot
+
+
 def test_a_foot_in_the_air_that_a_step_would_take_back_from_the_capture_point_is_left_to_land():
     # A stride (CMU-dev 07_01 started at its speed, traced): the left foot 0.7 m ahead of the right, just landed and
     # bounced (not on the ground), the body moving forward over it at 1.3 m/s. Its step, within reach of the right

@@ -14,7 +14,15 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from stylesync import cli_args as typed
-from stylesync.config import SHARED_DIR, VIEWER_DRAW_HZ, ClockConfig, ControlConfig, OperatorConfig, SessionConfig
+from stylesync.config import (
+    SHARED_DIR,
+    VIEWER_DRAW_HZ,
+    ClockConfig,
+    ControlConfig,
+    OperatorConfig,
+    SessionConfig,
+    follow_path,
+)
 from stylesync.errors import ConfigError, SourceError, StylesyncError
 from stylesync.files import write_atomically
 
@@ -157,8 +165,11 @@ def _demo(args: argparse.Namespace) -> int:
     cfg = SessionConfig(duration_s=args.duration, seed=args.seed, gui=args.gui,
                         realtime=args.realtime or args.viewer != "none", operator=OperatorConfig(clip=args.clip),
                         control=ControlConfig(lipm_time_sync=not args.no_lipm))
+    if args.follow_path:
+        cfg = follow_path(cfg)
     source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
-    return _run_session(cfg, source, Path(args.out), {"clip": args.clip, "lipm_time_sync": not args.no_lipm}, args)
+    return _run_session(cfg, source, Path(args.out), {"clip": args.clip, "lipm_time_sync": not args.no_lipm,
+                                                      "follow_path": args.follow_path}, args)
 
 
 def _open(args: argparse.Namespace, clocks: ClockConfig, duration_s: float | None):
@@ -183,8 +194,11 @@ def _run(args: argparse.Namespace) -> int:
                         realtime=args.realtime or live or args.viewer != "none",
                         clocks=dataclasses.replace(clocks, mocap_hz=opened.mocap_hz),
                         control=ControlConfig(lipm_time_sync=not args.no_lipm))
+    if args.follow_path:
+        cfg = follow_path(cfg)
     return _run_session(cfg, opened.source, Path(args.out), {"source": args.source, "sensor": opened.sensor,
                                                               "lipm_time_sync": not args.no_lipm,
+                                                              "follow_path": args.follow_path,
                                                               **opened.extras}, args)
 
 
@@ -286,6 +300,9 @@ def _add_session_args(p: argparse.ArgumentParser, out_default: str, realtime_hel
     p.add_argument("--gui", action="store_true", help="open the PyBullet window")
     p.add_argument("--realtime", action="store_true", help=realtime_help)
     p.add_argument("--no-lipm", action="store_true", help="switch the LIPM time-sync compensation off (Eq. 21-23)")
+    p.add_argument("--follow-path", action="store_true",
+                   help="keep to the operator's path over the ground (a recording starts at its speed); "
+                        "falls more often (README, status)")
     p.add_argument("--record", type=typed.out_file, help="session file to write (default: OUT/session.jsonl)")
     p.add_argument("--progress", action="store_true", help="show a progress line (default: when on a terminal)")
     p.add_argument("--continue-after-fall", action="store_true",

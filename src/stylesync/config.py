@@ -9,6 +9,7 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from stylesync.errors import ConfigError
 
@@ -316,6 +317,10 @@ class MotionConfig:
     # (capture_bound_sole_share); False: not while the operator walks from one foot onto the other
     # (double_stance_momentum.moves_between_feet), whose capture point runs ahead of his front foot.
     capture_bound_in_his_gait: bool = True
+    # While the operator walks (his capture point outside his soles), a recovery step lands with the capture point
+    # this far ahead of its ankle instead of on its sole's trailing edge: a step that walks on with him rather than
+    # one that stops the body (recovery_step.capture_landing). None: every recovery step stops it [m].
+    recovery_walk_on_m: float | None = None
     # Following the operator over the ground (motion/path_feedback.py): the swing's landing relative to the
     # character's capture point is moved so that a step removes this share of the capture point's error from his,
     # scaled onto the character's path from where both started (the divergent component of motion: 1 removes it
@@ -582,6 +587,24 @@ class SessionConfig:
 
     def replace(self, **changes) -> SessionConfig:
         return dataclasses.replace(self, **changes)
+
+
+# The opt-ins that keep the character to its operator's path over the ground, at a cost in falls
+# (docs/decisions.md, "Following the operator's path by the landing"): `--follow-path`.
+FOLLOW_PATH_MOTION: dict[str, Any] = {
+    "double_stance_keeps_momentum_m": 0.1,  # a gait's double stance does not brake it
+    "capture_bound_in_his_gait": False,  # nor does the capture bound while he walks
+    "reference_follows_operator_s": 0.5,  # the targets go on at his speed
+    "path_feedback_share": 0.5,  # each landing takes up half the path's error
+    "recovery_walk_on_m": 0.1,  # its own steps walk on while he walks
+}
+
+
+def follow_path(cfg: SessionConfig) -> SessionConfig:
+    """``cfg`` with FOLLOW_PATH_MOTION and a recording's start at its own velocities
+    (OperatorConfig.start_with_clip_velocity)."""
+    return cfg.replace(motion=dataclasses.replace(cfg.motion, **FOLLOW_PATH_MOTION),
+                       operator=dataclasses.replace(cfg.operator, start_with_clip_velocity=True))
 
 
 def pid_group(joint_name: str) -> str:

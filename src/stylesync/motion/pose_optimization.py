@@ -550,9 +550,12 @@ class MotionOptimizer:
                 other = _OTHER_SIDE[side]
                 com_vel = (mass.com_velocity_carried(state, LEG_LINKS[side], _ROOT_LINK)
                            if self.cfg.recovery_landing_without_swing else tick.com_vel_c)
+                walk_on = self.cfg.recovery_walk_on_m
+                if walk_on is not None and self._operator_stands(tick):
+                    walk_on = None  # he stands: the step stops the body
                 tick.targets[side] = self.recovery.swing_target(
                     state.time_s, tick.com_c, com_vel, tick.a_c[other],
-                    state.link_quat_wxyz[_LINK[f"{other}_ankle"]], tick.R_root_d)
+                    state.link_quat_wxyz[_LINK[f"{other}_ankle"]], tick.R_root_d, walk_on)
                 tick.foot_yaw[side] = (float(np.arctan2(tick.R_root_d[1, 0], tick.R_root_d[0, 0]))
                                        if self.cfg.foot_yaw_control  # along the heading, as its landing is planned
                                        else rot.twist_angle(state.link_quat_wxyz[_LINK[f"{side}_ankle"]], _UP))

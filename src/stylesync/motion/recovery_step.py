@@ -317,10 +317,11 @@ class RecoveryStepper:
 
     def capture_landing(self, remaining_s: float, com_world: np.ndarray, com_vel_world: np.ndarray,
                         stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray, heading_world: np.ndarray,
-                        side: str) -> tuple[np.ndarray, np.ndarray]:
+                        side: str, walk_on_m: float | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Where the ``side`` ankle lands (3,) so that the capture point, ``remaining_s`` from now, is on the
         trailing edge of its sole (within reach, across the stance foot only as a crossover step), and that capture
-        point (2,) [m].
+        point (2,) [m]. With ``walk_on_m``, instead, the capture point that far ahead of the ankle, along its
+        direction of divergence: a step that walks on, as a gait's lands behind its capture point [m].
         ``heading_world``: (3, 3) the heading frame's rotation (x forward, y left)."""
         xi, omega = capture_point(com_world, com_vel_world, self.g)
         _, cop = outside_distance_m(xi, convex_hull_xy(sole_corners_world(stance_ankle_world,
@@ -336,6 +337,8 @@ class RecoveryStepper:
         half_extent = abs(u_heading[0]) * FOOT_LENGTH_M / 2 + abs(u_heading[1]) * FOOT_WIDTH_M / 2
         centre = np.array([xi_land[0], xi_land[1], 0.0]) + half_extent * u
         ankle = centre - R @ np.array([FOOT_CENTER_AHEAD_OF_ANKLE_M, 0.0, 0.0])
+        if walk_on_m is not None:
+            ankle = np.array([xi_land[0], xi_land[1], 0.0]) - walk_on_m * u
         # Within reach, and across the stance foot only as a crossover step (relative to the stance ankle, in the
         # stance sole's own yaw frame or the heading frame).
         base = np.array([stance_ankle_world[0], stance_ankle_world[1], 0.0])
@@ -353,14 +356,16 @@ class RecoveryStepper:
 
     def swing_target(self, time_s: float, com_world: np.ndarray, com_vel_world: np.ndarray,
                      stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray,
-                     heading_world: np.ndarray) -> np.ndarray:
-        """(3,) this tick's target of the swing ankle [m]; the landing re-planned on the capture point.
+                     heading_world: np.ndarray, walk_on_m: float | None = None) -> np.ndarray:
+        """(3,) this tick's target of the swing ankle [m]; the landing re-planned on the capture point (``walk_on_m``:
+        :meth:`capture_landing`).
         ``heading_world``: (3, 3) the heading frame's rotation (x forward, y left)."""
         step, cfg = self.step, self.cfg
         assert step is not None
         elapsed = time_s - step.start_s
         landing, _ = self.capture_landing(max(cfg.recovery_swing_s - elapsed, 0.0), com_world, com_vel_world,
-                                          stance_ankle_world, stance_foot_quat_wxyz, heading_world, step.side)
+                                          stance_ankle_world, stance_foot_quat_wxyz, heading_world, step.side,
+                                          walk_on_m)
         step.landing_world = landing
         phase = elapsed / cfg.recovery_swing_s
         moved = smooth_step(min(phase / HORIZONTAL_SHARE, 1.0))
