@@ -119,3 +119,16 @@ def test_a_report_on_a_damaged_folder_is_written_and_says_so(tmp_path, capsys, m
     assert cli_main(["report", str(tmp_path)]) == 0
     text = (tmp_path / "report.html").read_text()
     assert metrics == "{}" or "not readable as JSON" in text or "not a JSON object" in text
+
+
+def test_follow_path_is_taken_and_recorded(tmp_path, capsys):
+    from stylesync.config import FOLLOW_PATH_MOTION
+    from stylesync.export.session_file import read_session
+
+    assert cli_main(["demo", "--follow-path", "--duration", "0.2", "--out", str(tmp_path / "fp")]) == 0
+    assert cli_main(["demo", "--duration", "0.2", "--out", str(tmp_path / "plain")]) == 0
+    follow = read_session(tmp_path / "fp" / "session.jsonl").header["config"]
+    plain = read_session(tmp_path / "plain" / "session.jsonl").header["config"]
+    assert follow["operator"]["start_with_clip_velocity"] and not plain["operator"]["start_with_clip_velocity"]
+    for name, value in FOLLOW_PATH_MOTION.items():
+        assert follow["motion"][name] == value != plain["motion"][name]
