@@ -23,11 +23,11 @@ def test_the_reference_is_his_capture_point_scaled_about_both_starts():
     path = PathReference(share=0.5, max_m=1.0)
     # first tick: the character stands at (2, 1), he at (10, -3); both capture points over their pelvises
     d = path.update(np.array([2.0, 1.0, 0.9]), np.array([10.0, -3.0, 1.0]), np.array([2.0, 1.0, 0.0]),
-                    np.array([10.0, -3.0, 0.0]), scale=0.8)
+                    np.array([10.0, -3.0, 0.0]), scale=0.8, omega_per_s=OMEGA)
     assert d == pytest.approx([0.0, 0.0])
     # he has gone 1 m along x; scaled, 0.8 m; the character has gone 0.5 m: 0.3 m behind
     d = path.update(np.array([9.0, 9.0, 0.9]), np.array([0.0, 0.0, 1.0]), np.array([2.5, 1.0, 0.0]),
-                    np.array([11.0, -3.0, 0.0]), scale=0.8)
+                    np.array([11.0, -3.0, 0.0]), scale=0.8, omega_per_s=OMEGA)
     assert d == pytest.approx([-0.3, 0.0])  # the origins stay those of the first tick
 
 
@@ -39,9 +39,10 @@ def test_a_step_removes_the_share_of_the_error(share):
     land = -0.1  # his landing relative to his capture point [m]
     xi_ref, xi_c = 1.0, 0.7
     path = PathReference(share=share, max_m=1.0)
-    path.update(np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), scale=1.0)  # both start at the origin
-    delta = path.update(np.zeros(3), np.zeros(3), np.array([xi_c, 0.0, 0.0]), np.array([xi_ref, 0.0, 0.0]), 1.0)
-    shift = path.landing_shift_xy(OMEGA, STEP_S)
+    # both start at the origin
+    path.update(np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), scale=1.0, omega_per_s=OMEGA)
+    delta = path.update(np.zeros(3), np.zeros(3), np.array([xi_c, 0.0, 0.0]), np.array([xi_ref, 0.0, 0.0]), 1.0, OMEGA)
+    shift = path.landing_shift_xy(STEP_S)
     p_ref, p_c = xi_ref + land, xi_c + land + shift[0]
     after = _stance(xi_c, p_c, STEP_S) - _stance(xi_ref, p_ref, STEP_S)
     assert after == pytest.approx((1.0 - share) * delta[0], abs=1e-9)
@@ -55,9 +56,9 @@ def test_the_gain_is_the_pendulums_deadbeat_gain():
 
 def test_the_landing_shift_is_bounded():
     path = PathReference(share=1.0, max_m=0.15)
-    path.update(np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), scale=1.0)
-    path.update(np.zeros(3), np.zeros(3), np.array([-3.0, 4.0, 0.0]), np.zeros(3), scale=1.0)
-    shift = path.landing_shift_xy(OMEGA, STEP_S)
+    path.update(np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), scale=1.0, omega_per_s=OMEGA)
+    path.update(np.zeros(3), np.zeros(3), np.array([-3.0, 4.0, 0.0]), np.zeros(3), scale=1.0, omega_per_s=OMEGA)
+    shift = path.landing_shift_xy(STEP_S)
     assert np.linalg.norm(shift) == pytest.approx(0.15)
     assert shift / np.linalg.norm(shift) == pytest.approx([-0.6, 0.8])  # along the error: behind, it lands behind
 

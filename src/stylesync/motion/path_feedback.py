@@ -32,16 +32,19 @@ class PathReference:
         self._char_origin_xy: np.ndarray | None = None  # the character's pelvis over the ground at the start [m]
         self._op_origin_xy: np.ndarray | None = None  # the operator's [m]
         self.error_xy = np.zeros(2)  # δ = ξ_c - ξ_ref of the last update, world frame [m]
+        self.omega_per_s = 1.0  # ω of the character's pendulum at the last update [1/s]
 
     @property
     def enabled(self) -> bool:
         return self.share > 0.0
 
     def update(self, char_pelvis_world: np.ndarray, op_pelvis_world: np.ndarray, xi_c_world: np.ndarray,
-               xi_h_world: np.ndarray, scale: float) -> np.ndarray:
+               xi_h_world: np.ndarray, scale: float, omega_per_s: float) -> np.ndarray:
         """δ = ξ_c - ξ_ref (2,) [m], world frame: the character's capture point ``xi_c_world`` against the
         operator's ``xi_h_world`` scaled by ``scale`` about his first pelvis ground point, moved onto the
-        character's first pelvis ground point. The first call fixes both origins."""
+        character's first pelvis ground point; ``omega_per_s``: the character's ω [1/s]. The first call fixes both
+        origins."""
+        self.omega_per_s = omega_per_s
         if self._char_origin_xy is None or self._op_origin_xy is None:
             self._char_origin_xy = np.asarray(char_pelvis_world, dtype=float)[:2].copy()
             self._op_origin_xy = np.asarray(op_pelvis_world, dtype=float)[:2].copy()
@@ -49,10 +52,10 @@ class PathReference:
         self.error_xy = np.asarray(xi_c_world, dtype=float)[:2] - xi_ref
         return self.error_xy
 
-    def landing_shift_xy(self, omega_per_s: float, step_s: float) -> np.ndarray:
-        """k δ (2,) [m], world frame, k = share / (e^(ω T) - 1) for ``omega_per_s`` = ω [1/s] and ``step_s`` = T [s],
+    def landing_shift_xy(self, step_s: float) -> np.ndarray:
+        """k δ (2,) [m], world frame, k = share / (e^(ω T) - 1) for the last update's ω and ``step_s`` = T [s],
         bounded to ``max_m``: what the landing moves by."""
-        shift = deadbeat_gain(omega_per_s, step_s) * self.share * self.error_xy
+        shift = deadbeat_gain(self.omega_per_s, step_s) * self.share * self.error_xy
         n = float(np.linalg.norm(shift))
         return shift * (self.max_m / n) if n > self.max_m else shift
 

@@ -510,8 +510,8 @@ class MotionOptimizer:
             com_vel_d = kept_com_velocity(com_vel_d, scale * tick.com_vel_h, tick.com_vel_c)
         tick.com_vel_d = com_vel_d
         if self.path.enabled:
-            xi_c = com_c + tick.com_vel_c * np.sqrt(max(com_c[2], 0.1) / self.g)
-            self.path.update(state.root_pos_world, p_h, xi_c, self._operator_capture_point(tick), scale)
+            xi_c, omega = capture_point(com_c, tick.com_vel_c, self.g)
+            self.path.update(state.root_pos_world, p_h, xi_c, self._operator_capture_point(tick), scale, omega)
 
     def _capture_near_support(self, tick: _Tick, state: CharacterState, within_m: float) -> bool:
         """Whether the character's capture point is within ``within_m`` outside the support polygon of its soles on
@@ -870,8 +870,7 @@ class MotionOptimizer:
                      else (a_c[other] + scale * (a_h[side] - a_h[other]))[:2])
             path_shift = np.zeros(2)
             if self.path.enabled:
-                omega = float(np.sqrt(self.g / max(com_c[2], 0.1)))
-                path_shift = R_root_d.T[:2, :2] @ self.path.landing_shift_xy(omega, self._op_swing_s + self._op_ds_s)
+                path_shift = R_root_d.T[:2, :2] @ self.path.landing_shift_xy(self._op_swing_s + self._op_ds_s)
             land[0] += path_shift[0]  # following him over the ground (path_feedback.py), within the bounds below
             land[0] = min(land[0], -cfg.step_behind_capture_point_m)
             if self._aim_at_his_landing and cfg.step_behind_capture_point_max_m is not None:

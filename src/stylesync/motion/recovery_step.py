@@ -328,17 +328,18 @@ class RecoveryStepper:
                                                                           stance_foot_quat_wxyz)[:, :2]))
         xi_land = cop + (xi - cop) * np.exp(omega * remaining_s)
         R = heading_world
-        # The sole's centre beyond ξ along its direction of divergence u by the sole's half-extent along u: ξ lands
-        # on the sole's trailing edge, and every centre of pressure on the sole then drives it back.
         away = xi - cop
         norm = float(np.linalg.norm(away))
-        u = np.array([*(away / norm), 0.0]) if norm > 1e-6 else np.zeros(3)
-        u_heading = R.T @ u
-        half_extent = abs(u_heading[0]) * FOOT_LENGTH_M / 2 + abs(u_heading[1]) * FOOT_WIDTH_M / 2
-        centre = np.array([xi_land[0], xi_land[1], 0.0]) + half_extent * u
-        ankle = centre - R @ np.array([FOOT_CENTER_AHEAD_OF_ANKLE_M, 0.0, 0.0])
+        u = np.array([*(away / norm), 0.0]) if norm > 1e-6 else np.zeros(3)  # ξ's direction of divergence
         if walk_on_m is not None:
             ankle = np.array([xi_land[0], xi_land[1], 0.0]) - walk_on_m * u
+        else:
+            # The sole's centre beyond ξ along u by the sole's half-extent along u: ξ lands on the sole's trailing
+            # edge, and every centre of pressure on the sole then drives it back.
+            u_heading = R.T @ u
+            half_extent = abs(u_heading[0]) * FOOT_LENGTH_M / 2 + abs(u_heading[1]) * FOOT_WIDTH_M / 2
+            centre = np.array([xi_land[0], xi_land[1], 0.0]) + half_extent * u
+            ankle = centre - R @ np.array([FOOT_CENTER_AHEAD_OF_ANKLE_M, 0.0, 0.0])
         # Within reach, and across the stance foot only as a crossover step (relative to the stance ankle, in the
         # stance sole's own yaw frame or the heading frame).
         base = np.array([stance_ankle_world[0], stance_ankle_world[1], 0.0])
