@@ -132,3 +132,12 @@ def test_follow_path_is_taken_and_recorded(tmp_path, capsys):
     assert follow["operator"]["start_with_clip_velocity"] and not plain["operator"]["start_with_clip_velocity"]
     for name, value in FOLLOW_PATH_MOTION.items():
         assert follow["motion"][name] == value != plain["motion"][name]
+
+
+def test_free_swing_is_taken_and_recorded(tmp_path, capsys):
+    from stylesync.export.session_file import read_session
+
+    assert cli_main(["demo", "--free-swing", "--duration", "0.2", "--out", str(tmp_path / "fs")]) == 0
+    assert cli_main(["demo", "--duration", "0.2", "--out", str(tmp_path / "plain")]) == 0
+    assert read_session(tmp_path / "fs" / "session.jsonl").header["config"]["motion"]["free_swing"] is True
+    assert read_session(tmp_path / "plain" / "session.jsonl").header["config"]["motion"]["free_swing"] is False

@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from stylesync.config import JacobianTransposeConfig, PidGains
+from stylesync.config import JacobianTransposeConfig, MotionConfig, PidGains
 from stylesync.experiments import kick, push, squat_jump, tune
-from stylesync.experiments.scripted_operator import sagittal_leg, standing_ankles
+from stylesync.experiments.scripted_operator import pose_frame, sagittal_leg, standing_ankles
 from stylesync.sources.deepmimic_clip import DeepMimicClip
 from stylesync.sources.frame import JOINT_INDEX
 from stylesync.sources.human_model import HumanModel
@@ -49,6 +49,43 @@ def test_squat_lowers_the_pelvis_with_feet_planted():
         assert np.allclose(got[[0, 2]], ankle[[0, 2]], atol=1e-6)
 
 
+def test_a_pelvis_shifted_sideways_rolls_the_legs_and_keeps_the_feet_planted_and_level():
+    human = HumanModel(1.75)
+    ankles = standing_ankles(human)
+    for shift in (0.0, 0.09, -0.05):
+        frame = pose_frame(human, 0.0, np.array([0.0, shift, human.hip_height_m - 0.02]), ankles)
+        for side, ankle in ankles.items():
+            S = side.upper()
+            got = frame.joint_pos_world[JOINT_INDEX[f"ANKLE_{S}"]]
+            assert np.allclose(got, ankle, atol=2e-4)  # the knee stops 1e-6 short of straight
+            toe = frame.joint_pos_world[JOINT_INDEX[f"FOOT_{S}"]]
+            assert toe[1] == pytest.approx(got[1], abs=1e-9)  # the foot points forward ...
+            assert toe[2] == pytest.approx(frame.joint_pos_world[JOINT_INDEX["FOOT_LEFT"]][2], abs=1e-9)  # level
+
+
+def test_the_scripted_kick_shifts_the_weight_then_strikes_forward_and_comes_back():
+    human = HumanModel(1.75)
+    frame_at = kick.kick_performer(human)
+    a, p = JOINT_INDEX["ANKLE_RIGHT"], JOINT_INDEX["PELVIS"]
+    lift = kick.KICK_START_S + kick.SHIFT_S
+    stand, shifted = frame_at(0.5), frame_at(lift)
+    assert shifted.joint_pos_world[p][1] - stand.joint_pos_world[p][1] == pytest.approx(kick.SHIFT_M, abs=1e-9)
+    assert np.allclose(shifted.joint_pos_world[a], stand.joint_pos_world[a], atol=2e-4)  # not lifted yet
+    struck = frame_at(lift + kick.DRAW_S + kick.STRIKE_S).joint_pos_world[a] - stand.joint_pos_world[a]
+    assert struck[0] == pytest.approx(kick.STRIKE_AHEAD_M, abs=2e-4)
+    assert struck[2] == pytest.approx(kick.STRIKE_UP_M, abs=2e-4)
+    end = frame_at(lift + kick.DRAW_S + kick.STRIKE_S + kick.RETURN_S + kick.SHIFT_S)
+    assert np.allclose(end.joint_pos_world[a], stand.joint_pos_world[a], atol=2e-4)
+    assert np.allclose(end.joint_pos_world[p], stand.joint_pos_world[p], atol=1e-9)
+    # the ball: in front of his toe at the strike, scaled to the character: clear of his standing toe (and so of
+    # the smaller character's), in line with the right foot
+    ball = kick.ball_position(frame_at, human, 0.0, kick.KICK_START_S + kick.KICK_AFTER_S, "FOOT_RIGHT")
+    toe0 = stand.joint_pos_world[JOINT_INDEX["FOOT_RIGHT"]]
+    assert ball[0] - kick.BALL_RADIUS_M > toe0[0] + 0.05
+    assert abs(ball[1] - toe0[1]) < 0.02
+    assert ball[2] == kick.BALL_RADIUS_M
+
+
 def test_tuning_ramp_error_falls_with_stiffer_gains():
     clip = DeepMimicClip.builtin("walk")
     slope, height, axis = tune.ramp_spec(clip, "knee")
@@ -68,3 +105,17 @@ def test_the_kick_claim_needs_the_walk_to_reach_the_ball_and_the_kick_to_move_it
     assert not kick.claim_holds({"walk-to-ball": walk, "kick": {**kicked, "kicked": False}})
     assert not kick.claim_holds({"walk-to-ball": {**walk, "fell": True}, "kick": kicked})
     assert not kick.claim_holds({"walk-to-ball": walk, "kick": {**kicked, "fell": True}})
+
+
+def test_a_free_swing_carries_the_kicks_strike_to_the_ball():
+    """The scripted kick from standing, seed 1 (`stylesync experiment kick`'s "kick"): with the free swing, the
+    swing foot follows his relative to the stance foot while both stand balanced on it, strikes forward and moves
+    the ball, with no fall. Without it the swing goes from its lift-off to its landing, which for a kick in place
+    is where it lifted off: the foot only rises and comes down, and never reaches the ball."""
+    reach = {}
+    for free in (False, True):
+        _, m, _ = kick.run_one("kick", 1, MotionConfig(free_swing=free))
+        reach[free] = m
+    assert not reach[True]["fell"] and reach[True]["kicked"]
+    assert reach[True]["closest_foot_m"] < 0.1
+    assert not reach[False]["kicked"] and reach[False]["closest_foot_m"] > 0.25

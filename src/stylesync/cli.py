@@ -165,11 +165,20 @@ def _demo(args: argparse.Namespace) -> int:
     cfg = SessionConfig(duration_s=args.duration, seed=args.seed, gui=args.gui,
                         realtime=args.realtime or args.viewer != "none", operator=OperatorConfig(clip=args.clip),
                         control=ControlConfig(lipm_time_sync=not args.no_lipm))
-    if args.follow_path:
-        cfg = follow_path(cfg)
+    cfg = _motion_options(cfg, args)
     source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
     return _run_session(cfg, source, Path(args.out), {"clip": args.clip, "lipm_time_sync": not args.no_lipm,
-                                                      "follow_path": args.follow_path}, args)
+                                                      "follow_path": args.follow_path,
+                                                      "free_swing": args.free_swing}, args)
+
+
+def _motion_options(cfg: SessionConfig, args: argparse.Namespace) -> SessionConfig:
+    """``cfg`` with the motion stage's opt-ins asked for on the command line (--follow-path, --free-swing)."""
+    if args.follow_path:
+        cfg = follow_path(cfg)
+    if args.free_swing:
+        cfg = cfg.replace(motion=dataclasses.replace(cfg.motion, free_swing=True))
+    return cfg
 
 
 def _open(args: argparse.Namespace, clocks: ClockConfig, duration_s: float | None):
@@ -194,11 +203,11 @@ def _run(args: argparse.Namespace) -> int:
                         realtime=args.realtime or live or args.viewer != "none",
                         clocks=dataclasses.replace(clocks, mocap_hz=opened.mocap_hz),
                         control=ControlConfig(lipm_time_sync=not args.no_lipm))
-    if args.follow_path:
-        cfg = follow_path(cfg)
+    cfg = _motion_options(cfg, args)
     return _run_session(cfg, opened.source, Path(args.out), {"source": args.source, "sensor": opened.sensor,
                                                               "lipm_time_sync": not args.no_lipm,
                                                               "follow_path": args.follow_path,
+                                                              "free_swing": args.free_swing,
                                                               **opened.extras}, args)
 
 
@@ -303,6 +312,9 @@ def _add_session_args(p: argparse.ArgumentParser, out_default: str, realtime_hel
     p.add_argument("--follow-path", action="store_true",
                    help="keep to the operator's path over the ground (a recording starts at its speed); "
                         "falls more often (README, status)")
+    p.add_argument("--free-swing", action="store_true",
+                   help="a swing foot follows the operator's while both stand balanced on the other foot (a kick "
+                        "strikes); by default every swing goes to a landing placed for balance")
     p.add_argument("--record", type=typed.out_file, help="session file to write (default: OUT/session.jsonl)")
     p.add_argument("--progress", action="store_true", help="show a progress line (default: when on a terminal)")
     p.add_argument("--continue-after-fall", action="store_true",

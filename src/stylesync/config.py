@@ -185,6 +185,11 @@ class MotionConfig:
     # and this far outside it, sideways (min, max): a foot further out throws the body back harder than the
     # next step can catch, and the sway grows from step to step [m]
     step_outside_capture_point_m: tuple[float, float] = (0.0, 0.04)
+    # With "capture_point", a swing that neither he nor the character needs to land (his capture point within the
+    # sole he stands on, the character's within its own: a kick, a raised leg) follows his foot relative to the
+    # stance foot, scaled, instead of going to the landing: the strike of a kick is his style (off: every swing goes
+    # from its lift-off to its landing, and a kick only lifts the foot and puts it down).
+    free_swing: bool = False
     # Recovery steps (motion/recovery_step.py): while the operator stands, the character steps on its own when its
     # capture point is further than the margin outside the support polygon of its soles [m]; the step's nominal
     # swing time [s] and height [m]; the double stance kept after one before another, and the time the operator

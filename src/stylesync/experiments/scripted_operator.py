@@ -15,6 +15,7 @@ from stylesync import rotations as rot
 from stylesync.sources.frame import OperatorFrame
 from stylesync.sources.human_model import HumanModel
 
+_X = np.array([1.0, 0.0, 0.0])
 _Y = np.array([0.0, 1.0, 0.0])
 
 
@@ -32,20 +33,34 @@ def sagittal_leg(human: HumanModel, ankle_rel_hip_m: np.ndarray) -> dict[str, fl
 
 def pose_frame(human: HumanModel, t_s: float, pelvis_world: np.ndarray, ankles_world: dict[str, np.ndarray],
                extra: dict[str, np.ndarray] | None = None) -> OperatorFrame:
-    """A frame with the pelvis at ``pelvis_world`` (facing +x) and each ankle at ``ankles_world[side]`` (its
-    lateral offset is the hip's), plus any other canonical joint rotations in ``extra``."""
+    """A frame with the pelvis at ``pelvis_world`` (facing +x) and each ankle at ``ankles_world[side]``, plus any
+    other canonical joint rotations in ``extra``. Each leg is rolled about the forward axis at the hip (and back
+    at the ankle, the foot level) so that its ankle is at its lateral position, then bent in the rolled plane by
+    `sagittal_leg`; an ankle straight below its hip has no roll."""
     quats: dict[str, np.ndarray] = {"PELVIS": rot.IDENTITY_WXYZ}
+    hip_half_width = _hip_half_width(human)
     for side in ("left", "right"):
         rel = ankles_world[side] - pelvis_world
-        leg = sagittal_leg(human, np.array([rel[0], rel[2]]))
+        dy = float(rel[1]) - (hip_half_width if side == "left" else -hip_half_width)  # ankle left of its hip [m]
+        roll = float(np.arctan2(dy, -float(rel[2])))  # + puts the ankle to the left [rad]
+        leg = sagittal_leg(human, np.array([rel[0], -np.hypot(dy, rel[2]) if dy else rel[2]]))
         S = side.upper()
-        quats[f"HIP_{S}"] = rot.quat_from_rotvec(_Y * leg["hip"])
+        hip, ankle = rot.quat_from_rotvec(_Y * leg["hip"]), rot.quat_from_rotvec(_Y * leg["ankle"])
+        if dy:
+            hip = rot.multiply(rot.quat_from_rotvec(_X * roll), hip)
+            ankle = rot.multiply(ankle, rot.quat_from_rotvec(_X * -roll))
+        quats[f"HIP_{S}"] = hip
         quats[f"KNEE_{S}"] = rot.quat_from_rotvec(_Y * leg["knee"])
-        quats[f"ANKLE_{S}"] = rot.quat_from_rotvec(_Y * leg["ankle"])
+        quats[f"ANKLE_{S}"] = ankle
     quats.update(extra or {})
     return human.frame_from_pose(t_s, pelvis_world, quats)
 
 
+def _hip_half_width(human: HumanModel) -> float:
+    """Lateral offset of the left hip from the pelvis [m] (the right one's is its negative)."""
+    return float(next(s for s in human.segments if s.name == "thigh_left").offset_in_parent[1])
+
+
 def standing_ankles(human: HumanModel) -> dict[str, np.ndarray]:
-    hw = float(next(s for s in human.segments if s.name == "thigh_left").offset_in_parent[1])  # hip half width
+    hw = _hip_half_width(human)
     return {"left": np.array([0.0, hw, human.ankle_height_m]), "right": np.array([0.0, -hw, human.ankle_height_m])}

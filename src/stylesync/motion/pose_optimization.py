@@ -81,6 +81,7 @@ LANDING_REACH = 0.97  # hip-ankle distance, as a fraction of the leg's length, a
 OPERATOR_SWING_S = 0.4  # the operator's swing time before one has been seen [s]
 OPERATOR_DOUBLE_STANCE_S = 0.2  # the operator's double-stance time before one has been seen [s]
 SWING_BLEND_S = 0.1  # time constant over which a swing foot moves from its lift-off point onto its target [s]
+FREE_SWING_BLEND_S = 0.1  # time over which a swing foot goes over to following his foot, or back [s]
 ANCHOR_BLEND_S = 0.15  # time constant over which a stance change's jump of the retargeting anchor is taken up
 _SCALE_SMOOTHING = 0.02  # per tick, exponential average of the operator's leg length
 _BALL_JOINTS = [k for k, j in enumerate(JOINTS) if j.kind is JointKind.BALL]
@@ -249,6 +250,7 @@ class MotionOptimizer:
         self._feet_by_own_step = False  # the character's last step was its own (a recovery step), not one of his
         self.path = PathReference(cfg.path_feedback_share, cfg.path_feedback_max_m)  # path_feedback.py
         self._swing_offset = np.zeros(2)  # lift-off foot position minus the first swing target, decaying [m]
+        self._free_share = 0.0  # how much the swing foot follows his (_free_swing_share) [0, 1]
         self._swing_t0_s = 0.0  # when the character's current swing began [s]
         self._liftoff_xy = np.zeros(2)  # where the current swing's foot lifted off [m]
         # Per side, the offset of the operator's foot from his capture point when it last came down, scaled, in his
@@ -885,6 +887,12 @@ class MotionOptimizer:
                 landing = self._stopping_landing(tick, state, side, xi_h, landing)
             tick.swing_landing_xy = landing[:2]
             target[:2] = start + progress * (landing[:2] - start)
+            if cfg.free_swing:  # a swing neither needs to land: his foot from the stance foot (a kick's strike)
+                if first_tick:
+                    self._free_share = 0.0
+                share = self._free_swing_share(tick, state, side)
+                his = a_c[other][:2] + scale * (a_h[side] - a_h[other])[:2]
+                target[:2] += share * (his - target[:2])
         else:
             target[:2] = (state.root_pos_world + scale * (a_h[side] - tick.p_h))[:2]
         target[2] = min(max(target[2], ANKLE_HEIGHT_M), ANKLE_HEIGHT_M + cfg.max_swing_foot_lift_m)
@@ -916,6 +924,19 @@ class MotionOptimizer:
             if dist > self._swing_reach_m:
                 target[:2] = hip[:2] + away * (self._swing_reach_m / dist)
         return target
+
+    def _free_swing_share(self, tick: _Tick, state: CharacterState, side: str) -> float:
+        """How much [0, 1] the character's swing foot follows his foot relative to the stance foot (scaled) rather
+        than its way to the landing (MotionConfig.free_swing): 1 while his capture point is within the sole he
+        stands on and the character's within its own (neither needs the swing foot to land: a kick, a raised leg),
+        0 otherwise; it moves between the two over FREE_SWING_BLEND_S, so that the target does not jump."""
+        other = _OTHER_SIDE[side]
+        free = self._operator_stands(tick, (other,)) and support_outside_m(
+            capture_point(tick.com_c, tick.com_vel_c, self.g)[0], tick.a_c,
+            {other: state.link_quat_wxyz[_LINK[f"{other}_ankle"]]}, [other]) <= 0.0
+        step = self.dt_s / FREE_SWING_BLEND_S
+        self._free_share = min(self._free_share + step, 1.0) if free else max(self._free_share - step, 0.0)
+        return self._free_share
 
     # ---- 4. leg IK (Sec. 5.3) and balance strategy (Sec. 5.4) ------------------------------------------------
     def _solve_legs(self, tick: _Tick, state: CharacterState) -> tuple[dict[str, np.ndarray], dict[str, float]]:
