@@ -13,9 +13,10 @@ Four runs:
 * ``kick-default`` (reported, not part of the claim): the same with the default settings, where every swing goes
   from its lift-off to a landing placed for balance: a kick in place only lifts the foot and puts it down;
 * ``kick-clip`` (reported): the recorded ``humanoid3d_kick`` clip (default settings), the ball where the operator's
-  right ankle is at its fastest, scaled in the same way. That kicker lunges a metre forward into his kick; the
-  character does not follow a lunge that far (it keeps to its own capture point), so the ball is out of its
-  reach, and the run shows what following the operator over the ground still lacks.
+  right ankle is at its fastest, scaled in the same way. That kicker slides his feet apart over the ground and
+  kicks from there, his pelvis a metre forward of its start (scaled); the character's feet do not slide and it
+  keeps to its own capture point, so the ball is out of its reach: the run shows what following the operator over
+  the ground still lacks.
 
 Kicked = the ball moved more than ``KICKED_M``. The claim checked (the paper's: the character reaches the ball
 and kicks it, keeping its balance): the walk reaches the ball and the kick moves it, both with no fall. The walk
