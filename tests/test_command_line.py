@@ -139,5 +139,9 @@ def test_free_swing_is_taken_and_recorded(tmp_path, capsys):
 
     assert cli_main(["demo", "--free-swing", "--duration", "0.2", "--out", str(tmp_path / "fs")]) == 0
     assert cli_main(["demo", "--duration", "0.2", "--out", str(tmp_path / "plain")]) == 0
-    assert read_session(tmp_path / "fs" / "session.jsonl").header["config"]["motion"]["free_swing"] is True
-    assert read_session(tmp_path / "plain" / "session.jsonl").header["config"]["motion"]["free_swing"] is False
+    from stylesync.config import FREE_SWING_MOTION
+
+    free = read_session(tmp_path / "fs" / "session.jsonl").header["config"]["motion"]
+    plain = read_session(tmp_path / "plain" / "session.jsonl").header["config"]["motion"]
+    for name, value in FREE_SWING_MOTION.items():
+        assert free[name] == value != plain[name]

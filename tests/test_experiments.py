@@ -119,3 +119,16 @@ def test_a_free_swing_carries_the_kicks_strike_to_the_ball():
     assert not reach[True]["fell"] and reach[True]["kicked"]
     assert reach[True]["closest_foot_m"] < 0.1
     assert not reach[False]["kicked"] and reach[False]["closest_foot_m"] > 0.25
+
+
+def test_a_kick_does_not_lift_off_with_the_weight_already_beyond_the_stance_ankle():
+    """The scripted kick with the free swing, seed 0: lifting off with its capture point 2.4 cm outside its stance
+    ankle (and moving out), the character could not bring it back; the strike pushed it out of the sole, the swing
+    went back to a landing and missed the ball. Waiting until it is within 1 cm of the ankle outwards as well
+    (``liftoff_shift_outward_m``), the foot strikes and moves the ball, with no fall."""
+    out = {}
+    for outward in (None, 0.01):
+        _, m, _ = kick.run_one("kick", 0, MotionConfig(free_swing=True, liftoff_shift_outward_m=outward))
+        out[outward] = m
+    assert not out[None]["kicked"] and out[None]["closest_foot_m"] > 0.25
+    assert out[0.01]["kicked"] and not out[0.01]["fell"]

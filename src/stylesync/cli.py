@@ -22,6 +22,7 @@ from stylesync.config import (
     OperatorConfig,
     SessionConfig,
     follow_path,
+    free_swing,
 )
 from stylesync.errors import ConfigError, SourceError, StylesyncError
 from stylesync.files import write_atomically
@@ -177,7 +178,7 @@ def _motion_options(cfg: SessionConfig, args: argparse.Namespace) -> SessionConf
     if args.follow_path:
         cfg = follow_path(cfg)
     if args.free_swing:
-        cfg = cfg.replace(motion=dataclasses.replace(cfg.motion, free_swing=True))
+        cfg = free_swing(cfg)
     return cfg
 
 
@@ -313,8 +314,9 @@ def _add_session_args(p: argparse.ArgumentParser, out_default: str, realtime_hel
                    help="keep to the operator's path over the ground (a recording starts at its speed); "
                         "falls more often (README, status)")
     p.add_argument("--free-swing", action="store_true",
-                   help="a swing foot follows the operator's while both stand balanced on the other foot (a kick "
-                        "strikes); by default every swing goes to a landing placed for balance")
+                   help="a swing foot follows the operator's while both stand balanced on the other foot, lifted "
+                        "only with the weight over that ankle (a kick strikes); by default every swing goes to a "
+                        "landing placed for balance")
     p.add_argument("--record", type=typed.out_file, help="session file to write (default: OUT/session.jsonl)")
     p.add_argument("--progress", action="store_true", help="show a progress line (default: when on a terminal)")
     p.add_argument("--continue-after-fall", action="store_true",

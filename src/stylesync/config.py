@@ -140,6 +140,10 @@ class MotionConfig:
     liftoff_after_stand_s: float = 0.3
     liftoff_margin_m: float = 0.02
     liftoff_shift_tolerance_m: float | None = 0.01
+    # ... and, where he stands on that foot, while the character's is further than this outwards of its stance ankle
+    # (moving out: lifted there, the stance ankle has no room left to bring it back, and a kick's strike pushed it
+    # out of the sole) [m] (None: no outward limit)
+    liftoff_shift_outward_m: float | None = None
     # Any lift-off, from standing or in a walk (pose_optimization._can_lift): a foot that bears weight waits, as
     # above, while the character's capture point is further than this outside its other sole towards the lifting
     # foot. Standing on that sole alone, the body could only fall back onto the foot it lifts [m] (None: off).
@@ -392,6 +396,8 @@ class MotionConfig:
         _non_negative("MotionConfig.path_feedback_max_m", self.path_feedback_max_m)
         for n in ("liftoff_weight_shift_s", "liftoff_after_stand_s", "liftoff_margin_m"):
             _non_negative(f"MotionConfig.{n}", getattr(self, n))
+        if self.liftoff_shift_outward_m is not None:
+            _non_negative("MotionConfig.liftoff_shift_outward_m", self.liftoff_shift_outward_m)
         if self.liftoff_shift_tolerance_m is not None:
             _non_negative("MotionConfig.liftoff_shift_tolerance_m", self.liftoff_shift_tolerance_m)
         if self.liftoff_capture_behind_m is not None:
@@ -603,6 +609,18 @@ FOLLOW_PATH_MOTION: dict[str, Any] = {
     "path_feedback_share": 0.5,  # each landing takes up half the path's error
     "recovery_walk_on_m": 0.1,  # its own steps walk on while he walks
 }
+
+
+# The opt-ins that let a kick strike (docs/decisions.md, "A kick that strikes: the free swing"): `--free-swing`.
+FREE_SWING_MOTION: dict[str, Any] = {
+    "free_swing": True,  # a swing neither he nor the character needs to land follows his foot
+    "liftoff_shift_outward_m": 0.01,  # and is not lifted with the weight already beyond the stance ankle
+}
+
+
+def free_swing(cfg: SessionConfig) -> SessionConfig:
+    """``cfg`` with FREE_SWING_MOTION."""
+    return cfg.replace(motion=dataclasses.replace(cfg.motion, **FREE_SWING_MOTION))
 
 
 def follow_path(cfg: SessionConfig) -> SessionConfig:

@@ -8,8 +8,9 @@ Four runs:
 * ``kick``: the kick from where he stands, scripted on the human model (scripted_operator.py: weight over the left
   foot, the right foot drawn back and up, the strike forward, back down, weight back), the ball in front of his
   right toe at the strike's fastest instant, scaled to the character (h_C / h_H, Eq. 9) about the starting pelvis,
-  with the free swing on (MotionConfig.free_swing: while he and the character both balance on the stance foot,
-  the swing foot follows his relative to it);
+  with the free swing on (config.FREE_SWING_MOTION, `--free-swing`: while he and the character both balance on
+  the stance foot, the swing foot follows his relative to it, and the foot does not lift off with the
+  character's weight already beyond its stance ankle);
 * ``kick-default`` (reported, not part of the claim): the same with the default settings, where every swing goes
   from its lift-off to a landing placed for balance: a kick in place only lifts the foot and puts it down;
 * ``kick-clip`` (reported): the recorded ``humanoid3d_kick`` clip (default settings), the ball where the operator's
@@ -36,7 +37,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from stylesync import rotations as rot  # noqa: E402
-from stylesync.config import MotionConfig, OperatorConfig, SessionConfig  # noqa: E402
+from stylesync.config import FREE_SWING_MOTION, MotionConfig, OperatorConfig, SessionConfig  # noqa: E402
 from stylesync.experiments.common import run_session  # noqa: E402
 from stylesync.experiments.scripted_operator import pose_frame, standing_ankles  # noqa: E402
 from stylesync.metrics.plots import plan_view, save_figure  # noqa: E402
@@ -56,7 +57,7 @@ AFTER_S = 2.0  # simulated after the clip [s]
 
 
 SCENARIOS = ("walk-to-ball", "kick", "kick-default", "kick-clip")
-FREE_SWING = MotionConfig(free_swing=True)  # the "kick" scenario's motion settings
+FREE_SWING = MotionConfig(**FREE_SWING_MOTION)  # the "kick" scenario's motion settings (--free-swing)
 # The scripted kick (times [s], the right ankle's displacements from standing, forward and up [m]): the weight goes
 # over the left foot, the foot is drawn back and up, strikes forward, comes back down, and the weight comes back.
 KICK_START_S = 2.0  # the character has stood this long

@@ -306,7 +306,9 @@ class MotionOptimizer:
           point over his other sole, sideways (within ``liftoff_margin_m`` of its inner edge, his sole the
           character's scaled to him), while the character's capture point is further than that inwards of its own
           other sole; where his is over or beyond his stance ankle (his weight on that foot: a kick, a pose on one
-          leg), while the character's is further inwards of its stance ankle than ``liftoff_shift_tolerance_m``."""
+          leg), while the character's is further inwards of its stance ankle than ``liftoff_shift_tolerance_m``; and
+          wherever his is over his stance sole, while the character's is further outwards of its stance ankle than
+          ``liftoff_shift_outward_m``."""
         cfg = self.cfg
         if cfg.liftoff_weight_shift_s <= 0.0:
             return None
@@ -338,7 +340,10 @@ class MotionOptimizer:
                     # within the margin of the sole's inner edge
                     limit = (edge if cfg.liftoff_shift_tolerance_m is None or inward_h > 0.0
                              else cfg.liftoff_shift_tolerance_m)
-                    may = may and _inward_m(xi, ankle, rot.twist_angle(foot_q, _UP), stance) <= limit
+                    inward = _inward_m(xi, ankle, rot.twist_angle(foot_q, _UP), stance)
+                    may = may and inward <= limit
+                    if cfg.liftoff_shift_outward_m is not None:  # nor beyond the stance ankle, outwards
+                        may = may and inward >= -cfg.liftoff_shift_outward_m
             can[side] = may
         return can
 
