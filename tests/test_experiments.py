@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from stylesync.config import JacobianTransposeConfig, MotionConfig, PidGains
+from stylesync.config import ControlConfig, JacobianTransposeConfig, MotionConfig, PidGains
 from stylesync.experiments import kick, push, squat_jump, tune
 from stylesync.experiments.scripted_operator import pose_frame, sagittal_leg, standing_ankles
 from stylesync.sources.deepmimic_clip import DeepMimicClip
@@ -114,7 +114,7 @@ def test_a_free_swing_carries_the_kicks_strike_to_the_ball():
     is where it lifted off: the foot only rises and comes down, and never reaches the ball."""
     reach = {}
     for free in (False, True):
-        _, m, _ = kick.run_one("kick", 1, MotionConfig(free_swing=free))
+        _, m, _ = kick.run_one("kick", 1, MotionConfig(free_swing=free), ControlConfig())
         reach[free] = m
     assert not reach[True]["fell"] and reach[True]["kicked"]
     assert reach[True]["closest_foot_m"] < 0.1
@@ -128,7 +128,27 @@ def test_a_kick_does_not_lift_off_with_the_weight_already_beyond_the_stance_ankl
     (``liftoff_shift_outward_m``), the foot strikes and moves the ball, with no fall."""
     out = {}
     for outward in (None, 0.01):
-        _, m, _ = kick.run_one("kick", 0, MotionConfig(free_swing=True, liftoff_shift_outward_m=outward))
+        _, m, _ = kick.run_one("kick", 0, MotionConfig(free_swing=True, liftoff_shift_outward_m=outward),
+                               ControlConfig())
         out[outward] = m
     assert not out[None]["kicked"] and out[None]["closest_foot_m"] > 0.25
     assert out[0.01]["kicked"] and not out[0.01]["fell"]
+
+
+def test_a_stance_foot_off_the_ground_is_held_where_it_came_off():
+    """The scripted kick, seed 14: while the weight shifts onto the left foot the right one bears no force and comes
+    a few millimetres off the ground. Pressed down only, it slid 0.2 m forwards and inwards (the QP swung the free leg
+    for momentum), the lift-off came from there with the weight never over the stance sole, and the kick missed.
+    Held where it came off (WholeBodyConfig.press_holds_foot), it stays within 3 cm and the kick moves the ball."""
+    from stylesync.config import WholeBodyConfig
+
+    out = {}
+    for hold in (False, True):
+        control = ControlConfig(whole_body=WholeBodyConfig(press_holds_foot=hold))  # with the free swing
+        result, m, _ = kick.run_one("kick", 14, control=control)
+        t = result.log.array("t")
+        shift = (t > kick.KICK_START_S) & (t < kick.KICK_START_S + kick.SHIFT_S + 0.25)  # before any lift-off
+        right = np.stack([result.log.array("ar_x"), result.log.array("ar_y")], axis=1)[shift]
+        out[hold] = (float(np.linalg.norm(right - right[0], axis=1).max()), m)
+    assert out[False][0] > 0.1 and not out[False][1]["kicked"]
+    assert out[True][0] < 0.03 and out[True][1]["kicked"] and not out[True][1]["fell"]

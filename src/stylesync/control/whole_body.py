@@ -125,6 +125,11 @@ class WholeBodyController(ControllerBase):
                                                            FOOT_TASK_WEIGHT, axes=(2,))) for s in SIDES}
         for task in self.foot_press.values():
             task.target_world = np.array([0.0, 0.0, ANKLE_HEIGHT_M - GROUND_PRESS_M])
+        self.foot_hold = ({s: f.add_task(FramePositionTask(f"{s}_foot_hold", f"{s}_ankle", self.kp, self.kd,
+                                                           FOOT_TASK_WEIGHT, axes=(0, 1))) for s in SIDES}
+                          if wb.press_holds_foot else {})
+        for task in self.foot_hold.values():
+            task.active = False  # until a stance foot comes off the ground (update)
         self.hands = ({s: f.add_task(FramePositionTask(f"{s}_hand", HAND_FRAMES[s], wb.hand_task_kp,
                                                        wb.hand_task_kd, wb.hand_task_weight)) for s in SIDES}
                       if wb.hand_tasks else {})
@@ -204,6 +209,11 @@ class WholeBodyController(ControllerBase):
         for s, task in self.foot_press.items():
             ws = ref.stance_weight[s]
             task.active = (ws > 0 and w[s] <= 0) or (ref.press_swing_foot and s == swing)
+            hold = self.foot_hold.get(s)
+            if hold is not None:  # a stance foot off the ground is held where it came off (press_holds_foot)
+                if ws > 0 and w[s] <= 0 and not hold.active:
+                    hold.target_world = state.link_origin_world[_FOOT_LINK[s]].copy()
+                hold.active = ws > 0 and w[s] <= 0
         for s, task in self.recovery_feet.items():
             target = None if ref.recovery_ankle_world is None else ref.recovery_ankle_world.get(s)
             task.active = target is not None

@@ -8,9 +8,10 @@ Four runs:
 * ``kick``: the kick from where he stands, scripted on the human model (scripted_operator.py: weight over the left
   foot, the right foot drawn back and up, the strike forward, back down, weight back), the ball in front of his
   right toe at the strike's fastest instant, scaled to the character (h_C / h_H, Eq. 9) about the starting pelvis,
-  with the free swing on (config.FREE_SWING_MOTION, `--free-swing`: while he and the character both balance on
-  the stance foot, the swing foot follows his relative to it, and the foot does not lift off with the
-  character's weight already beyond its stance ankle);
+  with the free swing on (config.FREE_SWING_MOTION and FREE_SWING_WHOLE_BODY, `--free-swing`: while he and the
+  character both balance on the stance foot, the swing foot follows his relative to it; the foot does not lift
+  off with the character's weight already beyond its stance ankle, and while the weight shifts off it, it is held
+  where it stands);
 * ``kick-default`` (reported, not part of the claim): the same with the default settings, where every swing goes
   from its lift-off to a landing placed for balance: a kick in place only lifts the foot and puts it down;
 * ``kick-clip`` (reported): the recorded ``humanoid3d_kick`` clip (default settings), the ball where the operator's
@@ -37,7 +38,15 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from stylesync import rotations as rot  # noqa: E402
-from stylesync.config import FREE_SWING_MOTION, MotionConfig, OperatorConfig, SessionConfig  # noqa: E402
+from stylesync.config import (  # noqa: E402
+    FREE_SWING_MOTION,
+    FREE_SWING_WHOLE_BODY,
+    ControlConfig,
+    MotionConfig,
+    OperatorConfig,
+    SessionConfig,
+    WholeBodyConfig,
+)
 from stylesync.experiments.common import run_session  # noqa: E402
 from stylesync.experiments.scripted_operator import pose_frame, standing_ankles  # noqa: E402
 from stylesync.metrics.plots import plan_view, save_figure  # noqa: E402
@@ -57,7 +66,9 @@ AFTER_S = 2.0  # simulated after the clip [s]
 
 
 SCENARIOS = ("walk-to-ball", "kick", "kick-default", "kick-clip")
-FREE_SWING = MotionConfig(**FREE_SWING_MOTION)  # the "kick" scenario's motion settings (--free-swing)
+# the "kick" scenario's settings (--free-swing)
+FREE_SWING = MotionConfig(**FREE_SWING_MOTION)
+FREE_SWING_CONTROL = ControlConfig(whole_body=WholeBodyConfig(**FREE_SWING_WHOLE_BODY))
 # The scripted kick (times [s], the right ankle's displacements from standing, forward and up [m]): the weight goes
 # over the left foot, the foot is drawn back and up, strikes forward, comes back down, and the weight comes back.
 KICK_START_S = 2.0  # the character has stood this long
@@ -104,11 +115,13 @@ def ball_position(frame_at, human: HumanModel, t0_s: float, t1_s: float, contact
     return np.array([xy[0], xy[1], BALL_RADIUS_M])
 
 
-def _scenario_session(scenario: str, seed: int, motion: MotionConfig) -> tuple[Session, np.ndarray]:
+def _scenario_session(scenario: str, seed: int, motion: MotionConfig,
+                      control: ControlConfig) -> tuple[Session, np.ndarray]:
     """The session of a scenario and the ball's starting position [m]."""
     if scenario in ("kick", "kick-default"):
         op = OperatorConfig(clip="kick-in-place")
-        cfg = SessionConfig(duration_s=KICK_START_S + KICK_AFTER_S, seed=seed, operator=op, motion=motion)
+        cfg = SessionConfig(duration_s=KICK_START_S + KICK_AFTER_S, seed=seed, operator=op, motion=motion,
+                            control=control)
         human = HumanModel(op.height_m, op.mass_kg)
         frame_at = kick_performer(human)
         source = sensed(frame_at, op, cfg.clocks, cfg.duration_s + 1.0, seed, "kick-in-place")
@@ -117,7 +130,7 @@ def _scenario_session(scenario: str, seed: int, motion: MotionConfig) -> tuple[S
     op = OperatorConfig(clip=clip)
     clip_s = DeepMimicClip.builtin(clip).duration_s
     duration = min(op.standing_lead_in_s + clip_s * (3 if clip == "walk" else 1) + AFTER_S, 8.0)
-    cfg = SessionConfig(duration_s=duration, seed=seed, operator=op, motion=motion)
+    cfg = SessionConfig(duration_s=duration, seed=seed, operator=op, motion=motion, control=control)
     source, performer = builtin_operator(op, cfg.clocks, duration + 1.0, seed)
     if clip == "kick":
         lead_in = op.standing_lead_in_s
@@ -131,12 +144,15 @@ def _scenario_session(scenario: str, seed: int, motion: MotionConfig) -> tuple[S
     return Session(cfg, source), np.array([pelvis0[0] + ahead[0], pelvis0[1] + ahead[1], BALL_RADIUS_M])
 
 
-def run_one(scenario: str, seed: int, motion: MotionConfig | None = None):
-    """One scenario's run (``motion``: the motion stage's settings; if None, FREE_SWING for "kick" and the defaults
-    for the others): its SessionResult, its metrics and the ball's path (n, 3) [m]."""
+def run_one(scenario: str, seed: int, motion: MotionConfig | None = None, control: ControlConfig | None = None):
+    """One scenario's run (``motion``, ``control``: the motion stage's and the controller's settings; if None,
+    FREE_SWING and FREE_SWING_CONTROL for "kick", the defaults for the others): its SessionResult, its metrics and
+    the ball's path (n, 3) [m]."""
     if motion is None:
         motion = FREE_SWING if scenario == "kick" else MotionConfig()
-    session, ball0 = _scenario_session(scenario, seed, motion)
+    if control is None:
+        control = FREE_SWING_CONTROL if scenario == "kick" else ControlConfig()
+    session, ball0 = _scenario_session(scenario, seed, motion, control)
     ball = session.backend.throw_ball(ball0, np.zeros(3), radius_m=BALL_RADIUS_M)
     track: list[np.ndarray] = []
     reach = [np.inf]
