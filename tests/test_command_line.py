@@ -139,11 +139,9 @@ def test_free_swing_is_taken_and_recorded(tmp_path, capsys):
 
     assert cli_main(["demo", "--free-swing", "--duration", "0.2", "--out", str(tmp_path / "fs")]) == 0
     assert cli_main(["demo", "--duration", "0.2", "--out", str(tmp_path / "plain")]) == 0
-    from stylesync.config import FREE_SWING_MOTION, FREE_SWING_WHOLE_BODY
+    from stylesync.config import FREE_SWING_MOTION
 
     free = read_session(tmp_path / "fs" / "session.jsonl").header["config"]
     plain = read_session(tmp_path / "plain" / "session.jsonl").header["config"]
     for name, value in FREE_SWING_MOTION.items():
         assert free["motion"][name] == value != plain["motion"][name]
-    for name, value in FREE_SWING_WHOLE_BODY.items():
-        assert free["control"]["whole_body"][name] == value != plain["control"]["whole_body"][name]

@@ -139,12 +139,13 @@ def test_a_stance_foot_off_the_ground_is_held_where_it_came_off():
     """The scripted kick, seed 14: while the weight shifts onto the left foot the right one bears no force and comes
     a few millimetres off the ground. Pressed down only, it slid 0.2 m forwards and inwards (the QP swung the free leg
     for momentum), the lift-off came from there with the weight never over the stance sole, and the kick missed.
-    Held where it came off (WholeBodyConfig.press_holds_foot), it stays within 3 cm and the kick moves the ball."""
+    Held where it came off (WholeBodyConfig.press_holds_foot, off by default and in --free-swing), it stays within
+    3 cm and the kick moves the ball."""
     from stylesync.config import WholeBodyConfig
 
     out = {}
     for hold in (False, True):
-        control = ControlConfig(whole_body=WholeBodyConfig(press_holds_foot=hold))  # with the free swing
+        control = ControlConfig(whole_body=WholeBodyConfig(press_holds_foot=hold))  # with --free-swing
         result, m, _ = kick.run_one("kick", 14, control=control)
         t = result.log.array("t")
         shift = (t > kick.KICK_START_S) & (t < kick.KICK_START_S + kick.SHIFT_S + 0.25)  # before any lift-off

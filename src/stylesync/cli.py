@@ -315,8 +315,8 @@ def _add_session_args(p: argparse.ArgumentParser, out_default: str, realtime_hel
                         "falls more often (README, status)")
     p.add_argument("--free-swing", action="store_true",
                    help="a swing foot follows the operator's while both stand balanced on the other foot, lifted "
-                        "only with the weight over that ankle and held in place while the weight shifts (a kick "
-                        "strikes); by default every swing goes to a landing placed for balance")
+                        "only with the weight over that ankle (a kick strikes); by default every swing goes to a "
+                        "landing placed for balance")
     p.add_argument("--record", type=typed.out_file, help="session file to write (default: OUT/session.jsonl)")
     p.add_argument("--progress", action="store_true", help="show a progress line (default: when on a terminal)")
     p.add_argument("--continue-after-fall", action="store_true",

@@ -465,8 +465,9 @@ class WholeBodyConfig:
     hand_tasks: bool = False
     # A stance foot that has come off the ground (its force planned at zero while the weight shifts off it) is held
     # where it came off, horizontally, as well as pressed down: left free, the QP swung it for momentum and it slid
-    # 0.2 m over the ground before a kick (docs/decisions.md, "A kick that strikes: the free swing"). In the
-    # default, 323 of 352 suite runs completed against 337 (runs 33 of 48 against 42): part of --free-swing only.
+    # 0.2 m over the ground before a kick (docs/decisions.md, "A kick that strikes: the free swing"). It holds a
+    # runner's rear foot back too: 323 of 352 suite runs completed against 337 (runs 33 of 48 against 42), and 324
+    # with --free-swing against 336 without it: off, and not part of --free-swing.
     press_holds_foot: bool = False
     hand_task_kp: float = 100.0
     hand_task_kd: float = 20.0
@@ -623,15 +624,9 @@ FREE_SWING_MOTION: dict[str, Any] = {
 }
 
 
-# ... and the controller's: a stance foot the weight shift has lifted stays where it was.
-FREE_SWING_WHOLE_BODY: dict[str, Any] = {"press_holds_foot": True}
-
-
 def free_swing(cfg: SessionConfig) -> SessionConfig:
-    """``cfg`` with FREE_SWING_MOTION and FREE_SWING_WHOLE_BODY."""
-    control = dataclasses.replace(cfg.control, whole_body=dataclasses.replace(cfg.control.whole_body,
-                                                                              **FREE_SWING_WHOLE_BODY))
-    return cfg.replace(motion=dataclasses.replace(cfg.motion, **FREE_SWING_MOTION), control=control)
+    """``cfg`` with FREE_SWING_MOTION."""
+    return cfg.replace(motion=dataclasses.replace(cfg.motion, **FREE_SWING_MOTION))
 
 
 def follow_path(cfg: SessionConfig) -> SessionConfig:

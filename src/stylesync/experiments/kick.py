@@ -8,10 +8,9 @@ Four runs:
 * ``kick``: the kick from where he stands, scripted on the human model (scripted_operator.py: weight over the left
   foot, the right foot drawn back and up, the strike forward, back down, weight back), the ball in front of his
   right toe at the strike's fastest instant, scaled to the character (h_C / h_H, Eq. 9) about the starting pelvis,
-  with the free swing on (config.FREE_SWING_MOTION and FREE_SWING_WHOLE_BODY, `--free-swing`: while he and the
-  character both balance on the stance foot, the swing foot follows his relative to it; the foot does not lift
-  off with the character's weight already beyond its stance ankle, and while the weight shifts off it, it is held
-  where it stands);
+  with the free swing on (config.FREE_SWING_MOTION, `--free-swing`: while he and the character both balance on
+  the stance foot, the swing foot follows his relative to it, and the foot does not lift off with the
+  character's weight already beyond its stance ankle);
 * ``kick-default`` (reported, not part of the claim): the same with the default settings, where every swing goes
   from its lift-off to a landing placed for balance: a kick in place only lifts the foot and puts it down;
 * ``kick-clip`` (reported): the recorded ``humanoid3d_kick`` clip (default settings), the ball where the operator's
@@ -40,12 +39,10 @@ import numpy as np  # noqa: E402
 from stylesync import rotations as rot  # noqa: E402
 from stylesync.config import (  # noqa: E402
     FREE_SWING_MOTION,
-    FREE_SWING_WHOLE_BODY,
     ControlConfig,
     MotionConfig,
     OperatorConfig,
     SessionConfig,
-    WholeBodyConfig,
 )
 from stylesync.experiments.common import run_session  # noqa: E402
 from stylesync.experiments.scripted_operator import pose_frame, standing_ankles  # noqa: E402
@@ -66,9 +63,7 @@ AFTER_S = 2.0  # simulated after the clip [s]
 
 
 SCENARIOS = ("walk-to-ball", "kick", "kick-default", "kick-clip")
-# the "kick" scenario's settings (--free-swing)
-FREE_SWING = MotionConfig(**FREE_SWING_MOTION)
-FREE_SWING_CONTROL = ControlConfig(whole_body=WholeBodyConfig(**FREE_SWING_WHOLE_BODY))
+FREE_SWING = MotionConfig(**FREE_SWING_MOTION)  # the "kick" scenario's motion settings (--free-swing)
 # The scripted kick (times [s], the right ankle's displacements from standing, forward and up [m]): the weight goes
 # over the left foot, the foot is drawn back and up, strikes forward, comes back down, and the weight comes back.
 KICK_START_S = 2.0  # the character has stood this long
@@ -145,14 +140,12 @@ def _scenario_session(scenario: str, seed: int, motion: MotionConfig,
 
 
 def run_one(scenario: str, seed: int, motion: MotionConfig | None = None, control: ControlConfig | None = None):
-    """One scenario's run (``motion``, ``control``: the motion stage's and the controller's settings; if None,
-    FREE_SWING and FREE_SWING_CONTROL for "kick", the defaults for the others): its SessionResult, its metrics and
-    the ball's path (n, 3) [m]."""
+    """One scenario's run (``motion``: the motion stage's settings, if None FREE_SWING for "kick" and the defaults
+    for the others; ``control``: the controller's, the defaults if None): its SessionResult, its metrics and the
+    ball's path (n, 3) [m]."""
     if motion is None:
         motion = FREE_SWING if scenario == "kick" else MotionConfig()
-    if control is None:
-        control = FREE_SWING_CONTROL if scenario == "kick" else ControlConfig()
-    session, ball0 = _scenario_session(scenario, seed, motion, control)
+    session, ball0 = _scenario_session(scenario, seed, motion, control or ControlConfig())
     ball = session.backend.throw_ball(ball0, np.zeros(3), radius_m=BALL_RADIUS_M)
     track: list[np.ndarray] = []
     reach = [np.inf]
