@@ -207,13 +207,13 @@ class WholeBodyController(ControllerBase):
         # otherwise be lifted by the other's reaction), and so is a swing foot the reference is held for.
         swing = swing_side(ref.character_stance)
         for s, task in self.foot_press.items():
-            ws = ref.stance_weight[s]
-            task.active = (ws > 0 and w[s] <= 0) or (ref.press_swing_foot and s == swing)
+            lifted = ref.stance_weight[s] > 0 and w[s] <= 0  # a stance foot off the ground
+            task.active = lifted or (ref.press_swing_foot and s == swing)
             hold = self.foot_hold.get(s)
-            if hold is not None:  # a stance foot off the ground is held where it came off (press_holds_foot)
-                if ws > 0 and w[s] <= 0 and not hold.active:
+            if hold is not None:  # ... is held where it came off (press_holds_foot)
+                if lifted and not hold.active:
                     hold.target_world = state.link_origin_world[_FOOT_LINK[s]].copy()
-                hold.active = ws > 0 and w[s] <= 0
+                hold.active = lifted
         for s, task in self.recovery_feet.items():
             target = None if ref.recovery_ankle_world is None else ref.recovery_ankle_world.get(s)
             task.active = target is not None

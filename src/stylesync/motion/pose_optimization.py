@@ -520,10 +520,11 @@ class MotionOptimizer:
             xi_c, omega = capture_point(com_c, tick.com_vel_c, self.g)
             self.path.update(state.root_pos_world, p_h, xi_c, self._operator_capture_point(tick), scale, omega)
 
-    def _capture_near_support(self, tick: _Tick, state: CharacterState, within_m: float) -> bool:
+    def _capture_near_support(self, tick: _Tick, state: CharacterState, within_m: float,
+                              sides: list[str] | None = None) -> bool:
         """Whether the character's capture point is within ``within_m`` outside the support polygon of its soles on
-        the ground (inside counts; no sole on the ground: False) [m]."""
-        on_ground = soles_on_ground(state)
+        the ground, or of the soles ``sides`` if given (inside counts; no sole: False) [m]."""
+        on_ground = soles_on_ground(state) if sides is None else sides
         if not on_ground:
             return False
         xi_c, _ = capture_point(tick.com_c, tick.com_vel_c, self.g)
@@ -936,9 +937,7 @@ class MotionOptimizer:
         stands on and the character's within its own (neither needs the swing foot to land: a kick, a raised leg),
         0 otherwise; it moves between the two over FREE_SWING_BLEND_S, so that the target does not jump."""
         other = _OTHER_SIDE[side]
-        free = self._operator_stands(tick, (other,)) and support_outside_m(
-            capture_point(tick.com_c, tick.com_vel_c, self.g)[0], tick.a_c,
-            {other: state.link_quat_wxyz[_LINK[f"{other}_ankle"]]}, [other]) <= 0.0
+        free = self._operator_stands(tick, (other,)) and self._capture_near_support(tick, state, 0.0, [other])
         step = self.dt_s / FREE_SWING_BLEND_S
         self._free_share = min(self._free_share + step, 1.0) if free else max(self._free_share - step, 0.0)
         return self._free_share
