@@ -101,6 +101,97 @@ def test_bvh_rotation_moves_the_segment(tmp_path):
     assert d @ knee_rel / 0.42 == pytest.approx(1.0, abs=1e-6)
 
 
+def _bones_along_x(text: str) -> str:
+    """The same BVH motion on joint frames with x along each joint's (first) bone, as rigs with joint frames along
+    their bones write it: every bone lies along x at rest (legs and spine alike), and each frame's rotations turn it
+    back. Joint j's frame becomes Q_j (x onto its bone); offsets of its children Q_j⁻¹ o; rotations Q_par⁻¹ R Q_j."""
+    from scipy.spatial.transform import Rotation
+
+    head, motion = text.split("MOTION", 1)
+    lines = head.splitlines()
+    joints: list[dict] = []
+    stack: list[int] = []
+    pending: dict = {}
+    for i, ln in enumerate(lines):
+        s = ln.strip()
+        if s.startswith(("ROOT", "JOINT")):
+            pending = {"parent": stack[-1] if stack else -1, "kids": [], "end": None}
+            joints.append(pending)
+        elif s.startswith("End Site"):
+            pending = {"end_of": stack[-1]}
+        elif s == "{":
+            stack.append(len(joints) - 1 if "parent" in pending else stack[-1])
+        elif s == "}":
+            stack.pop()
+        elif s.startswith("OFFSET"):
+            v = np.array([float(x) for x in s.split()[1:4]])
+            if "end_of" in pending:
+                joints[pending["end_of"]]["end"] = (i, v)
+            else:
+                pending["line"], pending["off"] = i, v
+        elif s.startswith("CHANNELS"):
+            pending["chans"] = s.split()[2:]
+    for j, jt in enumerate(joints):
+        if jt["parent"] >= 0:
+            joints[jt["parent"]]["kids"].append(j)
+    q = []
+    for jt in joints:
+        bone = joints[jt["kids"][0]]["off"] if jt["kids"] else (jt["end"][1] if jt["end"] else np.zeros(3))
+        length = float(np.linalg.norm(bone))
+        if length < 1e-9:  # a joint on its child (CMU's hip joints): its frame stays
+            q.append(Rotation.identity())
+            continue
+        x = np.array([1.0, 0.0, 0.0])
+        axis, c = np.cross(x, bone / length), float(x @ bone) / length
+        sin = float(np.linalg.norm(axis))
+        q.append(Rotation.identity() if sin < 1e-9 and c > 0 else Rotation.from_rotvec(
+            [0.0, 0.0, np.pi] if sin < 1e-9 else axis / sin * np.arctan2(sin, c)))
+
+    def offset_line(i: int, v: np.ndarray) -> str:
+        return lines[i][:len(lines[i]) - len(lines[i].lstrip())] + "OFFSET " + " ".join(f"{a:.6f}" for a in v)
+
+    for j, jt in enumerate(joints):
+        if jt["parent"] >= 0:
+            lines[jt["line"]] = offset_line(jt["line"], q[jt["parent"]].inv().apply(jt["off"]))
+        if jt["end"]:
+            lines[jt["end"][0]] = offset_line(jt["end"][0], q[j].inv().apply(jt["end"][1]))
+    header, *frames = motion.strip("\n").splitlines()[0:2], *motion.strip("\n").splitlines()[2:]
+    out = []
+    for fr in frames:
+        values, k, row = [float(x) for x in fr.split()], 0, []
+        for j, jt in enumerate(joints):
+            names = jt["chans"]
+            v = values[k:k + len(names)]
+            k += len(names)
+            rotation = [n for n in names if n.lower().endswith("rotation")]
+            order = "".join(n[0].upper() for n in rotation)
+            r = Rotation.from_euler(order, [x for n, x in zip(names, v, strict=True) if n.lower().endswith("rotation")],
+                                    degrees=True)
+            r = r * q[j] if jt["parent"] < 0 else q[jt["parent"]].inv() * r * q[j]
+            angles = iter(r.as_euler(order, degrees=True))
+            row += [next(angles) if n.lower().endswith("rotation") else x for n, x in zip(names, v, strict=True)]
+        out.append(" ".join(f"{x:.6f}" for x in row))
+    return "\n".join(lines) + "\nMOTION\n" + "\n".join(header + out) + "\n"
+
+
+@needs_cmu
+def test_a_bvh_whose_rest_pose_lays_every_bone_along_x_loads_as_the_same_motion(tmp_path):
+    """Rigs with joint frames along their bones (x along the bone) lay every bone along x at rest: the rest pose says
+    neither which way is up nor the file's units. The same CMU walk written that way loads with the same up axis,
+    units and joint positions, its up axis and stature taken from the frames, its orientations from the joint
+    positions; before, its stature at rest (11.6 file units) fitted no unit and the file was refused."""
+    original = BvhRecording(CMU / "02_01.bvh")
+    path = tmp_path / "along_x.bvh"
+    path.write_text(_bones_along_x((CMU / "02_01.bvh").read_text()))
+    along_x = BvhRecording(path)
+    assert (along_x.up_axis, along_x.scale_m) == (original.up_axis, original.scale_m)
+    assert along_x.orientations_from_positions and not original.orientations_from_positions
+    assert np.abs(along_x.performer.pos_world - original.performer.pos_world).max() < 1e-5
+    hips = along_x.performer.pos_world[:, JOINT_INDEX["PELVIS"], 2]
+    head = along_x.performer.pos_world[:, JOINT_INDEX["HEAD"], 2]
+    assert np.all(head > hips + 0.3)  # standing: the head above the pelvis
+
+
 def test_unknown_skeleton_and_custom_joint_map(tmp_path):
     p = _write_tiny(tmp_path, names={"LeftUpLeg": "Oberschenkel_L"})
     # A name not understood: the skeleton is matched by structure instead (skeleton_structure.py).

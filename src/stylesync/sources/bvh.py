@@ -9,7 +9,10 @@ the upper arm ...) and Biped (``Bip01 L Thigh`` ...). A JSON object ``{"HIP_LEFT
 
 Units: unless given, the scale to metres is the one of {m, cm, mm, inch, CMU (0.056444)} that makes the rest-pose
 stature (ankle-to-head joint / 0.87) 1.0-2.3 m. Up axis: unless given, the file axis closest to head-minus-ankles
-in the rest pose. The floor is placed by :func:`place_on_floor`.
+in the rest pose. A rest pose that does not stand upright (the legs not pointing away from the head: rigs with joint
+frames along their bones lay every bone along x) tells neither: the up axis is then the one closest to the frames'
+mean head-minus-ankles, the stature their tallest, and the segment orientations come from the joint positions
+(segment_frames.py), as the rest pose cannot tell a segment's twist. The floor is placed by :func:`place_on_floor`.
 """
 
 from __future__ import annotations
@@ -25,6 +28,7 @@ from stylesync.errors import SourceError
 from stylesync.sources.base import read_json_file
 from stylesync.sources.frame import JOINT_INDEX, N_JOINTS
 from stylesync.sources.limits import MAX_RECORDING_S, distance_problem, frame_interval_problem
+from stylesync.sources.segment_frames import canonical_quats_from_positions
 from stylesync.sources.skeleton_names import match_by_name
 from stylesync.sources.skeleton_structure import match_by_structure
 from stylesync.sources.skeleton_tracks import (
@@ -47,7 +51,17 @@ BIND_BLEND_RATIO = 3.0
 BIND_BLEND_WINDOW_S = 1.0
 BIND_BLEND_MAX_S = 0.25
 BIND_BLEND_MIN_MOVE_M = 0.01
+UPRIGHT_REST_MIN_DEG = 120.0  # legs and spine at least this far apart: a rest pose standing upright
 log = logging.getLogger("stylesync.sources")
+
+
+def rest_stands_upright(pelvis: np.ndarray, ankles: np.ndarray, head: np.ndarray) -> bool:
+    """Whether a skeleton's rest pose is a person standing: the legs (pelvis to the ankles' midpoint) point away from
+    the head (pelvis to head), at more than UPRIGHT_REST_MIN_DEG between them. Rigs whose joint frames have x along
+    the bone lay every bone along x at rest, legs and spine alike."""
+    legs, spine = np.asarray(ankles) - pelvis, np.asarray(head) - pelvis
+    norms = float(np.linalg.norm(legs) * np.linalg.norm(spine))
+    return norms > 0 and float(legs @ spine) / norms < np.cos(np.radians(UPRIGHT_REST_MIN_DEG))
 
 
 def load_joint_map(path: str | Path) -> dict[str, str]:
@@ -221,32 +235,7 @@ class BvhRecording:
             while np.linalg.norm(rest[idx[distal]] - rest[idx[seg]]) < 1e-9 and parent_index[idx[seg]] >= 0:
                 idx[seg] = parent_index[idx[seg]]
                 self.matches[seg] = (names[idx[seg]], f"parent of {self.matches[seg][0]} (which sits on {distal})")
-        ankles = 0.5 * (rest[idx["ANKLE_LEFT"]] + rest[idx["ANKLE_RIGHT"]])
-        up_vec = rest[idx["HEAD"]] - ankles
-        if up_axis is None:
-            ax = int(np.argmax(np.abs(up_vec)))
-            sign = float(np.sign(up_vec[ax]) or 1.0)
-        else:
-            if up_axis.lstrip("+-") not in ("x", "y", "z"):
-                raise SourceError(f"up axis must be x, y or z (optionally signed), got '{up_axis}'")
-            ax, sign = "xyz".index(up_axis.lstrip("+-")), (-1.0 if up_axis.startswith("-") else 1.0)
-        stature_units = float(abs(up_vec[ax])) * 1.15  # rest ankle-to-head-joint, ~87 % of stature
-        if scale_m is None:
-            fits = [s for s in UNIT_SCALES_M.values() if STATURE_RANGE_M[0] <= stature_units * s <= STATURE_RANGE_M[1]]
-            if not fits:
-                raise SourceError(f"BVH file {p}: rest-pose stature {stature_units:.3g} file units fits none of the "
-                                  f"units {sorted(UNIT_SCALES_M)}; give the scale to metres")
-            scale_m = fits[0]
-        if not (np.isfinite(scale_m) and scale_m > 0):
-            raise SourceError(f"BVH scale to metres must be > 0, got {scale_m}")
-        self.scale_m = float(scale_m)
-        self.up_axis = ("+" if sign > 0 else "-") + "xyz"[ax]  # the file's up axis
-        self.frame_time_s = frame_time
-        self.stature_m = stature_units * self.scale_m
-        A = _axes_matrix(ax, sign)
-        q_axes = rot.quat_from_matrix(A)
-
-        # Forward kinematics over all frames, file axes.
+        # Forward kinematics over all frames, file axes and units.
         T = n_frames
         world_pos = np.zeros((len(names), T, 3))
         world_R = np.zeros((len(names), T, 3, 3))
@@ -261,9 +250,46 @@ class BvhRecording:
                 world_pos[j] = world_pos[par] + np.einsum("tij,tj->ti", world_R[par], local_pos[j])
             world_R[j] = rot.batch_matrix_from_quat(world_q[j])
 
-        # Our axes and metres; canonical segment orientations q(t) = (A R_file(t) A^T) ⊗ q_rest.
+        # The file's up axis and stature: from the rest pose when it stands upright, otherwise from the frames.
+        ankles = 0.5 * (rest[idx["ANKLE_LEFT"]] + rest[idx["ANKLE_RIGHT"]])
+        up_vec = rest[idx["HEAD"]] - ankles
+        posed = not rest_stands_upright(rest[idx["PELVIS"]], ankles, rest[idx["HEAD"]])
+        up_t = world_pos[idx["HEAD"]] - 0.5 * (world_pos[idx["ANKLE_LEFT"]] + world_pos[idx["ANKLE_RIGHT"]])
+        if posed:
+            # Rigs whose bones lie along one axis at rest (joint frames with x along the bone): the pose at rest is
+            # not a person standing, and only the frames say which way is up.
+            up_vec = up_t.mean(axis=0)
+            log.info("BVH file %s: the rest pose does not stand upright; up axis and stature from the frames", p)
+        if up_axis is None:
+            ax = int(np.argmax(np.abs(up_vec)))
+            sign = float(np.sign(up_vec[ax]) or 1.0)
+        else:
+            if up_axis.lstrip("+-") not in ("x", "y", "z"):
+                raise SourceError(f"up axis must be x, y or z (optionally signed), got '{up_axis}'")
+            ax, sign = "xyz".index(up_axis.lstrip("+-")), (-1.0 if up_axis.startswith("-") else 1.0)
+        # Ankle-to-head-joint height, ~87 % of stature: at rest, or the tallest over the frames.
+        height = float(np.max(np.abs(up_t[:, ax]))) if posed else float(abs(up_vec[ax]))
+        stature_units = height * 1.15
+        if scale_m is None:
+            fits = [s for s in UNIT_SCALES_M.values() if STATURE_RANGE_M[0] <= stature_units * s <= STATURE_RANGE_M[1]]
+            if not fits:
+                raise SourceError(f"BVH file {p}: stature {stature_units:.3g} file units fits none of the "
+                                  f"units {sorted(UNIT_SCALES_M)}; give the scale to metres")
+            scale_m = fits[0]
+        if not (np.isfinite(scale_m) and scale_m > 0):
+            raise SourceError(f"BVH scale to metres must be > 0, got {scale_m}")
+        self.scale_m = float(scale_m)
+        self.up_axis = ("+" if sign > 0 else "-") + "xyz"[ax]  # the file's up axis
+        self.frame_time_s = frame_time
+        self.stature_m = stature_units * self.scale_m
+        A = _axes_matrix(ax, sign)
+        q_axes = rot.quat_from_matrix(A)
+
+        # Our axes and metres; canonical segment orientations q(t) = (A R_file(t) A^T) ⊗ q_rest. A rest pose that
+        # does not stand cannot tell a segment's twist (rest_corrections takes a T- or A-pose's): the orientations
+        # then come from the joint positions, as a position-only source's (segment_frames.py).
         rest_ours = {canon: A @ rest[i] * self.scale_m for canon, i in idx.items()}
-        q_rest = rest_corrections(rest_ours)
+        q_rest = {} if posed else rest_corrections(rest_ours)
         pos = np.zeros((T, N_JOINTS, 3))
         quat = np.tile(rot.IDENTITY_WXYZ, (T, N_JOINTS, 1))
         conf = np.zeros((T, N_JOINTS))
@@ -277,6 +303,9 @@ class BvhRecording:
                 q_ours = rot.batch_multiply(rot.batch_multiply(qa, world_q[i]), qa_inv)
                 quat[:, k] = rot.batch_multiply(q_ours, np.tile(q_rest[canon], (T, 1)))
         fill_canonical(pos, quat, conf)
+        if posed:
+            quat = canonical_quats_from_positions(pos)
+        self.orientations_from_positions = posed
         n_bind = self.bind_frames_skipped = bind_blend_frames(pos, frame_time)
         if n_bind:
             log.info("BVH file %s: %d leading frame(s) blend from a bind pose; left out", p, n_bind)
