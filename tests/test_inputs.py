@@ -175,11 +175,12 @@ def _bones_along_x(text: str) -> str:
 
 
 @needs_cmu
-def test_a_bvh_whose_rest_pose_lays_every_bone_along_x_loads_as_the_same_motion(tmp_path):
+def test_a_bvh_whose_rest_pose_lays_every_bone_along_x_loads_as_the_same_motion(tmp_path, capsys):
     """Rigs with joint frames along their bones (x along the bone) lay every bone along x at rest: the rest pose says
     neither which way is up nor the file's units. The same CMU walk written that way loads with the same up axis,
     units and joint positions, its up axis and stature taken from the frames, its orientations from the joint
-    positions; before, its stature at rest (11.6 file units) fitted no unit and the file was refused."""
+    positions (and `stylesync inspect` says so); before, its stature at rest (11.6 file units) fitted no unit and the
+    file was refused."""
     original = BvhRecording(CMU / "02_01.bvh")
     path = tmp_path / "along_x.bvh"
     path.write_text(_bones_along_x((CMU / "02_01.bvh").read_text()))
@@ -187,6 +188,8 @@ def test_a_bvh_whose_rest_pose_lays_every_bone_along_x_loads_as_the_same_motion(
     assert (along_x.up_axis, along_x.scale_m) == (original.up_axis, original.scale_m)
     assert along_x.orientations_from_positions and not original.orientations_from_positions
     assert np.abs(along_x.performer.pos_world - original.performer.pos_world).max() < 1e-5
+    assert cli_main(["inspect", str(path)]) == 0
+    assert "from the frames (the rest pose does not stand" in capsys.readouterr().out
     hips = along_x.performer.pos_world[:, JOINT_INDEX["PELVIS"], 2]
     head = along_x.performer.pos_world[:, JOINT_INDEX["HEAD"], 2]
     assert np.all(head > hips + 0.3)  # standing: the head above the pelvis

@@ -395,8 +395,10 @@ def _inspect(args: argparse.Namespace) -> int:
     rec = BvhRecording(args.file, joint_map=jm, scale_m=args.bvh_scale, up_axis=args.up_axis)
     perf = rec.performer
     print(f"file: {rec.path}")
+    source = ("the frames (the rest pose does not stand; orientations from the joint positions)"
+              if rec.orientations_from_positions else "the rest pose")
     print(f"joints in file: {len(rec.joint_names)}; units: 1 file unit = {rec.scale_m:g} m; up axis: {rec.up_axis}; "
-          f"rest-pose stature {rec.stature_m:.2f} m")
+          f"stature {rec.stature_m:.2f} m; from {source}")
     print(f"frames: {len(perf.times_s)} at {1.0 / rec.frame_time_s:.1f} Hz, {perf.duration_s:.2f} s"
           + (f" ({rec.bind_frames_skipped} leading bind-pose frames left out)" if rec.bind_frames_skipped else ""))
     print("joint map (canonical <- file joint: how matched):")
