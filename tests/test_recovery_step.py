@@ -47,8 +47,9 @@ def traced_motion(**kwargs) -> MotionConfig:
     (``recovery_cross_nearest`` and ``recovery_cross_stance_frame`` off), a foot in the air stepping whatever
     its distance to the capture point (``recovery_landing_foot_waits`` off), and Eq. 10's fraction by side after a
     step of the character's own (``fraction_needs_feet_in_his_order`` off): their motion configurations start from
-    it."""
+    it. They were traced before a recovery step's timing adapted to its reach (``recovery_swing_min_s`` None)."""
     return MotionConfig(**{"swing_landing": "his_foot_now", "recovery_overdue_swing_horizon": False,
+                           "recovery_swing_min_s": None,
                            "recovery_cross_nearest": False, "recovery_cross_stance_frame": False,
                            "recovery_landing_foot_waits": False, "fraction_needs_feet_in_his_order": False,
                            **kwargs})
@@ -278,6 +279,67 @@ def _run(spec: str, seconds: float, motion: MotionConfig, seed: int = 0, control
     result = session.run()
     opened.source.close()
     return result, session
+
+
+def test_a_recovery_step_lands_when_its_capture_landing_would_leave_the_legs_reach():
+    """Step timing: the capture point runs ahead over the stance sole; the step's swing time shortens to when its
+    capture landing reaches the leg's reach (never below recovery_swing_min_s), where the landing then catches the
+    capture point on its sole's trailing edge. With the nominal time the landing is held at the reach, short of it."""
+    com, vel = np.array([0.15, -0.05, 0.8]), np.array([1.1, 0.0, 0.0])
+    stance = ANKLES["right"]
+    nominal = RecoveryStepper(traced_motion(), CHAR_LEG_LENGTH_M, G)
+    reach_s = nominal.time_to_reach_limit_s(com, vel, stance, IDENTITY, np.eye(3))
+    assert 0.0 < reach_s < nominal.cfg.recovery_swing_s
+    # At that time the unlimited landing is exactly at the reach: the landing there is not moved by the limit.
+    landing, xi_land = nominal.capture_landing(reach_s, com, vel, stance, IDENTITY, np.eye(3), "left")
+    assert np.hypot(*(landing - stance)[:2]) == pytest.approx(nominal.max_step_m, abs=1e-9)
+    assert stands_on(xi_land, stance, IDENTITY, landing, np.eye(3))
+    late, xi_late = nominal.capture_landing(nominal.cfg.recovery_swing_s, com, vel, stance, IDENTITY, np.eye(3),
+                                            "left")
+    assert not stands_on(xi_late, stance, IDENTITY, late, np.eye(3))
+    # Standing still over the sole the capture landing never leaves the reach; beyond it already, it has left it.
+    assert nominal.time_to_reach_limit_s(np.array([0.0, -0.1, 0.8]), np.zeros(3), stance, IDENTITY,
+                                         np.eye(3)) == np.inf
+    assert nominal.time_to_reach_limit_s(np.array([0.6, -0.1, 0.8]), vel, stance, IDENTITY, np.eye(3)) == 0.0
+
+    for min_s, expected_s in ((None, nominal.cfg.recovery_swing_s), (0.05, reach_s), (0.15, 0.15)):
+        stepper = RecoveryStepper(traced_motion(recovery_swing_min_s=min_s), CHAR_LEG_LENGTH_M, G)
+        step = stepper.take_over("left", 1.0, np.array([0.0, 0.1, 0.1]))
+        stepper.swing_target(1.0, com, vel, stance, IDENTITY, np.eye(3))
+        assert step.duration_s == pytest.approx(expected_s)
+        assert not stepper.landing_due(1.0 + 0.79 * expected_s)
+        assert stepper.landing_due(1.0 + 0.81 * expected_s)
+    with pytest.raises(ConfigError):
+        MotionConfig(recovery_swing_min_s=0.0)
+
+
+@pytest.mark.skipif(not (MOCAP / "cmu-dev" / "02_03.bvh").exists(),
+                    reason="../shared/mocap/cmu-dev/02_03.bvh is not available")
+def test_a_run_that_stops_comes_to_rest_on_steps_that_land_before_the_capture_point_leaves_the_reach(monkeypatch):
+    """CMU-dev 02_03 (a run; it ends at 1.41 s, then the operator holds his last pose), seed 0, as the development
+    suite runs it. The character stops from running speed on recovery steps. With their nominal 0.2 s each landed at
+    the leg's reach short of the capture point, and it fell in the rest (measured: at 4.30 s); landing when the
+    capture landing reaches the leg's reach, some of them sooner, it comes to rest."""
+    from stylesync.motion.recovery_step import RecoveryStepper
+
+    durations: list[float] = []
+    end = RecoveryStepper.end
+
+    def recorded(self, time_s):
+        if self.step is not None:
+            durations.append(self.step.duration_s)
+        end(self, time_s)
+
+    monkeypatch.setattr(RecoveryStepper, "end", recorded)
+    spec = f"bvh:{MOCAP / 'cmu-dev' / '02_03.bvh'}"
+    timed = suite_run(spec, 0, MotionConfig(), ControlConfig())
+    assert not timed.fell
+    assert any(d < MotionConfig().recovery_swing_s - 1e-9 for d in durations)
+    assert all(d >= MotionConfig().recovery_swing_min_s - 1e-9 for d in durations)
+    durations.clear()
+    nominal = suite_run(spec, 0, MotionConfig(recovery_swing_min_s=None), ControlConfig())
+    assert nominal.fell and nominal.fall_time_s is not None and nominal.fall_time_s > 1.41
+    assert all(d == MotionConfig().recovery_swing_s for d in durations)
 
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "08_01.bvh").exists(),

@@ -203,6 +203,12 @@ class MotionConfig:
     recovery_steps: bool = True
     recovery_step_margin_m: float = 0.02
     recovery_swing_s: float = 0.2
+    # Step timing: a recovery step lands when its capture landing would leave the leg's reach
+    # (RecoveryStepper.time_to_reach_limit_s), if that is sooner than recovery_swing_s, but no sooner than this
+    # after its start: a step that lands later lands short of the capture point, and the next one starts with it
+    # outside its support (docs/decisions.md, "Recovery steps that land before the capture point leaves the
+    # reach"). None: every recovery step takes recovery_swing_s [s].
+    recovery_swing_min_s: float | None = 0.1
     recovery_step_height_m: float = 0.05
     recovery_min_stance_s: float = 0.03
     # A recovery step's foot target comes down to the ground at this share of recovery_swing_s (and is then aimed
@@ -375,6 +381,8 @@ class MotionConfig:
             raise ConfigError(f"MotionConfig.capture_bound_sole_share must be within [0, 1], got "
                               f"{self.capture_bound_sole_share}")
         _positive("MotionConfig.recovery_swing_s", self.recovery_swing_s)
+        if self.recovery_swing_min_s is not None:
+            _positive("MotionConfig.recovery_swing_min_s", self.recovery_swing_min_s)
         if self.recovery_landing_gap_m is not None:
             _positive("MotionConfig.recovery_landing_gap_m", self.recovery_landing_gap_m)
         if not 0.0 < self.recovery_touchdown_share <= 1.0:

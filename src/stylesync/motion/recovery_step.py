@@ -232,6 +232,7 @@ class RecoveryStep:
     start_s: float
     lift_off_world: np.ndarray  # (3,) swing ankle at lift-off (or where it was when the step took a swing over)
     landing_world: np.ndarray  # (3,) the planned landing of the swing ankle, re-planned each tick
+    duration_s: float  # the swing's time: the nominal one, shortened while the capture point runs out of reach
     taken_over: bool = False  # the step took over a swing already in the air (it only lands it)
 
 
@@ -285,7 +286,7 @@ class RecoveryStepper:
                 stance = min(residual, key=lambda s: residual[s])
         side = _OTHER[stance]
         self.step = RecoveryStep(side, time_s, np.array(ankles_world[side], dtype=float),
-                                 np.array(ankles_world[side], dtype=float))
+                                 np.array(ankles_world[side], dtype=float), cfg.recovery_swing_s)
         self.count += 1
         return self.step
 
@@ -301,19 +302,33 @@ class RecoveryStepper:
         """Turn the swing of ``side``, in the air since the operator lifted it, into a recovery step that lands it
         (step timing adaptation: the balance decides when the step ends)."""
         ankle = np.array(swing_ankle_world, dtype=float)
-        self.step = RecoveryStep(side, time_s, ankle, ankle.copy(), taken_over=True)
+        self.step = RecoveryStep(side, time_s, ankle, ankle.copy(), self.cfg.recovery_swing_s, taken_over=True)
         self.count += 1
         return self.step
 
     def landing_due(self, time_s: float) -> bool:
         """Whether the step's foot is past its horizontal travel and should now be going down to the ground."""
-        return self.step is not None and time_s - self.step.start_s >= HORIZONTAL_SHARE * self.cfg.recovery_swing_s
+        return self.step is not None and time_s - self.step.start_s >= HORIZONTAL_SHARE * self.step.duration_s
 
     def end(self, time_s: float) -> None:
         """The step is over (the stance FSM saw the foot land, or the operator took over)."""
         if self.step is not None:
             self.step = None
             self._last_end_s = time_s
+
+    @staticmethod
+    def _landing_ankle(xi_land_world: np.ndarray, u: np.ndarray, heading_world: np.ndarray,
+                       walk_on_m: float | None) -> np.ndarray:
+        """(3,) the swing ankle's landing for the capture point ``xi_land_world`` (2,) there, ``u`` (3,) its direction
+        of divergence (unit, horizontal): the ankle ``walk_on_m`` behind it along ``u``, or (None) the sole's centre
+        beyond it along ``u`` by the sole's half-extent along ``u`` (ξ then lands on the sole's trailing edge, and
+        every centre of pressure on the sole drives it back) [m]."""
+        if walk_on_m is not None:
+            return np.array([xi_land_world[0], xi_land_world[1], 0.0]) - walk_on_m * u
+        u_heading = heading_world.T @ u
+        half_extent = abs(u_heading[0]) * FOOT_LENGTH_M / 2 + abs(u_heading[1]) * FOOT_WIDTH_M / 2
+        centre = np.array([xi_land_world[0], xi_land_world[1], 0.0]) + half_extent * u
+        return centre - heading_world @ np.array([FOOT_CENTER_AHEAD_OF_ANKLE_M, 0.0, 0.0])
 
     def capture_landing(self, remaining_s: float, com_world: np.ndarray, com_vel_world: np.ndarray,
                         stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray, heading_world: np.ndarray,
@@ -331,15 +346,7 @@ class RecoveryStepper:
         away = xi - cop
         norm = float(np.linalg.norm(away))
         u = np.array([*(away / norm), 0.0]) if norm > 1e-6 else np.zeros(3)  # ξ's direction of divergence
-        if walk_on_m is not None:
-            ankle = np.array([xi_land[0], xi_land[1], 0.0]) - walk_on_m * u
-        else:
-            # The sole's centre beyond ξ along u by the sole's half-extent along u: ξ lands on the sole's trailing
-            # edge, and every centre of pressure on the sole then drives it back.
-            u_heading = R.T @ u
-            half_extent = abs(u_heading[0]) * FOOT_LENGTH_M / 2 + abs(u_heading[1]) * FOOT_WIDTH_M / 2
-            centre = np.array([xi_land[0], xi_land[1], 0.0]) + half_extent * u
-            ankle = centre - R @ np.array([FOOT_CENTER_AHEAD_OF_ANKLE_M, 0.0, 0.0])
+        ankle = self._landing_ankle(xi_land, u, R, walk_on_m)
         # Within reach, and across the stance foot only as a crossover step (relative to the stance ankle, in the
         # stance sole's own yaw frame or the heading frame).
         base = np.array([stance_ankle_world[0], stance_ankle_world[1], 0.0])
@@ -355,6 +362,35 @@ class RecoveryStepper:
         landing[2] = ANKLE_HEIGHT_M
         return landing, xi_land
 
+    def time_to_reach_limit_s(self, com_world: np.ndarray, com_vel_world: np.ndarray,
+                              stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray,
+                              heading_world: np.ndarray, walk_on_m: float | None = None) -> float:
+        """How long from now the capture landing (:meth:`capture_landing`, before its reach limit) stays within the
+        step's reach of the stance ankle: the τ >= 0 at which ``|a + b e^(ω τ)| = max_step_m``, with ``a`` the
+        landing's offset from the stance ankle when the capture point is on the centre of pressure and ``b = ξ - p``
+        (Eq. 21's pendulum, the centre of pressure ``p`` held at the stance sole's point nearest ξ); 0 when it is
+        already beyond reach, infinity when it never leaves it [s]. A step that lands later lands short of the
+        capture point, and the next step then starts with the capture point outside its support."""
+        xi, omega = capture_point(com_world, com_vel_world, self.g)
+        _, cop = outside_distance_m(xi, convex_hull_xy(sole_corners_world(stance_ankle_world,
+                                                                          stance_foot_quat_wxyz)[:, :2]))
+        b = xi - cop
+        norm = float(np.linalg.norm(b))
+        if norm < 1e-6:
+            return math.inf
+        u = np.array([*(b / norm), 0.0])
+        a = (self._landing_ankle(cop, u, heading_world, walk_on_m)[:2]
+             - np.asarray(stance_ankle_world, dtype=float)[:2])
+        # |a + b s|² = L² for s = e^(ω τ) >= 1: s² |b|² + 2 s a·b + |a|² - L² = 0, the larger root.
+        bb, ab, c = norm * norm, float(a @ b), float(a @ a) - self.max_step_m ** 2
+        disc = ab * ab - bb * c
+        if disc < 0.0:
+            return math.inf  # the landing's line never meets the reach circle ahead of the stance ankle
+        s = (-ab + math.sqrt(disc)) / bb
+        if s <= 0.0:
+            return math.inf
+        return max(math.log(s) / omega, 0.0) if s >= 1.0 else 0.0
+
     def swing_target(self, time_s: float, com_world: np.ndarray, com_vel_world: np.ndarray,
                      stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray,
                      heading_world: np.ndarray, walk_on_m: float | None = None) -> np.ndarray:
@@ -364,11 +400,17 @@ class RecoveryStepper:
         step, cfg = self.step, self.cfg
         assert step is not None
         elapsed = time_s - step.start_s
-        landing, _ = self.capture_landing(max(cfg.recovery_swing_s - elapsed, 0.0), com_world, com_vel_world,
+        if cfg.recovery_swing_min_s is not None and elapsed < step.duration_s:
+            # Step timing: the step lands no later than when its capture landing leaves the leg's reach (and no
+            # sooner than the shortest swing); the duration only shortens.
+            reach_s = self.time_to_reach_limit_s(com_world, com_vel_world, stance_ankle_world,
+                                                 stance_foot_quat_wxyz, heading_world, walk_on_m)
+            step.duration_s = min(step.duration_s, max(elapsed + reach_s, cfg.recovery_swing_min_s))
+        landing, _ = self.capture_landing(max(step.duration_s - elapsed, 0.0), com_world, com_vel_world,
                                           stance_ankle_world, stance_foot_quat_wxyz, heading_world, step.side,
                                           walk_on_m)
         step.landing_world = landing
-        phase = elapsed / cfg.recovery_swing_s
+        phase = elapsed / step.duration_s
         moved = smooth_step(min(phase / HORIZONTAL_SHARE, 1.0))
         target = step.lift_off_world + moved * (landing - step.lift_off_world)
         if phase < 1.0 and step.taken_over:
