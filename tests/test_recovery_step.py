@@ -1037,10 +1037,12 @@ def test_a_swing_past_its_usual_time_is_landed_before_the_capture_point_runs_out
                                                            state.link_quat_wxyz[stance])))
             return on_tick
 
-        # traced before the joints' no-load speed (with it, the late swing's run also comes to rest) and before Eq.
-        # 10's fraction from the rear foot to the front one after the character's own step (with it, too)
+        # traced before the joints' no-load speed (with it, the late swing's run also comes to rest), before Eq.
+        # 10's fraction from the rear foot to the front one after the character's own step (with it, too) and before
+        # a recovery step's timing adapted to its reach (with it, too)
         control = ControlConfig(whole_body=WholeBodyConfig(joint_speed_limit_rad_s=None))
-        motion = MotionConfig(recovery_overdue_swing_horizon=flag, fraction_needs_feet_in_his_order=False)
+        motion = MotionConfig(recovery_overdue_swing_horizon=flag, fraction_needs_feet_in_his_order=False,
+                              recovery_swing_min_s=None)
         return taken, suite_run(spec, 7, motion, control, watch=watch)
 
     taken, result = run(True)
@@ -1232,8 +1234,10 @@ def test_a_recovery_step_whose_landing_is_due_is_pressed_onto_the_ground():
     0.08 s) and the run stands. Traced with landings short of the crossover clearance moved outwards in the heading
     frame (MotionConfig.recovery_cross_nearest and recovery_cross_stance_frame off; with the first, one of three
     landings waits 0.29 s, and the run stands), before the joints' no-load speed (with it, no recovery step of this
-    run has a landing falling due) and with Eq. 10's fraction by side after a step of the character's own
-    (MotionConfig.fraction_needs_feet_in_his_order off)."""
+    run has a landing falling due), with Eq. 10's fraction by side after a step of the character's own
+    (MotionConfig.fraction_needs_feet_in_his_order off), and with every recovery step's nominal time
+    (MotionConfig.recovery_swing_min_s None: a step shortened to land before the capture point leaves the reach is due
+    sooner, while its foot is still on its way, and that configuration's landings then wait up to 0.17 s)."""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '08_08.bvh'}"
 
     def run(landing_weight: float):
@@ -1252,7 +1256,7 @@ def test_a_recovery_step_whose_landing_is_due_is_pressed_onto_the_ground():
             last_tick_s[0] = state.time_s
 
         result = suite_run(spec, 1, MotionConfig(recovery_cross_nearest=False, recovery_cross_stance_frame=False,
-                                                 fraction_needs_feet_in_his_order=False),
+                                                 fraction_needs_feet_in_his_order=False, recovery_swing_min_s=None),
                            ControlConfig(whole_body=WholeBodyConfig(recovery_foot_landing_weight=landing_weight,
                                                                     joint_speed_limit_rad_s=None)),
                            on_tick=on_tick)

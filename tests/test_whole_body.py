@@ -275,10 +275,12 @@ def test_a_light_link_does_not_spin_up_within_a_control_tick():
     """The built-in dance_a, seed 2 (the development suite's settings): at 3.45-3.54 s a reference jump's torques,
     held over the control tick, spun the feet and hands to 26 m/s with the pelvis at 0.8 m: "the motion diverged"
     at 3.54 s (measured). With the joints' no-load speed the run completes its 12 s. Traced with Eq. 10's fraction
-    by side after a step of the character's own (MotionConfig.fraction_needs_feet_in_his_order off)."""
+    by side after a step of the character's own (MotionConfig.fraction_needs_feet_in_his_order off) and every
+    recovery step's nominal time (MotionConfig.recovery_swing_min_s None)."""
     def run(limit):
         control = ControlConfig(whole_body=WholeBodyConfig(joint_speed_limit_rad_s=limit))
-        return suite_run("builtin:dance_a", 2, MotionConfig(fraction_needs_feet_in_his_order=False), control)
+        motion = MotionConfig(fraction_needs_feet_in_his_order=False, recovery_swing_min_s=None)
+        return suite_run("builtin:dance_a", 2, motion, control)
 
     unlimited, limited = run(None), run(30.0)
     assert unlimited.fell and "diverged" in unlimited.fall_reason and unlimited.fall_time_s < 4.0
