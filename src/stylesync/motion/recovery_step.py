@@ -376,20 +376,21 @@ class RecoveryStepper:
                                                                           stance_foot_quat_wxyz)[:, :2]))
         b = xi - cop
         norm = float(np.linalg.norm(b))
-        if norm < 1e-6:
-            return math.inf
-        u = np.array([*(b / norm), 0.0])
+        u = np.array([*(b / norm), 0.0]) if norm > 1e-6 else np.zeros(3)
         a = (self._landing_ankle(cop, u, heading_world, walk_on_m)[:2]
              - np.asarray(stance_ankle_world, dtype=float)[:2])
-        # |a + b s|² = L² for s = e^(ω τ) >= 1: s² |b|² + 2 s a·b + |a|² - L² = 0, the larger root.
+        # Within reach while |a + b s|² - L² = s² |b|² + 2 s a·b + |a|² - L² <= 0, s = e^(ω τ) >= 1 (now: s = 1):
+        # between the roots.
         bb, ab, c = norm * norm, float(a @ b), float(a @ a) - self.max_step_m ** 2
+        if norm <= 1e-6:
+            return math.inf if c <= 0.0 else 0.0  # ξ on the centre of pressure: the landing stays where it is
         disc = ab * ab - bb * c
         if disc < 0.0:
-            return math.inf  # the landing's line never meets the reach circle ahead of the stance ankle
-        s = (-ab + math.sqrt(disc)) / bb
-        if s <= 0.0:
-            return math.inf
-        return max(math.log(s) / omega, 0.0) if s >= 1.0 else 0.0
+            return 0.0  # the landing's line never comes within reach
+        s_low, s_high = (-ab - math.sqrt(disc)) / bb, (-ab + math.sqrt(disc)) / bb
+        if not s_low <= 1.0 <= s_high:
+            return 0.0  # beyond reach now
+        return math.log(s_high) / omega
 
     def swing_target(self, time_s: float, com_world: np.ndarray, com_vel_world: np.ndarray,
                      stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray,
