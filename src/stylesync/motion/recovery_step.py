@@ -35,10 +35,14 @@ own:
   it touches (the stance FSM ends the step on its contact); the whole-body controller tracks that target with a
   task of its own (``ReferencePose.recovery_ankle_world``).
 
-The step's timing is the nominal swing time; its position is what adapts, each tick, to the capture point. A
-swing of the operator's that he holds up too long while the character cannot stand on one foot, or that would land
-at his pace only once the capture point is out of a step's reach, is taken over by such a step in the air
-(:meth:`RecoveryStepper.take_over`, pose_optimization.py): the foot is lowered from where it is.
+The step's timing is the nominal swing time (``recovery_swing_s``) as long as its capture landing stays within the
+leg's reach; otherwise it is shortened, each tick, to when that landing would leave the reach
+(:meth:`RecoveryStepper.time_to_reach_limit_s`), but to no less than ``recovery_swing_min_s``: landing later, the step
+would land short of the capture point, and the next one would start with it outside its support. Its position and its
+timing both adapt to the capture point. A swing of the operator's that he holds up too long while the character cannot
+stand on one foot, or that would land at his pace only once the capture point is out of a step's reach, is taken over
+by such a step in the air (:meth:`RecoveryStepper.take_over`, pose_optimization.py): the foot is lowered from where it
+is.
 """
 
 from __future__ import annotations
