@@ -25,7 +25,6 @@ from pathlib import Path
 
 import numpy as np
 
-from stylesync.config import MotionConfig
 from stylesync.metrics.dev_suite import clip_specs, suite_config
 from stylesync.motion.recovery_step import capture_point
 from stylesync.session import Session
@@ -34,7 +33,6 @@ from stylesync.sources.registry import open_source
 MOCAP = Path(__file__).resolve().parents[2] / "shared" / "mocap"
 CLIPS = "131_01,131_02,08_07,stealthy_walk,zombie_walk,07_11,08_08,10_04,09_06,09_11,jog,run,131_03,dance_b"
 DURATION_BINS_S = (0.0, 0.22, 0.25, 0.3, np.inf)
-NOMINAL_SWING_S = MotionConfig().recovery_swing_s
 
 
 def watch_steps(session: Session) -> list[dict]:
@@ -70,6 +68,7 @@ def watch_steps(session: Session) -> list[dict]:
             direction = travel / norm if norm > 1e-6 else np.zeros(2)
             steps.append({"taken_over": record["taken_over"], "duration_s": record["elapsed_s"],
                           "planned_s": record["planned_s"],
+                          "shortened": record["planned_s"] < stepper.cfg.recovery_swing_s,
                           "overshoot_m": float((record["xi"] - record["predicted"]) @ direction)})
         plan_end(time_s)
 
@@ -107,7 +106,7 @@ def main() -> None:
         durations = np.array([s["duration_s"] for s in group])
         overshoot = np.array([s["overshoot_m"] for s in group])
         planned = np.array([s["planned_s"] for s in group])
-        shortened = planned < NOMINAL_SWING_S - 1e-9
+        shortened = np.array([s["shortened"] for s in group])
         print(f"{label}: {len(group)} steps; duration p10/p50/p90 "
               f"{' / '.join(f'{v:.3f}' for v in np.percentile(durations, [10, 50, 90]))} s; "
               f"overshoot p10/p50/p90 {' / '.join(f'{v:+.3f}' for v in np.percentile(overshoot, [10, 50, 90]))} m; "

@@ -228,6 +228,18 @@ def not_across(landing_world: np.ndarray, stance_ankle_world: np.ndarray, frame_
     return landing
 
 
+@dataclass(frozen=True)
+class _OverStance:
+    """The linear inverted pendulum over a stance sole (world frame, horizontal) [m, 1/s]."""
+
+    xi: np.ndarray  # (2,) the capture point
+    omega: float  # sqrt(g / h)
+    cop: np.ndarray  # (2,) the centre of pressure: the sole's point nearest xi
+    away: np.ndarray  # (2,) xi - cop
+    norm: float  # |xi - cop|
+    u: np.ndarray  # (3,) xi's direction of divergence from cop (unit; zero when xi is on the sole)
+
+
 @dataclass
 class RecoveryStep:
     """A step the character takes on its own (world frame) [m, s]."""
@@ -334,6 +346,18 @@ class RecoveryStepper:
         centre = np.array([xi_land_world[0], xi_land_world[1], 0.0]) + half_extent * u
         return centre - heading_world @ np.array([FOOT_CENTER_AHEAD_OF_ANKLE_M, 0.0, 0.0])
 
+    def _over_stance(self, com_world: np.ndarray, com_vel_world: np.ndarray, stance_ankle_world: np.ndarray,
+                     stance_foot_quat_wxyz: np.ndarray) -> _OverStance:
+        """The pendulum over the stance sole (Eq. 21): the capture point ξ, ω, the centre of pressure p held at the
+        sole's point nearest ξ, and ξ's direction of divergence from p."""
+        xi, omega = capture_point(com_world, com_vel_world, self.g)
+        _, cop = outside_distance_m(xi, convex_hull_xy(sole_corners_world(stance_ankle_world,
+                                                                          stance_foot_quat_wxyz)[:, :2]))
+        away = xi - cop
+        norm = float(np.linalg.norm(away))
+        u = np.array([*(away / norm), 0.0]) if norm > 1e-6 else np.zeros(3)
+        return _OverStance(xi, omega, cop, away, norm, u)
+
     def capture_landing(self, remaining_s: float, com_world: np.ndarray, com_vel_world: np.ndarray,
                         stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray, heading_world: np.ndarray,
                         side: str, walk_on_m: float | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -342,15 +366,17 @@ class RecoveryStepper:
         point (2,) [m]. With ``walk_on_m``, instead, the capture point that far ahead of the ankle, along its
         direction of divergence: a step that walks on, as a gait's lands behind its capture point [m].
         ``heading_world``: (3, 3) the heading frame's rotation (x forward, y left)."""
-        xi, omega = capture_point(com_world, com_vel_world, self.g)
-        _, cop = outside_distance_m(xi, convex_hull_xy(sole_corners_world(stance_ankle_world,
-                                                                          stance_foot_quat_wxyz)[:, :2]))
-        xi_land = cop + (xi - cop) * np.exp(omega * remaining_s)
+        over = self._over_stance(com_world, com_vel_world, stance_ankle_world, stance_foot_quat_wxyz)
+        return self._landing_over(over, remaining_s, stance_ankle_world, stance_foot_quat_wxyz, heading_world, side,
+                                  walk_on_m)
+
+    def _landing_over(self, over: _OverStance, remaining_s: float, stance_ankle_world: np.ndarray,
+                      stance_foot_quat_wxyz: np.ndarray, heading_world: np.ndarray, side: str,
+                      walk_on_m: float | None) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`capture_landing` of the pendulum ``over`` the stance sole."""
+        xi_land = over.cop + over.away * np.exp(over.omega * remaining_s)
         R = heading_world
-        away = xi - cop
-        norm = float(np.linalg.norm(away))
-        u = np.array([*(away / norm), 0.0]) if norm > 1e-6 else np.zeros(3)  # ξ's direction of divergence
-        ankle = self._landing_ankle(xi_land, u, R, walk_on_m)
+        ankle = self._landing_ankle(xi_land, over.u, R, walk_on_m)
         # Within reach, and across the stance foot only as a crossover step (relative to the stance ankle, in the
         # stance sole's own yaw frame or the heading frame).
         base = np.array([stance_ankle_world[0], stance_ankle_world[1], 0.0])
@@ -375,13 +401,14 @@ class RecoveryStepper:
         (Eq. 21's pendulum, the centre of pressure ``p`` held at the stance sole's point nearest ξ); 0 when it is
         already beyond reach, infinity when it never leaves it [s]. A step that lands later lands short of the
         capture point, and the next step then starts with the capture point outside its support."""
-        xi, omega = capture_point(com_world, com_vel_world, self.g)
-        _, cop = outside_distance_m(xi, convex_hull_xy(sole_corners_world(stance_ankle_world,
-                                                                          stance_foot_quat_wxyz)[:, :2]))
-        b = xi - cop
-        norm = float(np.linalg.norm(b))
-        u = np.array([*(b / norm), 0.0]) if norm > 1e-6 else np.zeros(3)
-        a = (self._landing_ankle(cop, u, heading_world, walk_on_m)[:2]
+        over = self._over_stance(com_world, com_vel_world, stance_ankle_world, stance_foot_quat_wxyz)
+        return self._reach_time_over(over, stance_ankle_world, heading_world, walk_on_m)
+
+    def _reach_time_over(self, over: _OverStance, stance_ankle_world: np.ndarray, heading_world: np.ndarray,
+                         walk_on_m: float | None) -> float:
+        """:meth:`time_to_reach_limit_s` of the pendulum ``over`` the stance sole [s]."""
+        b, norm = over.away, over.norm
+        a = (self._landing_ankle(over.cop, over.u, heading_world, walk_on_m)[:2]
              - np.asarray(stance_ankle_world, dtype=float)[:2])
         # Within reach while |a + b s|² - L² = s² |b|² + 2 s a·b + |a|² - L² <= 0, s = e^(ω τ) >= 1 (now: s = 1):
         # between the roots.
@@ -394,7 +421,7 @@ class RecoveryStepper:
         s_low, s_high = (-ab - math.sqrt(disc)) / bb, (-ab + math.sqrt(disc)) / bb
         if not s_low <= 1.0 <= s_high:
             return 0.0  # beyond reach now
-        return math.log(s_high) / omega
+        return math.log(s_high) / over.omega
 
     def swing_target(self, time_s: float, com_world: np.ndarray, com_vel_world: np.ndarray,
                      stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray,
@@ -405,15 +432,14 @@ class RecoveryStepper:
         step, cfg = self.step, self.cfg
         assert step is not None
         elapsed = time_s - step.start_s
+        over = self._over_stance(com_world, com_vel_world, stance_ankle_world, stance_foot_quat_wxyz)
         if cfg.recovery_swing_min_s is not None and elapsed < step.duration_s:
             # Step timing: the step lands no later than when its capture landing leaves the leg's reach (and no
             # sooner than the shortest swing); the duration only shortens.
-            reach_s = self.time_to_reach_limit_s(com_world, com_vel_world, stance_ankle_world,
-                                                 stance_foot_quat_wxyz, heading_world, walk_on_m)
+            reach_s = self._reach_time_over(over, stance_ankle_world, heading_world, walk_on_m)
             step.duration_s = min(step.duration_s, max(elapsed + reach_s, cfg.recovery_swing_min_s))
-        landing, _ = self.capture_landing(max(step.duration_s - elapsed, 0.0), com_world, com_vel_world,
-                                          stance_ankle_world, stance_foot_quat_wxyz, heading_world, step.side,
-                                          walk_on_m)
+        landing, _ = self._landing_over(over, max(step.duration_s - elapsed, 0.0), stance_ankle_world,
+                                        stance_foot_quat_wxyz, heading_world, step.side, walk_on_m)
         step.landing_world = landing
         phase = elapsed / step.duration_s
         moved = smooth_step(min(phase / HORIZONTAL_SHARE, 1.0))
