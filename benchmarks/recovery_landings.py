@@ -45,16 +45,16 @@ def watch_steps(session: Session) -> list[dict]:
     record: dict = {}  # the step under way (its object, its first capture point and predicted landing one)
 
     def swing_target(time_s, com_world, com_vel_world, stance_ankle_world, stance_foot_quat_wxyz, heading_world,
-                     walk_on_m=None):
+                     walk_on=None):
         step = stepper.step
         elapsed_s = time_s - step.start_s
         xi, _ = capture_point(com_world, com_vel_world, stepper.g)
         target = plan_target(time_s, com_world, com_vel_world, stance_ankle_world, stance_foot_quat_wxyz,
-                             heading_world, walk_on_m)
+                             heading_world, walk_on)
         if record.get("step") is not step:  # its first tick: where the landing is planned for
             remaining_s = max(step.duration_s - elapsed_s, 0.0)
             _, xi_land = stepper.capture_landing(remaining_s, com_world, com_vel_world, stance_ankle_world,
-                                                 stance_foot_quat_wxyz, heading_world, step.side, walk_on_m)
+                                                 stance_foot_quat_wxyz, heading_world, step.side, walk_on)
             record.clear()
             record.update(step=step, taken_over=step.taken_over, xi0=xi[:2].copy(),
                           predicted=np.asarray(xi_land[:2], dtype=float).copy())

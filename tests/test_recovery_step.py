@@ -20,6 +20,7 @@ from stylesync.motion.pose_optimization import CHAR_LEG_LENGTH_M, LANDING_REACH
 from stylesync.motion.recovery_step import (
     MIN_FOOT_SEPARATION_M,
     RecoveryStepper,
+    WalkOn,
     beyond_sole_towards_m,
     capture_point,
     not_across,
@@ -134,11 +135,35 @@ def test_a_step_that_walks_on_lands_behind_the_capture_point():
     stepper = RecoveryStepper(traced_motion(), CHAR_LEG_LENGTH_M, G)
     com, vel = np.array([0.1, 0.1, 0.8]), np.array([0.6, 0.0, 0.0])  # walking forwards over the left foot
     stop, xi_land = stepper.capture_landing(0.2, com, vel, ANKLES["left"], IDENTITY, np.eye(3), "right")
-    walk, xi_walk = stepper.capture_landing(0.2, com, vel, ANKLES["left"], IDENTITY, np.eye(3), "right", 0.1)
+    walk, xi_walk = stepper.capture_landing(0.2, com, vel, ANKLES["left"], IDENTITY, np.eye(3), "right",
+                                            WalkOn(0.1))
     assert xi_walk == pytest.approx(xi_land)
     assert walk[0] == pytest.approx(xi_land[0] - 0.1, abs=1e-9)  # the ankle 0.1 m behind the capture point
     assert stop[0] > xi_land[0]  # the stopping step's ankle beyond it (the sole's trailing edge on it)
     assert walk[1] == pytest.approx(stop[1])  # sideways, the same clearance from the stance foot
+
+
+def test_a_step_that_walks_on_his_way_walks_on_only_along_it():
+    """MotionConfig.recovery_walk_on_his_way: the capture point lands ahead of the ankle only along the operator's way
+    over the ground, by the share of its divergence that goes that way; a divergence across his way is caught on the
+    ankle, where walking on along the divergence carries a sideways drift into the next step."""
+    stepper = RecoveryStepper(traced_motion(), CHAR_LEG_LENGTH_M, G)
+    way = np.array([1.0, 0.0, 0.0])
+    # Diverging forwards and to the right (45°) over the left foot, the right foot to land.
+    com, vel = np.array([0.1, 0.0, 0.8]), np.array([0.5, -0.5, 0.0])
+    own, xi_land = stepper.capture_landing(0.2, com, vel, ANKLES["left"], IDENTITY, np.eye(3), "right",
+                                           WalkOn(0.1))
+    his, xi_his = stepper.capture_landing(0.2, com, vel, ANKLES["left"], IDENTITY, np.eye(3), "right",
+                                          WalkOn(0.1, way))
+    assert xi_his == pytest.approx(xi_land)
+    u = (xi_land - own[:2]) / 0.1  # along the divergence from the stance sole, sideways too
+    assert np.linalg.norm(u) == pytest.approx(1.0) and u[0] > 0.3 and u[1] < -0.3
+    assert his[0] == pytest.approx(xi_land[0] - 0.1 * u[0], abs=1e-9)  # along his way: its share of the divergence
+    assert his[1] == pytest.approx(xi_land[1], abs=1e-9)  # across it: the capture point on the ankle
+    # Diverging against his way (thrown back): no walk-on at all.
+    back = WalkOn(0.1, -way)
+    assert back.ahead_world(np.array([1.0, 0.0, 0.0])) == pytest.approx(np.zeros(3))
+    assert WalkOn(0.1, way).ahead_world(np.array([0.0, 1.0, 0.0])) == pytest.approx(np.zeros(3))
 
 
 def test_a_foot_in_the_air_that_a_step_would_take_back_from_the_capture_point_is_left_to_land():

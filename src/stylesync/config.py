@@ -336,6 +336,10 @@ class MotionConfig:
     # this far ahead of its ankle instead of on its sole's trailing edge: a step that walks on with him rather than
     # one that stops the body (recovery_step.capture_landing). None: every recovery step stops it [m].
     recovery_walk_on_m: float | None = None
+    # The walk-on above along the operator's way over the ground (his COM's direction of motion), as far as the
+    # capture point diverges that way; across it the step catches the body on its ankle (recovery_step.WalkOn).
+    # False: along the capture point's own divergence, which carries a sideways drift on from step to step.
+    recovery_walk_on_his_way: bool = False
     # Following the operator over the ground (motion/path_feedback.py): the swing's landing relative to the
     # character's capture point is moved so that a step removes this share of the capture point's error from his,
     # scaled onto the character's path from where both started (the divergent component of motion: 1 removes it

@@ -51,6 +51,7 @@ from stylesync.motion.operator_analysis import UPPER_JOINTS, OperatorAnalysis, a
 from stylesync.motion.path_feedback import PathReference
 from stylesync.motion.recovery_step import (
     RecoveryStepper,
+    WalkOn,
     beyond_sole_towards_m,
     capture_point,
     capture_point_after,
@@ -88,6 +89,8 @@ _BALL_JOINTS = [k for k, j in enumerate(JOINTS) if j.kind is JointKind.BALL]
 _HINGE_JOINTS = [k for k, j in enumerate(JOINTS) if j.kind is not JointKind.BALL]
 _VELOCITY_SMOOTHING = 0.2  # per tick, exponential average of the desired COM velocity
 _SIDE_UP = {"left": "LEFT", "right": "RIGHT"}
+# Below this COM speed the operator's way over the ground is his heading, not his velocity's direction [m/s]
+_HIS_WAY_MIN_SPEED_MPS = 0.1
 _OTHER_SIDE = {"left": "right", "right": "left"}
 _LINK = {n: i for i, n in enumerate(LINK_NAMES)}
 _ROOT_LINK = _LINK["root"]
@@ -562,12 +565,9 @@ class MotionOptimizer:
                 other = _OTHER_SIDE[side]
                 com_vel = (mass.com_velocity_carried(state, LEG_LINKS[side], _ROOT_LINK)
                            if self.cfg.recovery_landing_without_swing else tick.com_vel_c)
-                walk_on = self.cfg.recovery_walk_on_m
-                if walk_on is not None and self._operator_stands(tick):
-                    walk_on = None  # he stands: the step stops the body
                 tick.targets[side] = self.recovery.swing_target(
                     state.time_s, tick.com_c, com_vel, tick.a_c[other],
-                    state.link_quat_wxyz[_LINK[f"{other}_ankle"]], tick.R_root_d, walk_on)
+                    state.link_quat_wxyz[_LINK[f"{other}_ankle"]], tick.R_root_d, self._walk_on(tick))
                 tick.foot_yaw[side] = (float(np.arctan2(tick.R_root_d[1, 0], tick.R_root_d[0, 0]))
                                        if self.cfg.foot_yaw_control  # along the heading, as its landing is planned
                                        else rot.twist_angle(state.link_quat_wxyz[_LINK[f"{side}_ankle"]], _UP))
@@ -609,6 +609,20 @@ class MotionOptimizer:
                 above_foot = max(float(np.sqrt(max(_LANDING_REACH_M * _LANDING_REACH_M - d2, 0.0))),
                                  self._landing_pelvis_floor_m)
                 tick.pelvis_d[2] = min(tick.pelvis_d[2], tick.targets[side][2] + above_foot)
+
+    def _walk_on(self, tick: _Tick) -> WalkOn | None:
+        """How the character's own step lands while the operator walks (recovery_step.WalkOn): None while he stands
+        (the step stops the body) or with MotionConfig.recovery_walk_on_m None; along his way over the ground (his
+        COM's horizontal velocity, or his heading when he barely moves) with recovery_walk_on_his_way."""
+        distance_m = self.cfg.recovery_walk_on_m
+        if distance_m is None or self._operator_stands(tick):
+            return None
+        if not self.cfg.recovery_walk_on_his_way:
+            return WalkOn(distance_m)
+        v = np.array([tick.com_vel_h[0], tick.com_vel_h[1], 0.0])
+        speed = float(np.linalg.norm(v))
+        way = v / speed if speed >= _HIS_WAY_MIN_SPEED_MPS else tick.R_root_d[:, 0] * np.array([1.0, 1.0, 0.0])
+        return WalkOn(distance_m, way / max(float(np.linalg.norm(way)), 1e-9))
 
     def _record_his_landing(self, tick: _Tick) -> None:
         """On the tick the operator lands a foot: its offset from his capture point, scaled, in his heading frame

@@ -90,6 +90,24 @@ _OUT = {"left": 1.0, "right": -1.0}
 _UP = np.array([0.0, 0.0, 1.0])  # world up (Z)
 
 
+@dataclass(frozen=True)
+class WalkOn:
+    """A recovery step that walks on (MotionConfig.recovery_walk_on_m): it lands with the capture point
+    ``distance_m`` ahead of its ankle, as a gait's foot lands behind its capture point, instead of on its sole's
+    trailing edge. Along ``way_world`` ((3,) unit, horizontal: the operator's way over the ground,
+    MotionConfig.recovery_walk_on_his_way), only as far as the capture point diverges that way: across it the
+    step catches the body on its ankle. None: along the capture point's own divergence from the stance sole."""
+
+    distance_m: float
+    way_world: np.ndarray | None = None
+
+    def ahead_world(self, u: np.ndarray) -> np.ndarray:
+        """(3,) the capture point's offset ahead of the landing ankle for its divergence ``u`` (3,) (unit) [m]."""
+        if self.way_world is None:
+            return self.distance_m * u
+        return self.distance_m * max(float(u @ self.way_world), 0.0) * self.way_world
+
+
 def capture_point(com_world: np.ndarray, com_vel_world: np.ndarray, gravity_mps2: float) -> tuple[np.ndarray, float]:
     """ξ = c + ċ / ω (horizontal, (2,)) [m] and ω = sqrt(g / h) [1/s] of the linear inverted pendulum (Eq. 21),
     h the COM height above the ground."""
@@ -334,13 +352,13 @@ class RecoveryStepper:
 
     @staticmethod
     def _landing_ankle(xi_land_world: np.ndarray, u: np.ndarray, heading_world: np.ndarray,
-                       walk_on_m: float | None) -> np.ndarray:
+                       walk_on: WalkOn | None) -> np.ndarray:
         """(3,) the swing ankle's landing for the capture point ``xi_land_world`` (2,) there, ``u`` (3,) its direction
-        of divergence (unit, horizontal): the ankle ``walk_on_m`` behind it along ``u``, or (None) the sole's centre
+        of divergence (unit, horizontal): behind it as ``walk_on`` says (:class:`WalkOn`), or (None) the sole's centre
         beyond it along ``u`` by the sole's half-extent along ``u`` (ξ then lands on the sole's trailing edge, and
         every centre of pressure on the sole drives it back) [m]."""
-        if walk_on_m is not None:
-            return np.array([xi_land_world[0], xi_land_world[1], 0.0]) - walk_on_m * u
+        if walk_on is not None:
+            return np.array([xi_land_world[0], xi_land_world[1], 0.0]) - walk_on.ahead_world(u)
         u_heading = heading_world.T @ u
         half_extent = abs(u_heading[0]) * FOOT_LENGTH_M / 2 + abs(u_heading[1]) * FOOT_WIDTH_M / 2
         centre = np.array([xi_land_world[0], xi_land_world[1], 0.0]) + half_extent * u
@@ -360,23 +378,23 @@ class RecoveryStepper:
 
     def capture_landing(self, remaining_s: float, com_world: np.ndarray, com_vel_world: np.ndarray,
                         stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray, heading_world: np.ndarray,
-                        side: str, walk_on_m: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+                        side: str, walk_on: WalkOn | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Where the ``side`` ankle lands (3,) so that the capture point, ``remaining_s`` from now, is on the
         trailing edge of its sole (within reach, across the stance foot only as a crossover step), and that capture
-        point (2,) [m]. With ``walk_on_m``, instead, the capture point that far ahead of the ankle, along its
-        direction of divergence: a step that walks on, as a gait's lands behind its capture point [m].
+        point (2,) [m]. With ``walk_on``, instead, the capture point ahead of the ankle (:class:`WalkOn`): a step that
+        walks on, as a gait's lands behind its capture point.
         ``heading_world``: (3, 3) the heading frame's rotation (x forward, y left)."""
         over = self._over_stance(com_world, com_vel_world, stance_ankle_world, stance_foot_quat_wxyz)
         return self._landing_over(over, remaining_s, stance_ankle_world, stance_foot_quat_wxyz, heading_world, side,
-                                  walk_on_m)
+                                  walk_on)
 
     def _landing_over(self, over: _OverStance, remaining_s: float, stance_ankle_world: np.ndarray,
                       stance_foot_quat_wxyz: np.ndarray, heading_world: np.ndarray, side: str,
-                      walk_on_m: float | None) -> tuple[np.ndarray, np.ndarray]:
+                      walk_on: WalkOn | None) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`capture_landing` of the pendulum ``over`` the stance sole."""
         xi_land = over.cop + over.away * np.exp(over.omega * remaining_s)
         R = heading_world
-        ankle = self._landing_ankle(xi_land, over.u, R, walk_on_m)
+        ankle = self._landing_ankle(xi_land, over.u, R, walk_on)
         # Within reach, and across the stance foot only as a crossover step (relative to the stance ankle, in the
         # stance sole's own yaw frame or the heading frame).
         base = np.array([stance_ankle_world[0], stance_ankle_world[1], 0.0])
@@ -394,7 +412,7 @@ class RecoveryStepper:
 
     def time_to_reach_limit_s(self, com_world: np.ndarray, com_vel_world: np.ndarray,
                               stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray,
-                              heading_world: np.ndarray, walk_on_m: float | None = None) -> float:
+                              heading_world: np.ndarray, walk_on: WalkOn | None = None) -> float:
         """How long from now the capture landing (:meth:`capture_landing`, before its reach limit) stays within the
         step's reach of the stance ankle: the τ >= 0 at which ``|a + b e^(ω τ)| = max_step_m``, with ``a`` the
         landing's offset from the stance ankle when the capture point is on the centre of pressure and ``b = ξ - p``
@@ -402,13 +420,13 @@ class RecoveryStepper:
         already beyond reach, infinity when it never leaves it [s]. A step that lands later lands short of the
         capture point, and the next step then starts with the capture point outside its support."""
         over = self._over_stance(com_world, com_vel_world, stance_ankle_world, stance_foot_quat_wxyz)
-        return self._reach_time_over(over, stance_ankle_world, heading_world, walk_on_m)
+        return self._reach_time_over(over, stance_ankle_world, heading_world, walk_on)
 
     def _reach_time_over(self, over: _OverStance, stance_ankle_world: np.ndarray, heading_world: np.ndarray,
-                         walk_on_m: float | None) -> float:
+                         walk_on: WalkOn | None) -> float:
         """:meth:`time_to_reach_limit_s` of the pendulum ``over`` the stance sole [s]."""
         b, norm = over.away, over.norm
-        a = (self._landing_ankle(over.cop, over.u, heading_world, walk_on_m)[:2]
+        a = (self._landing_ankle(over.cop, over.u, heading_world, walk_on)[:2]
              - np.asarray(stance_ankle_world, dtype=float)[:2])
         # Within reach while |a + b s|² - L² = s² |b|² + 2 s a·b + |a|² - L² <= 0, s = e^(ω τ) >= 1 (now: s = 1):
         # between the roots.
@@ -425,8 +443,8 @@ class RecoveryStepper:
 
     def swing_target(self, time_s: float, com_world: np.ndarray, com_vel_world: np.ndarray,
                      stance_ankle_world: np.ndarray, stance_foot_quat_wxyz: np.ndarray,
-                     heading_world: np.ndarray, walk_on_m: float | None = None) -> np.ndarray:
-        """(3,) this tick's target of the swing ankle [m]; the landing re-planned on the capture point (``walk_on_m``:
+                     heading_world: np.ndarray, walk_on: WalkOn | None = None) -> np.ndarray:
+        """(3,) this tick's target of the swing ankle [m]; the landing re-planned on the capture point (``walk_on``:
         :meth:`capture_landing`).
         ``heading_world``: (3, 3) the heading frame's rotation (x forward, y left)."""
         step, cfg = self.step, self.cfg
@@ -436,10 +454,10 @@ class RecoveryStepper:
         if cfg.recovery_swing_min_s is not None and elapsed < step.duration_s:
             # Step timing: the step lands no later than when its capture landing leaves the leg's reach (and no
             # sooner than the shortest swing); the duration only shortens.
-            reach_s = self._reach_time_over(over, stance_ankle_world, heading_world, walk_on_m)
+            reach_s = self._reach_time_over(over, stance_ankle_world, heading_world, walk_on)
             step.duration_s = min(step.duration_s, max(elapsed + reach_s, cfg.recovery_swing_min_s))
         landing, _ = self._landing_over(over, max(step.duration_s - elapsed, 0.0), stance_ankle_world,
-                                        stance_foot_quat_wxyz, heading_world, step.side, walk_on_m)
+                                        stance_foot_quat_wxyz, heading_world, step.side, walk_on)
         step.landing_world = landing
         phase = elapsed / step.duration_s
         moved = smooth_step(min(phase / HORIZONTAL_SHARE, 1.0))
