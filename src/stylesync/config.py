@@ -340,6 +340,13 @@ class MotionConfig:
     # capture point diverges that way; across it the step catches the body on its ankle (recovery_step.WalkOn).
     # False: along the capture point's own divergence, which carries a sideways drift on from step to step.
     recovery_walk_on_his_way: bool = False
+    # The operator's way over the ground: his scaled COM velocity averaged with this time constant, longer than a
+    # step (motion/operator_way.py) [s]. While its speed is below gait_min_way_speed_mps he goes nowhere (a sway on
+    # the spot, a dance): his double stance is no gait's (double_stance_keeps_momentum_m and
+    # capture_bound_in_his_gait do not apply) and the character's own steps stop the body (no walk-on). None: any
+    # double stance whose COM moves between his feet is a gait's [m/s].
+    operator_way_time_s: float = 1.0
+    gait_min_way_speed_mps: float | None = None
     # Following the operator over the ground (motion/path_feedback.py): the swing's landing relative to the
     # character's capture point is moved so that a step removes this share of the capture point's error from his,
     # scaled onto the character's path from where both started (the divergent component of motion: 1 removes it
@@ -389,6 +396,9 @@ class MotionConfig:
             _positive("MotionConfig.recovery_swing_min_s", self.recovery_swing_min_s)
         if self.recovery_landing_gap_m is not None:
             _positive("MotionConfig.recovery_landing_gap_m", self.recovery_landing_gap_m)
+        _positive("MotionConfig.operator_way_time_s", self.operator_way_time_s)
+        if self.gait_min_way_speed_mps is not None:
+            _non_negative("MotionConfig.gait_min_way_speed_mps", self.gait_min_way_speed_mps)
         if not 0.0 < self.recovery_touchdown_share <= 1.0:
             raise ConfigError(f"MotionConfig.recovery_touchdown_share must be within (0, 1], "
                               f"got {self.recovery_touchdown_share}")

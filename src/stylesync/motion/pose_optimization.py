@@ -48,6 +48,7 @@ from stylesync.motion.capture_bound import bounded_com_target, landing_catch_reg
 from stylesync.motion.double_stance_momentum import kept_com_velocity, moves_between_feet
 from stylesync.motion.leg_ik import solve_leg
 from stylesync.motion.operator_analysis import UPPER_JOINTS, OperatorAnalysis, analyse_operator, upper_local
+from stylesync.motion.operator_way import OperatorWay
 from stylesync.motion.path_feedback import PathReference
 from stylesync.motion.recovery_step import (
     RecoveryStepper,
@@ -89,8 +90,6 @@ _BALL_JOINTS = [k for k, j in enumerate(JOINTS) if j.kind is JointKind.BALL]
 _HINGE_JOINTS = [k for k, j in enumerate(JOINTS) if j.kind is not JointKind.BALL]
 _VELOCITY_SMOOTHING = 0.2  # per tick, exponential average of the desired COM velocity
 _SIDE_UP = {"left": "LEFT", "right": "RIGHT"}
-# Below this COM speed the operator's way over the ground is his heading, not his velocity's direction [m/s]
-_HIS_WAY_MIN_SPEED_MPS = 0.1
 _OTHER_SIDE = {"left": "right", "right": "left"}
 _LINK = {n: i for i, n in enumerate(LINK_NAMES)}
 _ROOT_LINK = _LINK["root"]
@@ -238,6 +237,7 @@ class MotionOptimizer:
         self._held: OperatorSample | None = None
         self._com_d_rate = _SmoothedRate(self.dt_s)  # desired COM velocity [m/s]
         self._com_h_rate = _SmoothedRate(self.dt_s)  # operator COM velocity [m/s]
+        self.way = OperatorWay(cfg.operator_way_time_s, self.dt_s)  # his way over the ground (operator_way.py)
         self.bounds = bounds if bounds is not None else BoundsMonitor()
         self._anchor_stance: Stance | None = None
         self._anchor_offset = np.zeros((2, 2))  # (pelvis, COM) x (x, y) [m]
@@ -280,6 +280,7 @@ class MotionOptimizer:
         rest: a character started with a recording's velocities (OperatorConfig.start_with_clip_velocity)."""
         self._com_h_rate.prime(com_vel_h_world)
         self._com_d_rate.prime(com_vel_d_world)
+        self.way.prime(com_vel_d_world)
 
     def update(self, sample: OperatorSample, state: CharacterState, mass: MassProperties,
                analysis: OperatorAnalysis | None = None) -> ReferencePose:
@@ -513,9 +514,9 @@ class MotionOptimizer:
         com_vel_d = self._com_d_rate(tick.com_d)
         com_vel_d[2] = 0.0
         tick.com_vel_h = self._com_h_rate(com_h)
+        self.way.update(scale * tick.com_vel_h)
         keep_m = self.cfg.double_stance_keeps_momentum_m
-        if (keep_m is not None and anchor is Stance.DS
-                and moves_between_feet(tick.com_vel_h, a_hs["left"], a_hs["right"])
+        if (keep_m is not None and anchor is Stance.DS and self._his_gait(tick, a_hs)
                 and self._capture_near_support(tick, state, keep_m)):
             com_vel_d = kept_com_velocity(com_vel_d, scale * tick.com_vel_h, tick.com_vel_c)
         tick.com_vel_d = com_vel_d
@@ -610,19 +611,29 @@ class MotionOptimizer:
                                  self._landing_pelvis_floor_m)
                 tick.pelvis_d[2] = min(tick.pelvis_d[2], tick.targets[side][2] + above_foot)
 
+    def _his_gait(self, tick: _Tick, his_ankles_world: dict[str, np.ndarray]) -> bool:
+        """Whether the operator's double stance on ``his_ankles_world`` is a gait's: his COM moves from one foot
+        towards the other (double_stance_momentum.moves_between_feet) and he goes somewhere (operator_way.py,
+        MotionConfig.gait_min_way_speed_mps), not a sway on the spot."""
+        return (moves_between_feet(tick.com_vel_h, his_ankles_world["left"], his_ankles_world["right"])
+                and self.way.goes(self.cfg.gait_min_way_speed_mps))
+
     def _walk_on(self, tick: _Tick) -> WalkOn | None:
         """How the character's own step lands while the operator walks (recovery_step.WalkOn): None while he stands
-        (the step stops the body) or with MotionConfig.recovery_walk_on_m None; along his way over the ground (his
-        COM's horizontal velocity, or his heading when he barely moves) with recovery_walk_on_his_way."""
+        or does not go anywhere (MotionConfig.gait_min_way_speed_mps; the step stops the body), or with
+        MotionConfig.recovery_walk_on_m None; along his way over the ground (operator_way.py, or his heading while
+        the average is zero) with recovery_walk_on_his_way."""
         distance_m = self.cfg.recovery_walk_on_m
-        if distance_m is None or self._operator_stands(tick):
+        if (distance_m is None or self._operator_stands(tick)
+                or not self.way.goes(self.cfg.gait_min_way_speed_mps)):
             return None
         if not self.cfg.recovery_walk_on_his_way:
             return WalkOn(distance_m)
-        v = np.array([tick.com_vel_h[0], tick.com_vel_h[1], 0.0])
-        speed = float(np.linalg.norm(v))
-        way = v / speed if speed >= _HIS_WAY_MIN_SPEED_MPS else tick.R_root_d[:, 0] * np.array([1.0, 1.0, 0.0])
-        return WalkOn(distance_m, way / max(float(np.linalg.norm(way)), 1e-9))
+        way = self.way.direction_world()
+        if way is None:
+            heading = np.array([tick.R_root_d[0, 0], tick.R_root_d[1, 0], 0.0])
+            way = heading / max(float(np.linalg.norm(heading)), 1e-9)
+        return WalkOn(distance_m, way)
 
     def _record_his_landing(self, tick: _Tick) -> None:
         """On the tick the operator lands a foot: its offset from his capture point, scaled, in his heading frame
@@ -658,8 +669,7 @@ class MotionOptimizer:
             # Opt-out: not while he walks from one foot onto the other (his gait's capture point runs ahead of his
             # front foot, and the character's, bounded within its soles, was braked at every double stance).
             return (self.cfg.capture_bound_in_his_gait or tick.op_state is not Stance.DS
-                    or not moves_between_feet(tick.com_vel_h, tick.sample.support_ankle_world["left"],
-                                              tick.sample.support_ankle_world["right"]))
+                    or not self._his_gait(tick, tick.sample.support_ankle_world))
         sides = tuple(s for s in _SIDE_UP if tick.op_state is Stance.DS or swing_side(tick.op_state) != s)
         return self._operator_stands(tick, sides)
 

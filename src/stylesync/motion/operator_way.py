@@ -1,0 +1,42 @@
+"""The operator's way over the ground: his COM's horizontal velocity averaged over longer than a step.
+
+A walk's double stance and a sway from foot to foot on the spot look alike tick by tick: in both his COM moves along
+the line through his feet (double_stance_momentum.moves_between_feet). Over a second they differ: the walker's COM
+goes somewhere, the swaying dancer's comes back. The average of his (scaled) COM velocity with time constant ``T``,
+``v̄ += (dt / T) (v - v̄)``, is his way over the ground; below ``min_speed_mps`` he is not going anywhere, and what
+keeps a walking character's momentum (a double stance that does not brake it, its own steps that walk on) is not
+applied (MotionConfig.gait_min_way_speed_mps).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+class OperatorWay:
+    """His COM's horizontal velocity [m/s], scaled onto the character, averaged with time constant ``time_s`` [s]."""
+
+    def __init__(self, time_s: float, dt_s: float):
+        self._share = min(dt_s / time_s, 1.0)
+        self.velocity_world = np.zeros(2)  # the average (2,) [m/s]
+
+    def prime(self, velocity_world: np.ndarray) -> None:
+        """Start the average at ``velocity_world`` ((2,) or (3,), scaled) instead of rest [m/s]."""
+        self.velocity_world = np.array(velocity_world, dtype=float)[:2]
+
+    def update(self, velocity_world: np.ndarray) -> np.ndarray:
+        """Take one tick's scaled COM velocity ((2,) or (3,)) [m/s]; returns the average (2,)."""
+        v = np.asarray(velocity_world, dtype=float)[:2]
+        self.velocity_world = self.velocity_world + self._share * (v - self.velocity_world)
+        return self.velocity_world
+
+    def goes(self, min_speed_mps: float | None) -> bool:
+        """Whether he goes somewhere: the average at least ``min_speed_mps`` fast (None: always) [m/s]."""
+        return min_speed_mps is None or float(np.hypot(*self.velocity_world)) >= min_speed_mps
+
+    def direction_world(self) -> np.ndarray | None:
+        """(3,) the unit horizontal direction of the average, or None when it is (nearly) zero."""
+        speed = float(np.hypot(*self.velocity_world))
+        if speed < 1e-6:
+            return None
+        return np.array([self.velocity_world[0] / speed, self.velocity_world[1] / speed, 0.0])

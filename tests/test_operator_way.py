@@ -1,0 +1,37 @@
+"""The operator's way over the ground (motion/operator_way.py): a walk goes somewhere, a sway on the spot does not."""
+
+import numpy as np
+import pytest
+
+from stylesync.motion.operator_way import OperatorWay
+
+DT_S = 1.0 / 60.0
+
+
+def _run(way: OperatorWay, velocity, seconds: float) -> None:
+    for k in range(int(round(seconds / DT_S))):
+        way.update(velocity(k * DT_S))
+
+
+def test_a_walk_goes_its_way_and_a_sway_on_the_spot_goes_nowhere():
+    # A walk at 1 m/s along x whose COM sways ±0.3 m/s sideways at the step frequency (1 Hz).
+    walk = OperatorWay(1.0, DT_S)
+    _run(walk, lambda t: np.array([1.0, 0.3 * np.sin(2 * np.pi * t), 0.0]), 5.0)
+    assert walk.goes(0.3)
+    assert walk.direction_world() == pytest.approx(np.array([1.0, 0.0, 0.0]), abs=0.05)
+    # A dancer swaying from foot to foot at 0.6 m/s peak: as fast, tick by tick, but he comes back.
+    sway = OperatorWay(1.0, DT_S)
+    _run(sway, lambda t: np.array([0.0, 0.6 * np.sin(2 * np.pi * 0.5 * t), 0.0]), 6.0)
+    assert float(np.hypot(*sway.velocity_world)) < 0.2
+    assert not sway.goes(0.3)
+    assert sway.goes(None)  # without a speed, every double stance that moves between the feet is a gait's
+
+
+def test_the_average_takes_its_time_constant_and_can_start_at_a_recordings_speed():
+    way = OperatorWay(1.0, DT_S)
+    _run(way, lambda t: np.array([1.0, 0.0]), 1.0)
+    assert way.velocity_world[0] == pytest.approx(1.0 - np.exp(-1.0), abs=0.01)  # one time constant
+    primed = OperatorWay(1.0, DT_S)
+    primed.prime(np.array([1.2, 0.0, 0.0]))
+    assert primed.goes(1.0) and primed.direction_world() == pytest.approx(np.array([1.0, 0.0, 0.0]))
+    assert OperatorWay(1.0, DT_S).direction_world() is None  # at rest: no direction
