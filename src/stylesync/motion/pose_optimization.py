@@ -613,10 +613,13 @@ class MotionOptimizer:
 
     def _his_gait(self, tick: _Tick, his_ankles_world: dict[str, np.ndarray]) -> bool:
         """Whether the operator's double stance on ``his_ankles_world`` is a gait's: his COM moves from one foot
-        towards the other (double_stance_momentum.moves_between_feet) and he goes somewhere (operator_way.py,
-        MotionConfig.gait_min_way_speed_mps), not a sway on the spot."""
+        towards the other (double_stance_momentum.moves_between_feet) and he goes somewhere, over the last second and
+        now (operator_way.py, MotionConfig.gait_min_way_speed_mps), not a sway on the spot nor a stop."""
+        min_speed = self.cfg.gait_min_way_speed_mps
         return (moves_between_feet(tick.com_vel_h, his_ankles_world["left"], his_ankles_world["right"])
-                and self.way.goes(self.cfg.gait_min_way_speed_mps))
+                and self.way.goes(min_speed)
+                # and now: the average trails his stop by a second, in which his COM stands over his feet
+                and (min_speed is None or tick.scale * float(np.hypot(*tick.com_vel_h[:2])) >= min_speed))
 
     def _walk_on(self, tick: _Tick) -> WalkOn | None:
         """How the character's own step lands while the operator walks (recovery_step.WalkOn): None while he stands
