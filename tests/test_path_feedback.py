@@ -82,7 +82,8 @@ def test_follow_path_sets_the_opt_ins_and_the_start_at_speed():
 @pytest.mark.parametrize("seed", [0, 1])
 def test_the_built_in_walk_keeps_to_its_operators_path_longer_with_follow_path(seed):
     """Measured (3.5 s of the built-in walk): by default the UHC termination comes at 2.42-2.45 s, the character
-    0.28-0.32 of the operator's way along; with follow_path at 2.99-3.05 s, 0.61-0.62 of it."""
+    0.28-0.32 of the operator's way along; with follow_path at 2.79-3.00 s, 0.54-0.60 of it (2.99-3.05 s and
+    0.61-0.62 before its own steps walked on only along his way and a gait needed him to go somewhere)."""
     import logging
 
     from stylesync.config import OperatorConfig, SessionConfig, follow_path
@@ -103,5 +104,5 @@ def test_the_built_in_walk_keeps_to_its_operators_path_longer_with_follow_path(s
         logging.disable(logging.NOTSET)
     assert not out[False]["fell"] and not out[True]["fell"]
     assert out[False]["uhc_fall_time_s"] < 2.6
-    assert out[True]["uhc_fall_time_s"] is None or out[True]["uhc_fall_time_s"] > 2.9
-    assert out[True]["path_progress"] > 1.8 * out[False]["path_progress"]
+    assert out[True]["uhc_fall_time_s"] is None or out[True]["uhc_fall_time_s"] > 2.7
+    assert out[True]["path_progress"] > 1.6 * out[False]["path_progress"]

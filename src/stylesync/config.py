@@ -636,6 +636,8 @@ FOLLOW_PATH_MOTION: dict[str, Any] = {
     "reference_follows_operator_s": 0.5,  # the targets go on at his speed
     "path_feedback_share": 0.5,  # each landing takes up half the path's error
     "recovery_walk_on_m": 0.1,  # its own steps walk on while he walks
+    "recovery_walk_on_his_way": True,  # along his way over the ground, a divergence across it caught
+    "gait_min_way_speed_mps": 0.3,  # a gait only while he goes somewhere (not a sway on the spot, not a stop)
 }
 
 
