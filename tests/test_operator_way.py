@@ -1,5 +1,7 @@
 """The operator's way over the ground (motion/operator_way.py): a walk goes somewhere, a sway on the spot does not."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -35,3 +37,36 @@ def test_the_average_takes_its_time_constant_and_can_start_at_a_recordings_speed
     primed.prime(np.array([1.2, 0.0, 0.0]))
     assert primed.goes(1.0) and primed.direction_world() == pytest.approx(np.array([1.0, 0.0, 0.0]))
     assert OperatorWay(1.0, DT_S).direction_world() is None  # at rest: no direction
+
+
+ZOMBIE = Path(__file__).resolve().parents[2] / "shared" / "mocap" / "deepmimic" / "humanoid3d_zombie_walk.txt"
+# The four settings that follow the operator's path from rest (docs/decisions.md, "Keeping up at rest")
+PATH_OPT_INS = {"double_stance_keeps_momentum_m": 0.1, "capture_bound_in_his_gait": False, "recovery_walk_on_m": 0.1,
+                "path_feedback_share": 0.5}
+
+
+@pytest.mark.skipif(not ZOMBIE.exists(), reason="../shared/mocap/deepmimic/humanoid3d_zombie_walk.txt is not available")
+def test_the_zombie_walk_goes_his_way_when_its_own_steps_walk_on_only_along_it():
+    """The zombie walk (seed 0, as the development suite runs it) with the path settings: its own steps walked on
+    along the capture point's divergence, sideways too, and the character walked 3.6 m to the side of his path, its
+    progress along it negative (-0.15). Walking on only along his way, and keeping a gait only while he goes somewhere,
+    it goes 0.37 of his way (measured), with no fall either way."""
+    import logging
+
+    from conftest import suite_run
+
+    from stylesync.config import ControlConfig, MotionConfig
+    from stylesync.metrics.summary import summarize
+
+    logging.disable(logging.WARNING)
+    try:
+        spec = f"deepmimic:{ZOMBIE}"
+        own = summarize(suite_run(spec, 0, MotionConfig(**PATH_OPT_INS), ControlConfig()))
+        his = summarize(suite_run(spec, 0, MotionConfig(**PATH_OPT_INS, recovery_walk_on_his_way=True,
+                                                        gait_min_way_speed_mps=0.3), ControlConfig()))
+    finally:
+        logging.disable(logging.NOTSET)
+    assert not own["fell"] and not his["fell"]
+    assert own["path_progress"] < 0.0
+    assert his["path_progress"] > 0.25
+    assert his["path_sideways_m"] < own["path_sideways_m"]
