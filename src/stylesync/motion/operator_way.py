@@ -24,15 +24,20 @@ class OperatorWay:
         """Start the average at ``velocity_world`` ((2,) or (3,), scaled) instead of rest [m/s]."""
         self.velocity_world = np.array(velocity_world, dtype=float)[:2]
 
-    def update(self, velocity_world: np.ndarray) -> np.ndarray:
-        """Take one tick's scaled COM velocity ((2,) or (3,)) [m/s]; returns the average (2,)."""
+    def update(self, velocity_world: np.ndarray) -> None:
+        """Take one tick's scaled COM velocity ((2,) or (3,)) [m/s]."""
         v = np.asarray(velocity_world, dtype=float)[:2]
         self.velocity_world = self.velocity_world + self._share * (v - self.velocity_world)
-        return self.velocity_world
 
-    def goes(self, min_speed_mps: float | None) -> bool:
-        """Whether he goes somewhere: the average at least ``min_speed_mps`` fast (None: always) [m/s]."""
-        return min_speed_mps is None or float(np.hypot(*self.velocity_world)) >= min_speed_mps
+    def goes(self, min_speed_mps: float | None, velocity_now_world: np.ndarray | None = None) -> bool:
+        """Whether he goes somewhere: the average at least ``min_speed_mps`` fast (None: always) and, if given, his
+        present scaled COM velocity ``velocity_now_world`` ((2,) or (3,)) too: the average trails a stop by its time
+        constant, while his COM already stands over his feet [m/s]."""
+        if min_speed_mps is None:
+            return True
+        if velocity_now_world is not None and float(np.hypot(*velocity_now_world[:2])) < min_speed_mps:
+            return False
+        return float(np.hypot(*self.velocity_world)) >= min_speed_mps
 
     def direction_world(self) -> np.ndarray | None:
         """(3,) the unit horizontal direction of the average, or None when it is (nearly) zero."""

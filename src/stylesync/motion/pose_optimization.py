@@ -238,6 +238,8 @@ class MotionOptimizer:
         self._com_d_rate = _SmoothedRate(self.dt_s)  # desired COM velocity [m/s]
         self._com_h_rate = _SmoothedRate(self.dt_s)  # operator COM velocity [m/s]
         self.way = OperatorWay(cfg.operator_way_time_s, self.dt_s)  # his way over the ground (operator_way.py)
+        # only a gait's speed or a walk-on along his way reads it: otherwise it is not kept up each tick
+        self._tracks_way = cfg.gait_min_way_speed_mps is not None or cfg.recovery_walk_on_his_way
         self.bounds = bounds if bounds is not None else BoundsMonitor()
         self._anchor_stance: Stance | None = None
         self._anchor_offset = np.zeros((2, 2))  # (pelvis, COM) x (x, y) [m]
@@ -514,7 +516,8 @@ class MotionOptimizer:
         com_vel_d = self._com_d_rate(tick.com_d)
         com_vel_d[2] = 0.0
         tick.com_vel_h = self._com_h_rate(com_h)
-        self.way.update(scale * tick.com_vel_h)
+        if self._tracks_way:
+            self.way.update(scale * tick.com_vel_h)
         keep_m = self.cfg.double_stance_keeps_momentum_m
         if (keep_m is not None and anchor is Stance.DS and self._his_gait(tick, a_hs)
                 and self._capture_near_support(tick, state, keep_m)):
@@ -615,11 +618,8 @@ class MotionOptimizer:
         """Whether the operator's double stance on ``his_ankles_world`` is a gait's: his COM moves from one foot
         towards the other (double_stance_momentum.moves_between_feet) and he goes somewhere, over the last second and
         now (operator_way.py, MotionConfig.gait_min_way_speed_mps), not a sway on the spot nor a stop."""
-        min_speed = self.cfg.gait_min_way_speed_mps
         return (moves_between_feet(tick.com_vel_h, his_ankles_world["left"], his_ankles_world["right"])
-                and self.way.goes(min_speed)
-                # and now: the average trails his stop by a second, in which his COM stands over his feet
-                and (min_speed is None or tick.scale * float(np.hypot(*tick.com_vel_h[:2])) >= min_speed))
+                and self.way.goes(self.cfg.gait_min_way_speed_mps, tick.scale * tick.com_vel_h))
 
     def _walk_on(self, tick: _Tick) -> WalkOn | None:
         """How the character's own step lands while the operator walks (recovery_step.WalkOn): None while he stands
