@@ -148,6 +148,9 @@ class MotionConfig:
     # above, while the character's capture point is further than this outside its other sole towards the lifting
     # foot. Standing on that sole alone, the body could only fall back onto the foot it lifts [m] (None: off).
     liftoff_capture_behind_m: float | None = 0.05
+    # A lift-off from double stance waits, however long, while the foot the operator lifts is the only one of the
+    # character's on the ground (stance_fsm.CharacterStanceFsm): lifted, it would leave the body on a foot in the air.
+    liftoff_needs_other_foot_down: bool = False
     # A raised rear foot that still bears weight (on its toes, pose_optimization._rear_foot_bears_weight): while the
     # operator's capture point is more than this behind his stance sole's heel (the character's sole scaled to him,
     # in the heading frame) and his raised foot is behind it, his single stance is read as a double stance.
@@ -479,6 +482,9 @@ class WholeBodyConfig:
     momentum_root_kd: float = 40.0  # [N·m·s/rad]
     momentum_moment_weight_per_m: float = 2.0  # the moment rows' weight is this squared, the force rows' 1 [1/m]
     contact_velocity_gain: float = 10.0  # a supporting sole's residual velocity is damped at this rate [1/s]
+    # A sole's forces as one wrench inside its contact wrench cone (sole_wrench_contact.py: 6 variables and the
+    # cone's 32 faces) instead of 16 magnitudes along its corners' friction pyramids (contacts.py).
+    sole_wrench_cone: bool = False
     # A planted sole whose lowest corner is within this height of the ground still counts as supporting
     # (contacts.sole_touches); 0 = only a foot pressing the ground does. Off by default, as
     # WorldConfig.friction_anchor, with which it keeps a standing character's feet planted [m].

@@ -29,6 +29,7 @@ MIN_WEIGHT = 0.05  # a stance weight below this is treated as this (ε = REGULAR
 MAX_NORMAL_FORCE_BODY_WEIGHTS = 3.0
 RAMP_WEIGHT = 0.1
 FORCES_PER_SOLE = 16  # 4 corners x 4 pyramid edges
+INFINITY = 1e20  # the QP's unbounded side
 # The corners the forces act at, relative to the ankle joint in the foot's canonical frame [m], (4, 3).
 SOLE_CORNERS_IN_FOOT = sole_corners_in_foot(SOLE_MARGIN)
 # The same relative to the sole's centre [m], (4, 3).
@@ -84,7 +85,17 @@ def feasible_horizontal_force(force_n: np.ndarray, com_world: np.ndarray, corner
 
 
 class SoleContact:
-    """One foot's sole on the ground, as the whole-body QP sees it."""
+    """One foot's sole on the ground, as the whole-body QP sees it: its force variables are the magnitudes λ of the
+    unit forces along the four corners' friction pyramids (world axes).
+
+    What the formulation reads of a contact (the same for :class:`~stylesync.control.sole_wrench_contact.
+    SoleWrenchContact`): ``n_forces`` variables, their ``generator`` (nv, n_forces) in the equations of motion,
+    their regularisation (:meth:`add_regularisation`), the ``normal_row`` (n_forces,) that gives the normal force,
+    and ``force_rows`` (k, n_forces) with ``force_lower``/``force_upper`` (k,): the force variables' own
+    inequalities, the same at every tick when ``force_rows_constant``."""
+
+    n_forces = FORCES_PER_SOLE
+    force_rows_constant = True  # λ >= 0: unit rows
 
     def __init__(self, side: str, friction: float, body_weight_n: float):
         self.side = side
@@ -99,6 +110,8 @@ class SoleContact:
         self.velocity = np.zeros(6)
         self.corners_world = np.zeros((4, 3))
         self._updated_for: tuple[int, int] | None = None  # (model, revision) of the last update
+        self.force_rows = np.eye(FORCES_PER_SOLE)
+        self.force_lower, self.force_upper = np.zeros(FORCES_PER_SOLE), np.full(FORCES_PER_SOLE, INFINITY)
         # Normal components of the 16 unit forces (the same at every corner): Σ_e n_e λ_e is the normal force.
         self.normal_row = np.tile(self.edges[:, 2], 4)
         self._forces = np.tile(self.edges.T, 4)  # (3, 16): the unit forces, corner by corner, edge by edge
@@ -131,6 +144,11 @@ class SoleContact:
     def regularisation(self) -> float:
         """ε of this contact's forces: larger as its stance weight falls."""
         return REGULARISATION / max(self.stance_weight, MIN_WEIGHT)
+
+    def add_regularisation(self, hessian: np.ndarray, start: int) -> None:
+        """Set ``ε λ²`` on the diagonal of the QP's ``hessian`` (n, n) from variable ``start`` on."""
+        n = len(hessian)
+        hessian.ravel()[start * (n + 1):(start + self.n_forces) * (n + 1):n + 1] = self.regularisation
 
     @property
     def max_normal_force_n(self) -> float:

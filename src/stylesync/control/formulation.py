@@ -1,7 +1,9 @@
 """The whole-body QP of one control tick: tasks, contacts and limits collected into one quadratic programme.
 
-Variables ``x = (q̈, λ)``: the joint accelerations (nv, the character's layout) and the magnitudes of the contact
-forces along the friction pyramids' edges (16 per active sole). The problem is
+Variables ``x = (q̈, λ)``: the joint accelerations (nv, the character's layout) and each active sole's force
+variables: by default the magnitudes of its forces along its corners' friction pyramid edges (16, contacts.py), or
+its wrench (6, sole_wrench_contact.py, with ``λ >= 0`` below its cone's faces ``U λ <= 0`` and ``ε |λ|²`` its
+metric ``ε λᵀ (G Gᵀ)⁻¹ λ``). The problem is
 
     min_x  ½ Σ_tasks Σ_rows w (A q̈ - b)² + ½ Σ_contacts ε |λ|²
     s.t.   M_root q̈ + h_root = (B λ)_root                     (the floating root's six equations of motion)
@@ -20,13 +22,14 @@ from typing import TypeVar
 
 import numpy as np
 
-from stylesync.control.contacts import FORCES_PER_SOLE, SoleContact
+from stylesync.control.contacts import INFINITY, SoleContact
+from stylesync.control.sole_wrench_contact import SoleWrenchContact
 from stylesync.control.tasks.base import Task
 from stylesync.model.character import JOINT_DOF_START, JOINTS, N_DOFS, ROOT_DOFS, JointKind
 from stylesync.model.character_model import CharacterModel
 
-INFINITY = 1e20  # ProxQP's unbounded side
 T = TypeVar("T", bound=Task)
+Contact = SoleContact | SoleWrenchContact  # what the formulation reads of a contact: SoleContact's docstring
 
 
 @dataclass
@@ -94,7 +97,7 @@ class WholeBodyFormulation:
         self._limit_upper = np.array([lim.upper_rad for lim in limits])  # [rad]
         self.contact_velocity_gain = contact_velocity_gain  # [1/s]
         self.limit_horizon_s = limit_horizon_s  # [s]
-        self._templates: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}  # by the number of soles
+        self._templates: dict[tuple[type, ...], tuple[np.ndarray, np.ndarray, np.ndarray]] = {}  # by the soles
 
     def add_task(self, task: T) -> T:
         self.tasks.append(task)
@@ -106,10 +109,10 @@ class WholeBodyFormulation:
                 return t
         raise KeyError(f"no task '{name}'; tasks: {', '.join(t.name for t in self.tasks)}")
 
-    def build(self, model: CharacterModel, contacts: list[SoleContact]) -> QpProblem:
+    def build(self, model: CharacterModel, contacts: list[Contact]) -> QpProblem:
         nv = N_DOFS
         n_c = len(contacts)
-        n_f = FORCES_PER_SOLE * n_c
+        n_f = sum(c.n_forces for c in contacts)
         n = nv + n_f
         h_mat = np.zeros((n, n))
         g = np.zeros(n)
@@ -128,23 +131,26 @@ class WholeBodyFormulation:
             h_mat[:nv, :nv] += r.jacobian.T @ wj
             g[:nv] -= wj.T @ r.target
         # Equalities: the root's equations of motion, then each sole's 6 acceleration rows. Then the inequalities:
-        # joint torques, each sole's normal force, the pyramids' λ >= 0, the hinges' limits. What does not change
-        # from one tick to the next (the pyramids' and the hinges' unit rows, their bounds) comes from a template.
+        # joint torques, each sole's normal force, each sole's own force rows (the pyramids' λ >= 0 or the wrench
+        # cone), the hinges' limits. What does not change from one tick to the next (the pyramids' and the hinges'
+        # unit rows, the bounds of the force rows) comes from a template.
         n_eq = ROOT_DOFS + 6 * n_c
         n_tau = nv - ROOT_DOFS
-        template = self._templates.get(n_c)
+        key = tuple(type(c) for c in contacts)
+        template = self._templates.get(key)
         if template is None:
-            template = self._templates[n_c] = self._template(n_c)
+            template = self._templates[key] = self._template(contacts)
         rows, lower, upper = (a.copy() for a in template)
         m, h = model.mass_matrix, model.bias_forces
         rows[:ROOT_DOFS, :nv] = m[:ROOT_DOFS]
         lower[:ROOT_DOFS] = -h[:ROOT_DOFS]
         tau_rows = slice(n_eq, n_eq + n_tau)
         rows[tau_rows, :nv] = m[ROOT_DOFS:]
+        start, force_row = nv, n_eq + n_tau + n_c
         for i, c in enumerate(contacts):
             c.update(model)
-            sl = slice(nv + FORCES_PER_SOLE * i, nv + FORCES_PER_SOLE * (i + 1))
-            h_mat.ravel()[sl.start * (n + 1):sl.stop * (n + 1):n + 1] = c.regularisation
+            sl = slice(start, start + c.n_forces)
+            c.add_regularisation(h_mat, start)
             rows[:ROOT_DOFS, sl] = -c.generator[:ROOT_DOFS]  # -B of the equations of motion
             rows[tau_rows, sl] = -c.generator[ROOT_DOFS:]
             jac, acc = c.constraint_rows(self.contact_velocity_gain)
@@ -153,6 +159,10 @@ class WholeBodyFormulation:
             normal = n_eq + n_tau + i
             rows[normal, sl] = c.normal_row
             upper[normal] = c.max_normal_force_n
+            k = len(c.force_rows)
+            if not c.force_rows_constant:
+                rows[force_row:force_row + k, sl] = c.force_rows
+            start, force_row = start + c.n_forces, force_row + k
         upper[:n_eq] = lower[:n_eq]
         lower[tau_rows] = -self.torque_limit_nm - h[ROOT_DOFS:]
         upper[tau_rows] = self.torque_limit_nm - h[ROOT_DOFS:]
@@ -164,18 +174,24 @@ class WholeBodyFormulation:
             upper[first:] = np.maximum(2.0 * (self._limit_upper - q - qd * t) / (t * t), 0.0)
         return QpProblem(h_mat, g, rows, lower, upper, n_eq, n_f)
 
-    def _template(self, n_contacts: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The constraint rows and bounds of a QP with ``n_contacts`` soles that are the same at every tick: the
-        pyramids' λ >= 0, the normal forces' lower bound 0 and the hinges' unit rows; the rest is zero."""
-        nv, n_f = N_DOFS, FORCES_PER_SOLE * n_contacts
-        n_eq = ROOT_DOFS + 6 * n_contacts
-        n_in = nv - ROOT_DOFS + n_contacts + n_f + len(self.limits)
+    def _template(self, contacts: list[Contact]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The constraint rows and bounds of a QP with these soles that are the same at every tick: the contacts'
+        constant force rows (the pyramids' λ >= 0) and their force rows' bounds, the normal forces' lower bound 0
+        and the hinges' unit rows; the rest is zero."""
+        nv, n_c = N_DOFS, len(contacts)
+        n_f = sum(c.n_forces for c in contacts)
+        n_eq = ROOT_DOFS + 6 * n_c
+        n_force_rows = sum(len(c.force_rows) for c in contacts)
+        n_in = nv - ROOT_DOFS + n_c + n_force_rows + len(self.limits)
         rows = np.zeros((n_eq + n_in, nv + n_f))
         lower, upper = np.zeros(n_eq + n_in), np.zeros(n_eq + n_in)
-        row = n_eq + nv - ROOT_DOFS + n_contacts  # the normal-force rows (lower bound 0) come before this
-        rows[row:row + n_f, nv:].flat[::n_f + 1] = 1.0
-        lower[row:row + n_f], upper[row:row + n_f] = 0.0, INFINITY
-        row += n_f
+        row, col = n_eq + nv - ROOT_DOFS + n_c, nv  # the normal-force rows (lower bound 0) come before this
+        for c in contacts:
+            k = len(c.force_rows)
+            if c.force_rows_constant:
+                rows[row:row + k, col:col + c.n_forces] = c.force_rows
+            lower[row:row + k], upper[row:row + k] = c.force_lower, c.force_upper
+            row, col = row + k, col + c.n_forces
         rows[row + self._limit_rows, self._limit_dofs] = 1.0
         return rows, lower, upper
 

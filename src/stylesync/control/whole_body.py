@@ -41,6 +41,7 @@ from stylesync.control.gravity_compensation import LEG_JOINTS
 from stylesync.control.joint_speed_limit import limit_joint_speed
 from stylesync.control.model_compensation import bounded_lipm_sync_force
 from stylesync.control.pid import IS_BALL
+from stylesync.control.sole_wrench_contact import SoleWrenchContact
 from stylesync.control.solver import DaqpSolver
 from stylesync.control.stable_pd import flatten_joint_values, unflatten_joint_values
 from stylesync.control.tasks import CentroidalMomentumTask, FrameOrientationTask, FramePositionTask, JointPostureTask
@@ -145,7 +146,8 @@ class WholeBodyController(ControllerBase):
         # The posture task's per-DOF weight share for each set of supporting feet (stance_leg_tracking_share)
         self._leg_share: dict[tuple[str, ...], np.ndarray] = {support: _leg_share(support, wb.stance_leg_tracking_share)
                            for support in ((), ("left",), ("right",), ("left", "right"))}
-        self.contacts = {s: SoleContact(s, friction, mass.total_kg * gravity_mps2) for s in SIDES}
+        contact = SoleWrenchContact if wb.sole_wrench_cone else SoleContact
+        self.contacts = {s: contact(s, friction, mass.total_kg * gravity_mps2) for s in SIDES}
         self.solver = DaqpSolver()
 
     def update(self, state: CharacterState, ref: ReferencePose) -> None:

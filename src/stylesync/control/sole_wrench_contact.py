@@ -1,0 +1,126 @@
+"""A sole's contact as one wrench inside its contact wrench cone (Caron, Pham and Nakamura, "Stability of surface
+contacts for humanoid robots: closed-form formulae of the contact wrench cone for rectangular support areas",
+ICRA 2015).
+
+The corner pyramids of contacts.py span a cone of wrenches at the sole's centre; for a rectangular sole with the
+pyramids in the sole's own axes, that cone has the closed form ``U w <= 0`` of 16 rows (the paper's Eq. 13-16):
+friction on the resultant force, the centre of pressure inside the sole, and the torsion about the normal within
+what the corners' friction can give. Its variables are the six components of the wrench ``w = (f, τ)`` at the
+sole's centre in world axes, instead of 16 magnitudes λ: the QP has 10 variables fewer per sole, and the active
+set that its solver carries from tick to tick holds only the faces the wrench lies on instead of every unloaded
+pyramid edge (docs/decisions.md, "The soles' wrench cone").
+
+The pyramids turn with the sole (about the vertical, for a flat foot): with contacts.py's they keep the world's
+axes. The regularisation is the corner forces' one, ``ε |λ|²`` for the least-norm λ that gives ``w``:
+``ε wᵀ (G Gᵀ)⁻¹ w`` with ``G`` (6, 16) the unit forces' wrenches. It is the same as contacts.py's while every λ of
+that least-norm solution is positive, and smaller near the cone's faces, where contacts.py's λ >= 0 bind.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial import ConvexHull
+
+from stylesync.control.contacts import (
+    _EDGE_DIRS,
+    FRICTION_MARGIN,
+    INFINITY,
+    MAX_NORMAL_FORCE_BODY_WEIGHTS,
+    MIN_WEIGHT,
+    RAMP_WEIGHT,
+    REGULARISATION,
+    SOLE_CORNERS_IN_SOLE,
+)
+from stylesync.model.character_model import SOLE_FRAMES, CharacterModel
+
+WRENCH_SIZE = 6
+
+
+def contact_wrench_cone(generators: np.ndarray) -> np.ndarray:
+    """(k, 6) U with ``U w <= 0`` exactly the cone spanned by the columns of ``generators`` (6, m), each with a
+    positive normal force (row 2): the facets of the generators' section at unit normal force, a 5-dimensional
+    polytope (its convex hull by Qhull), each ``a·p + b <= 0`` read as ``a·(w without f_z) + b f_z <= 0``.
+    For a rectangle's four corner pyramids this is the 16-row cone of Caron et al. (2015)."""
+    g = np.asarray(generators, dtype=float)
+    section = np.delete(g / g[2], 2, axis=0).T  # (m, 5): each generator scaled to f_z = 1, without f_z
+    hull = ConvexHull(section)
+    rows = np.insert(hull.equations[:, :5], 2, hull.equations[:, 5], axis=1)  # (facets, 6)
+    rows /= np.linalg.norm(rows, axis=1, keepdims=True)
+    return np.unique(np.round(rows, 12), axis=0)  # Qhull splits a facet into simplices: one row each
+
+
+def corner_wrench_generators(friction: float, corners_in_sole: np.ndarray) -> np.ndarray:
+    """(6, 16) G: the wrench at the sole's centre, in its axes, of a unit force along each corner's pyramid edge
+    (corner by corner, edge by edge as contacts.py orders them)."""
+    e = np.column_stack([friction * _EDGE_DIRS, np.ones(4)])
+    e /= np.linalg.norm(e, axis=1, keepdims=True)
+    cols = [np.concatenate([b, np.cross(c, b)]) for c in corners_in_sole for b in e]
+    return np.array(cols).T
+
+
+class SoleWrenchContact:
+    """One foot's sole on the ground with its wrench as the force variables (the interface of contacts.SoleContact)."""
+
+    n_forces = WRENCH_SIZE
+    force_rows_constant = False  # the cone turns with the sole
+
+    def __init__(self, side: str, friction: float, body_weight_n: float):
+        self.side = side
+        self.frame = SOLE_FRAMES[side]
+        self.body_weight_n = body_weight_n
+        self.stance_weight = 1.0  # set per tick: the share of the body this foot is meant to carry, [0, 1]
+        g = corner_wrench_generators(FRICTION_MARGIN * friction, SOLE_CORNERS_IN_SOLE)
+        self._cone_in_sole = contact_wrench_cone(g)  # (16, 6), in the sole's axes
+        self._metric_in_sole = np.linalg.inv(g @ g.T)  # (6, 6) (G Gᵀ)⁻¹
+        # Per tick, after update(): as SoleContact's; the cone's rows in world axes.
+        self.generator = np.zeros((0, 0))
+        self.jacobian = np.zeros((6, 0))
+        self.drift = np.zeros(6)
+        self.velocity = np.zeros(6)
+        self.corners_world = np.zeros((4, 3))
+        self.normal_row = np.zeros(WRENCH_SIZE)
+        self.force_rows = np.zeros((len(self._cone_in_sole), WRENCH_SIZE))
+        self.force_lower = np.full(len(self._cone_in_sole), -INFINITY)
+        self.force_upper = np.zeros(len(self._cone_in_sole))
+        self._metric_world = np.zeros((WRENCH_SIZE, WRENCH_SIZE))
+        self._updated_for: tuple[int, int] | None = None  # (model, revision) of the last update
+
+    def update(self, model: CharacterModel) -> None:
+        """The sole's Jacobian, drift, velocity, corners, generator ``Jᵀ`` and wrench cone in world axes at the
+        model's current state (once per model update)."""
+        if self._updated_for == (id(model), model.revision):
+            return
+        self._updated_for = (id(model), model.revision)
+        f = model.frame_id(self.frame)
+        self.jacobian = model.frame_jacobian(f)
+        self.drift = model.frame_drift(f)
+        self.velocity = model.frame_velocity(f)
+        placement = model.frame_placement(f)
+        r = placement.rotation
+        self.corners_world = placement.translation + SOLE_CORNERS_IN_SOLE @ r.T
+        self.generator = self.jacobian.T  # (nv, 6): the wrench at the sole's centre, world axes
+        # w_sole = blockdiag(Rᵀ, Rᵀ) w_world
+        self.force_rows[:, :3] = self._cone_in_sole[:, :3] @ r.T
+        self.force_rows[:, 3:] = self._cone_in_sole[:, 3:] @ r.T
+        self.normal_row[:3] = r[:, 2]
+        rr = np.zeros((WRENCH_SIZE, WRENCH_SIZE))
+        rr[:3, :3] = rr[3:, 3:] = r
+        self._metric_world = rr @ self._metric_in_sole @ rr.T
+
+    @property
+    def regularisation(self) -> float:
+        """ε of the corner forces this wrench stands for: larger as its stance weight falls."""
+        return REGULARISATION / max(self.stance_weight, MIN_WEIGHT)
+
+    def add_regularisation(self, hessian: np.ndarray, start: int) -> None:
+        """Set ``ε wᵀ (G Gᵀ)⁻¹ w`` (world axes) in the QP's ``hessian`` from variable ``start`` on."""
+        hessian[start:start + WRENCH_SIZE, start:start + WRENCH_SIZE] = self.regularisation * self._metric_world
+
+    @property
+    def max_normal_force_n(self) -> float:
+        """Upper bound of the normal force [N], ramped down with the stance weight below RAMP_WEIGHT."""
+        return MAX_NORMAL_FORCE_BODY_WEIGHTS * self.body_weight_n * min(1.0, self.stance_weight / RAMP_WEIGHT)
+
+    def constraint_rows(self, velocity_gain: float) -> tuple[np.ndarray, np.ndarray]:
+        """The sole does not move: ``J q̈ = -J̇ q̇ - k_v J q̇``."""
+        return self.jacobian, -self.drift - velocity_gain * self.velocity
