@@ -259,6 +259,23 @@ def test_the_fsm_keeps_a_recovery_step_until_its_foot_lands():
     assert fsm.update(Stance.DS, {"left": False, "right": True}, 1.31) is Stance.DS
 
 
+def test_a_lift_off_waits_while_the_lifted_foot_is_the_only_one_down():
+    """From double stance, the operator lifts his right foot while the character's left is off the ground and its
+    right carries it: with MotionConfig.liftoff_needs_other_foot_down the right stays down however long that lasts
+    (no weight-shift timeout), and lifts once the left is down; without it, the lift follows him at once."""
+    only_right = {"left": False, "right": True}
+    fsm = CharacterStanceFsm(late_contact_timeout_s=0.4, min_swing_s=0.12, lift_needs_other_down=True)
+    assert fsm.update(Stance.DS, {"left": True, "right": True}, 0.0) is Stance.DS
+    for t in (0.1, 0.5, 2.0):
+        assert fsm.update(Stance.LS, only_right, t, None, 0.25) is Stance.DS and fsm.waiting_to_lift
+    assert fsm.update(Stance.LS, {"left": True, "right": True}, 2.1, None, 0.25) is Stance.LS
+    # Neither foot down (a flight): no wait.
+    fsm = CharacterStanceFsm(late_contact_timeout_s=0.4, min_swing_s=0.12, lift_needs_other_down=True)
+    assert fsm.update(Stance.LS, {"left": False, "right": False}, 0.1, None, 0.25) is Stance.LS
+    plain = CharacterStanceFsm(late_contact_timeout_s=0.4, min_swing_s=0.12)
+    assert plain.update(Stance.LS, only_right, 0.1, None, 0.25) is Stance.LS
+
+
 # The controller the scenarios below were traced with: the supporting legs' posture and the pelvis at full weight
 # (before WholeBodyConfig.stance_leg_tracking_share and single_stance_pelvis_share). Each scenario is one clip and
 # seed on which a feature decides a fall; a change of the controller changes which runs fall, so the feature is

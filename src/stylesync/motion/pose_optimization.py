@@ -232,7 +232,8 @@ class MotionOptimizer:
         # How far from its hip, horizontally, a swing foot can land with the pelvis at that floor [m]
         self._swing_reach_m = math.sqrt(max(_LANDING_REACH_M ** 2 - self._landing_pelvis_floor_m ** 2, 0.0))
         self.op_fsm = OperatorStanceFsm(cfg.stance_height_threshold_m, cfg.stance_hysteresis_m)
-        self.char_fsm = CharacterStanceFsm(cfg.late_contact_timeout_s, cfg.min_swing_s)
+        self.char_fsm = CharacterStanceFsm(cfg.late_contact_timeout_s, cfg.min_swing_s,
+                                           cfg.liftoff_needs_other_foot_down)
         self._op_leg_m: float | None = None
         self._held: OperatorSample | None = None
         self._com_d_rate = _SmoothedRate(self.dt_s)  # desired COM velocity [m/s]

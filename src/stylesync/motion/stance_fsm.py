@@ -24,6 +24,9 @@ class Stance(Enum):
     DS = "DS"  # double stance
 
 
+_OTHER = {"left": "right", "right": "left"}
+
+
 def swing_side(s: Stance) -> str | None:
     return "right" if s is Stance.LS else ("left" if s is Stance.RS else None)
 
@@ -62,9 +65,12 @@ class OperatorStanceFsm:
 
 
 class CharacterStanceFsm:
-    def __init__(self, late_contact_timeout_s: float, min_swing_s: float):
+    def __init__(self, late_contact_timeout_s: float, min_swing_s: float, lift_needs_other_down: bool = False):
         self.timeout_s = late_contact_timeout_s
         self.min_swing_s = min_swing_s
+        # A lift-off from double stance waits, with no time limit, while the foot the operator lifts is on the
+        # ground and the other is not (MotionConfig.liftoff_needs_other_foot_down)
+        self.lift_needs_other_down = lift_needs_other_down
         self.state = Stance.DS
         self.hold_reference = False
         self._swing_start_s = 0.0
@@ -148,6 +154,11 @@ class CharacterStanceFsm:
                     self.hold_reference = True
             return self.state
         sw_op = swing_side(op)
+        if (self.lift_needs_other_down and self.state is Stance.DS and sw_op is not None and contact[sw_op]
+                and not contact[_OTHER[sw_op]]):
+            # The foot he lifts is the character's only one on the ground: lifted, it would stand on a foot in the air.
+            self.waiting_to_lift = True
+            return self.state
         if self.state is Stance.DS and sw_op is not None and can_lift is not None and not can_lift[sw_op]:
             # Lift-off from DS is the operator's decision, but the weight has to be over the stance foot first.
             if self._lift_wait_from_s is None:
