@@ -48,9 +48,10 @@ def traced_motion(**kwargs) -> MotionConfig:
     (``recovery_cross_nearest`` and ``recovery_cross_stance_frame`` off), a foot in the air stepping whatever
     its distance to the capture point (``recovery_landing_foot_waits`` off), and Eq. 10's fraction by side after a
     step of the character's own (``fraction_needs_feet_in_his_order`` off): their motion configurations start from
-    it. They were traced before a recovery step's timing adapted to its reach (``recovery_swing_min_s`` None)."""
+    it. They were traced before a recovery step's timing adapted to its reach (``recovery_swing_min_s`` None), and
+    before a lift-off waited for the other foot to be down (``liftoff_needs_other_foot_down`` off)."""
     return MotionConfig(**{"swing_landing": "his_foot_now", "recovery_overdue_swing_horizon": False,
-                           "recovery_swing_min_s": None,
+                           "recovery_swing_min_s": None, "liftoff_needs_other_foot_down": False,
                            "recovery_cross_nearest": False, "recovery_cross_stance_frame": False,
                            "recovery_landing_foot_waits": False, "fraction_needs_feet_in_his_order": False,
                            **kwargs})
@@ -1279,7 +1280,8 @@ def test_a_recovery_step_whose_landing_is_due_is_pressed_onto_the_ground():
     run has a landing falling due), with Eq. 10's fraction by side after a step of the character's own
     (MotionConfig.fraction_needs_feet_in_his_order off), and with every recovery step's nominal time
     (MotionConfig.recovery_swing_min_s None: a step shortened to land before the capture point leaves the reach is due
-    sooner, while its foot is still on its way, and that configuration's landings then wait up to 0.17 s)."""
+    sooner, while its foot is still on its way, and that configuration's landings then wait up to 0.17 s), and before
+    a lift-off waited for the other foot to be down (MotionConfig.liftoff_needs_other_foot_down off)."""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '08_08.bvh'}"
 
     def run(landing_weight: float):
@@ -1298,7 +1300,8 @@ def test_a_recovery_step_whose_landing_is_due_is_pressed_onto_the_ground():
             last_tick_s[0] = state.time_s
 
         result = suite_run(spec, 1, MotionConfig(recovery_cross_nearest=False, recovery_cross_stance_frame=False,
-                                                 fraction_needs_feet_in_his_order=False, recovery_swing_min_s=None),
+                                                 fraction_needs_feet_in_his_order=False, recovery_swing_min_s=None,
+                                                 liftoff_needs_other_foot_down=False),
                            ControlConfig(whole_body=WholeBodyConfig(recovery_foot_landing_weight=landing_weight,
                                                                     joint_speed_limit_rad_s=None)),
                            on_tick=on_tick)

@@ -149,8 +149,9 @@ class MotionConfig:
     # foot. Standing on that sole alone, the body could only fall back onto the foot it lifts [m] (None: off).
     liftoff_capture_behind_m: float | None = 0.05
     # A lift-off from double stance waits, however long, while the foot the operator lifts is the only one of the
-    # character's on the ground (stance_fsm.CharacterStanceFsm): lifted, it would leave the body on a foot in the air.
-    liftoff_needs_other_foot_down: bool = False
+    # character's on the ground (stance_fsm.CharacterStanceFsm): lifted, it would leave the body on a foot in the air
+    # (docs/decisions.md, "A lift-off onto a foot in the air").
+    liftoff_needs_other_foot_down: bool = True
     # A raised rear foot that still bears weight (on its toes, pose_optimization._rear_foot_bears_weight): while the
     # operator's capture point is more than this behind his stance sole's heel (the character's sole scaled to him,
     # in the heading frame) and his raised foot is behind it, his single stance is read as a double stance.
