@@ -10,7 +10,7 @@ from scipy.optimize import nnls
 
 from stylesync import rotations as rot
 from stylesync.config import WorldConfig
-from stylesync.control.contacts import FRICTION_MARGIN, REGULARISATION, SOLE_CORNERS_IN_SOLE, SoleContact
+from stylesync.control.contacts import REGULARISATION, SOLE_CORNERS_IN_SOLE, SoleContact, pyramid_edges
 from stylesync.control.formulation import WholeBodyFormulation
 from stylesync.control.sole_wrench_contact import (
     WRENCH_SIZE,
@@ -24,8 +24,6 @@ from stylesync.control.whole_body import _TORQUE_LIMIT_FLAT
 from stylesync.model.character import N_DOFS, ROOT_DOFS, STANDING_ROOT_HEIGHT_M
 from stylesync.model.character_model import CharacterModel
 from stylesync.sim.pybullet_backend import PyBulletBackend
-
-MU = FRICTION_MARGIN * 0.9
 
 
 @pytest.fixture(scope="module")
@@ -44,7 +42,7 @@ def test_the_cone_holds_exactly_what_the_corner_pyramids_give():
     """A wrench satisfies U w <= 0 if and only if non-negative corner forces give it (non-negative least squares
     with no residual), over random wrenches in, near and out of the cone; every face holds 5 independent
     generators (a facet, not a redundant row)."""
-    g = corner_wrench_generators(MU, SOLE_CORNERS_IN_SOLE)
+    g = corner_wrench_generators(pyramid_edges(0.9), SOLE_CORNERS_IN_SOLE)
     u = contact_wrench_cone(g)
     assert u.shape == (32, WRENCH_SIZE)
     assert np.max(u @ g) < 1e-9
@@ -66,7 +64,7 @@ def test_the_cone_holds_exactly_what_the_corner_pyramids_give():
 def test_the_regularisation_is_the_least_norm_corner_forces():
     """ε wᵀ (G Gᵀ)⁻¹ w equals ε |λ|² for the least-norm corner forces λ of w: here a standing sole's wrench, whose
     least-norm λ are all positive (so the pyramid contact's regularisation of that wrench is the same)."""
-    g = corner_wrench_generators(MU, SOLE_CORNERS_IN_SOLE)
+    g = corner_wrench_generators(pyramid_edges(0.9), SOLE_CORNERS_IN_SOLE)
     w = np.array([5.0, -3.0, 220.0, 2.0, -4.0, 0.3])
     lam = np.linalg.pinv(g) @ w
     assert lam.min() > 0.0
@@ -97,7 +95,7 @@ def test_a_qp_with_wrench_contacts_obeys_the_dynamics_the_contacts_and_the_cone(
     residual = model.mass_matrix @ qdd + model.bias_forces - gen @ result.x[N_DOFS:]
     np.testing.assert_allclose(residual[:ROOT_DOFS], 0.0, atol=1e-6)
     np.testing.assert_allclose(residual[ROOT_DOFS:], tau, atol=1e-6)
-    cone = contact_wrench_cone(corner_wrench_generators(MU, SOLE_CORNERS_IN_SOLE))
+    cone = contact_wrench_cone(corner_wrench_generators(pyramid_edges(0.9), SOLE_CORNERS_IN_SOLE))
     for c, w in zip(contacts, wrenches, strict=True):
         jac, acc = c.constraint_rows(10.0)
         np.testing.assert_allclose(jac @ qdd, acc, atol=1e-6)

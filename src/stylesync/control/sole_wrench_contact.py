@@ -2,13 +2,14 @@
 contacts for humanoid robots: closed-form formulae of the contact wrench cone for rectangular support areas",
 ICRA 2015).
 
-The corner pyramids of contacts.py span a cone of wrenches at the sole's centre; for a rectangular sole with the
-pyramids in the sole's own axes, that cone has the closed form ``U w <= 0`` of 16 rows (the paper's Eq. 13-16):
-friction on the resultant force, the centre of pressure inside the sole, and the torsion about the normal within
-what the corners' friction can give. Its variables are the six components of the wrench ``w = (f, τ)`` at the
-sole's centre in world axes, instead of 16 magnitudes λ: the QP has 10 variables fewer per sole, and the active
-set that its solver carries from tick to tick holds only the faces the wrench lies on instead of every unloaded
-pyramid edge (docs/decisions.md, "The soles' wrench cone").
+The corner pyramids of contacts.py span a cone of wrenches at the sole's centre, ``U w <= 0``: friction on the
+resultant force, the centre of pressure inside the sole, and the torsion about the normal within what the corners'
+friction can give. The paper gives its 16 rows in closed form for square pyramids; ours have their edges along the
+sole's axes, and the cone's 32 rows are found once from the generators (:func:`contact_wrench_cone`). The variables
+are the six components of the wrench ``w = (f, τ)`` at the sole's centre in world axes, instead of 16 magnitudes λ:
+the QP has 10 variables fewer per sole, and the active set its solver carries from tick to tick holds only the faces
+the wrench lies on instead of every unloaded pyramid edge (docs/decisions.md, "The control tick on the model and the
+QP: where the time goes").
 
 The pyramids turn with the sole (about the vertical, for a flat foot): with contacts.py's they keep the world's
 axes. The regularisation is the corner forces' one, ``ε |λ|²`` for the least-norm λ that gives ``w``:
@@ -22,14 +23,13 @@ import numpy as np
 from scipy.spatial import ConvexHull
 
 from stylesync.control.contacts import (
-    _EDGE_DIRS,
-    FRICTION_MARGIN,
     INFINITY,
     MAX_NORMAL_FORCE_BODY_WEIGHTS,
     MIN_WEIGHT,
     RAMP_WEIGHT,
     REGULARISATION,
     SOLE_CORNERS_IN_SOLE,
+    pyramid_edges,
 )
 from stylesync.model.character_model import SOLE_FRAMES, CharacterModel
 
@@ -40,7 +40,7 @@ def contact_wrench_cone(generators: np.ndarray) -> np.ndarray:
     """(k, 6) U with ``U w <= 0`` exactly the cone spanned by the columns of ``generators`` (6, m), each with a
     positive normal force (row 2): the facets of the generators' section at unit normal force, a 5-dimensional
     polytope (its convex hull by Qhull), each ``a·p + b <= 0`` read as ``a·(w without f_z) + b f_z <= 0``.
-    For a rectangle's four corner pyramids this is the 16-row cone of Caron et al. (2015)."""
+    For a rectangle's four corner pyramids with their edges along its axes, 32 rows."""
     g = np.asarray(generators, dtype=float)
     section = np.delete(g / g[2], 2, axis=0).T  # (m, 5): each generator scaled to f_z = 1, without f_z
     hull = ConvexHull(section)
@@ -49,12 +49,10 @@ def contact_wrench_cone(generators: np.ndarray) -> np.ndarray:
     return np.unique(np.round(rows, 12), axis=0)  # Qhull splits a facet into simplices: one row each
 
 
-def corner_wrench_generators(friction: float, corners_in_sole: np.ndarray) -> np.ndarray:
-    """(6, 16) G: the wrench at the sole's centre, in its axes, of a unit force along each corner's pyramid edge
-    (corner by corner, edge by edge as contacts.py orders them)."""
-    e = np.column_stack([friction * _EDGE_DIRS, np.ones(4)])
-    e /= np.linalg.norm(e, axis=1, keepdims=True)
-    cols = [np.concatenate([b, np.cross(c, b)]) for c in corners_in_sole for b in e]
+def corner_wrench_generators(edges: np.ndarray, corners_in_sole: np.ndarray) -> np.ndarray:
+    """(6, 16) G: the wrench at the sole's centre, in its axes, of a unit force along each of the pyramid ``edges``
+    (4, 3) at each corner (4, 3) (corner by corner, edge by edge as contacts.py orders them)."""
+    cols = [np.concatenate([b, np.cross(c, b)]) for c in corners_in_sole for b in edges]
     return np.array(cols).T
 
 
@@ -69,7 +67,7 @@ class SoleWrenchContact:
         self.frame = SOLE_FRAMES[side]
         self.body_weight_n = body_weight_n
         self.stance_weight = 1.0  # set per tick: the share of the body this foot is meant to carry, [0, 1]
-        g = corner_wrench_generators(FRICTION_MARGIN * friction, SOLE_CORNERS_IN_SOLE)
+        g = corner_wrench_generators(pyramid_edges(friction), SOLE_CORNERS_IN_SOLE)
         self._cone_in_sole = contact_wrench_cone(g)  # (16, 6), in the sole's axes
         self._metric_in_sole = np.linalg.inv(g @ g.T)  # (6, 6) (G Gᵀ)⁻¹
         # Per tick, after update(): as SoleContact's; the cone's rows in world axes.
