@@ -12,8 +12,10 @@ with the stance weight, so contacts are added and removed without a jump of the 
 from __future__ import annotations
 
 import functools
+from abc import ABC, abstractmethod
 
 import numpy as np
+import pinocchio as pin
 
 from stylesync.model.character_model import SOLE_FRAMES, CharacterModel
 from stylesync.model.sole import sole_corners_in_foot, sole_within_m
@@ -84,32 +86,83 @@ def feasible_horizontal_force(force_n: np.ndarray, com_world: np.ndarray, corner
     return out
 
 
-class SoleContact:
-    """One foot's sole on the ground, as the whole-body QP sees it: its force variables are the magnitudes λ of the
-    unit forces along the four corners' friction pyramids (world axes).
+class SoleContactBase(ABC):
+    """One foot's sole on the ground, as the whole-body QP sees it: its kinematics at the model's state, its
+    regularisation's weight and its normal force's bound, whatever its force variables.
 
-    What the formulation reads of a contact (the same for :class:`~stylesync.control.sole_wrench_contact.
-    SoleWrenchContact`): ``n_forces`` variables, their ``generator`` (nv, n_forces) in the equations of motion,
-    their regularisation (:meth:`add_regularisation`), the ``normal_row`` (n_forces,) that gives the normal force,
-    and ``force_rows`` (k, n_forces) with ``force_lower``/``force_upper`` (k,): the force variables' own
-    inequalities, the same at every tick when ``force_rows_constant``."""
+    What the formulation reads of a contact: ``n_forces`` variables, their ``generator`` (nv, n_forces) in the
+    equations of motion, their regularisation (:meth:`add_regularisation`), the ``normal_row`` (n_forces,) that gives
+    the normal force, and ``force_rows`` (k, n_forces) with ``force_lower``/``force_upper`` (k,): the force variables'
+    own inequalities, the same at every tick when ``force_rows_constant``. A subclass fills those from the sole's
+    placement (:meth:`_update_forces`)."""
 
-    n_forces = FORCES_PER_SOLE
-    force_rows_constant = True  # λ >= 0: unit rows
+    n_forces: int
+    force_rows_constant: bool
+    normal_row: np.ndarray
+    force_rows: np.ndarray
+    force_lower: np.ndarray
+    force_upper: np.ndarray
 
-    def __init__(self, side: str, friction: float, body_weight_n: float):
+    def __init__(self, side: str, body_weight_n: float):
         self.side = side
         self.frame = SOLE_FRAMES[side]
-        self.edges = pyramid_edges(friction)  # (4, 3)
         self.body_weight_n = body_weight_n
         self.stance_weight = 1.0  # set per tick: the share of the body this foot is meant to carry, [0, 1]
-        # Per tick, after update(): the generator (nv, 16), the sole's Jacobian (6, nv), drift (6,), corners (4, 3).
+        # Per tick, after update(): the generator (nv, n_forces), the sole's Jacobian (6, nv), drift (6,), corners
+        # (4, 3).
         self.generator = np.zeros((0, 0))
         self.jacobian = np.zeros((6, 0))
         self.drift = np.zeros(6)
         self.velocity = np.zeros(6)
         self.corners_world = np.zeros((4, 3))
         self._updated_for: tuple[int, int] | None = None  # (model, revision) of the last update
+
+    def update(self, model: CharacterModel) -> None:
+        """The sole's Jacobian, drift, velocity, corners and force variables' terms at the model's current state
+        (once per model update: a second call for the same state does nothing)."""
+        if self._updated_for == (id(model), model.revision):
+            return
+        self._updated_for = (id(model), model.revision)
+        f = model.frame_id(self.frame)
+        self.jacobian = model.frame_jacobian(f)
+        self.drift = model.frame_drift(f)
+        self.velocity = model.frame_velocity(f)
+        self._update_forces(model.frame_placement(f))
+
+    @abstractmethod
+    def _update_forces(self, placement: pin.SE3) -> None:
+        """``corners_world``, ``generator`` and what else of the force variables turns with the sole, from its world
+        ``placement`` (``jacobian`` is current)."""
+
+    @abstractmethod
+    def add_regularisation(self, hessian: np.ndarray, start: int) -> None:
+        """Set this contact's regularisation in the QP's ``hessian`` (n, n) from variable ``start`` on."""
+
+    @property
+    def regularisation(self) -> float:
+        """ε of this contact's forces: larger as its stance weight falls."""
+        return REGULARISATION / max(self.stance_weight, MIN_WEIGHT)
+
+    @property
+    def max_normal_force_n(self) -> float:
+        """Upper bound of the normal force [N], ramped down with the stance weight below RAMP_WEIGHT."""
+        return MAX_NORMAL_FORCE_BODY_WEIGHTS * self.body_weight_n * min(1.0, self.stance_weight / RAMP_WEIGHT)
+
+    def constraint_rows(self, velocity_gain: float) -> tuple[np.ndarray, np.ndarray]:
+        """The sole does not move: ``J q̈ = -J̇ q̇ - k_v J q̇`` (its residual velocity damped at ``velocity_gain``)."""
+        return self.jacobian, -self.drift - velocity_gain * self.velocity
+
+
+class SoleContact(SoleContactBase):
+    """A sole whose force variables are the magnitudes λ of the unit forces along its four corners' friction pyramids
+    (world axes)."""
+
+    n_forces = FORCES_PER_SOLE
+    force_rows_constant = True  # λ >= 0: unit rows
+
+    def __init__(self, side: str, friction: float, body_weight_n: float):
+        super().__init__(side, body_weight_n)
+        self.edges = pyramid_edges(friction)  # (4, 3)
         self.force_rows = np.eye(FORCES_PER_SOLE)
         self.force_lower, self.force_upper = np.zeros(FORCES_PER_SOLE), np.full(FORCES_PER_SOLE, INFINITY)
         # Normal components of the 16 unit forces (the same at every corner): Σ_e n_e λ_e is the normal force.
@@ -123,38 +176,14 @@ class SoleContact:
                 lever_to_moments[:, 4 * c + e, c, :] = np.cross(np.eye(3), b).T  # K r = r × b
         self._lever_to_moments = lever_to_moments.reshape(3 * FORCES_PER_SOLE, 12)
 
-    def update(self, model: CharacterModel) -> None:
-        """The sole's Jacobian, drift, velocity, corners and generator at the model's current state (once per model
-        update: a second call for the same state does nothing)."""
-        if self._updated_for == (id(model), model.revision):
-            return
-        self._updated_for = (id(model), model.revision)
-        f = model.frame_id(self.frame)
-        self.jacobian = model.frame_jacobian(f)
-        self.drift = model.frame_drift(f)
-        self.velocity = model.frame_velocity(f)
-        placement = model.frame_placement(f)
+    def _update_forces(self, placement: pin.SE3) -> None:
         levers = SOLE_CORNERS_IN_SOLE @ placement.rotation.T  # (4, 3) corner - sole centre, world axes
         self.corners_world = placement.translation + levers
         # B = Σ_c J_cᵀ β_e = J_linᵀ β_e + J_angᵀ (r_c × β_e), corner by corner, edge by edge.
         moments = (self._lever_to_moments @ levers.reshape(12)).reshape(3, FORCES_PER_SOLE)
         self.generator = self.jacobian[:3].T @ self._forces + self.jacobian[3:].T @ moments
 
-    @property
-    def regularisation(self) -> float:
-        """ε of this contact's forces: larger as its stance weight falls."""
-        return REGULARISATION / max(self.stance_weight, MIN_WEIGHT)
-
     def add_regularisation(self, hessian: np.ndarray, start: int) -> None:
         """Set ``ε λ²`` on the diagonal of the QP's ``hessian`` (n, n) from variable ``start`` on."""
         n = len(hessian)
         hessian.ravel()[start * (n + 1):(start + self.n_forces) * (n + 1):n + 1] = self.regularisation
-
-    @property
-    def max_normal_force_n(self) -> float:
-        """Upper bound of the normal force [N], ramped down with the stance weight below RAMP_WEIGHT."""
-        return MAX_NORMAL_FORCE_BODY_WEIGHTS * self.body_weight_n * min(1.0, self.stance_weight / RAMP_WEIGHT)
-
-    def constraint_rows(self, velocity_gain: float) -> tuple[np.ndarray, np.ndarray]:
-        """The sole does not move: ``J q̈ = -J̇ q̇ - k_v J q̇`` (its residual velocity damped at ``velocity_gain``)."""
-        return self.jacobian, -self.drift - velocity_gain * self.velocity

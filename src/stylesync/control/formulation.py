@@ -17,19 +17,18 @@ and the torques follow from the joint rows of the equations of motion, ``τ = M_
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TypeVar
 
 import numpy as np
 
-from stylesync.control.contacts import INFINITY, SoleContact
-from stylesync.control.sole_wrench_contact import SoleWrenchContact
+from stylesync.control.contacts import INFINITY, SoleContactBase
 from stylesync.control.tasks.base import Task
 from stylesync.model.character import JOINT_DOF_START, JOINTS, N_DOFS, ROOT_DOFS, JointKind
 from stylesync.model.character_model import CharacterModel
 
 T = TypeVar("T", bound=Task)
-Contact = SoleContact | SoleWrenchContact  # what the formulation reads of a contact: SoleContact's docstring
 
 
 @dataclass
@@ -109,7 +108,7 @@ class WholeBodyFormulation:
                 return t
         raise KeyError(f"no task '{name}'; tasks: {', '.join(t.name for t in self.tasks)}")
 
-    def build(self, model: CharacterModel, contacts: list[Contact]) -> QpProblem:
+    def build(self, model: CharacterModel, contacts: Sequence[SoleContactBase]) -> QpProblem:
         nv = N_DOFS
         n_c = len(contacts)
         n_f = sum(c.n_forces for c in contacts)
@@ -174,7 +173,7 @@ class WholeBodyFormulation:
             upper[first:] = np.maximum(2.0 * (self._limit_upper - q - qd * t) / (t * t), 0.0)
         return QpProblem(h_mat, g, rows, lower, upper, n_eq, n_f)
 
-    def _template(self, contacts: list[Contact]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _template(self, contacts: Sequence[SoleContactBase]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The constraint rows and bounds of a QP with these soles that are the same at every tick: the contacts'
         constant force rows (the pyramids' λ >= 0) and their force rows' bounds, the normal forces' lower bound 0
         and the hinges' unit rows; the rest is zero."""

@@ -20,18 +20,10 @@ that least-norm solution is positive, and smaller near the cone's faces, where c
 from __future__ import annotations
 
 import numpy as np
+import pinocchio as pin
 from scipy.spatial import ConvexHull
 
-from stylesync.control.contacts import (
-    INFINITY,
-    MAX_NORMAL_FORCE_BODY_WEIGHTS,
-    MIN_WEIGHT,
-    RAMP_WEIGHT,
-    REGULARISATION,
-    SOLE_CORNERS_IN_SOLE,
-    pyramid_edges,
-)
-from stylesync.model.character_model import SOLE_FRAMES, CharacterModel
+from stylesync.control.contacts import INFINITY, SOLE_CORNERS_IN_SOLE, SoleContactBase, pyramid_edges
 
 WRENCH_SIZE = 6
 
@@ -56,44 +48,25 @@ def corner_wrench_generators(edges: np.ndarray, corners_in_sole: np.ndarray) -> 
     return np.array(cols).T
 
 
-class SoleWrenchContact:
-    """One foot's sole on the ground with its wrench as the force variables (the interface of contacts.SoleContact)."""
+class SoleWrenchContact(SoleContactBase):
+    """A sole whose force variables are its wrench at its centre, in world axes, inside its contact wrench cone."""
 
     n_forces = WRENCH_SIZE
     force_rows_constant = False  # the cone turns with the sole
 
     def __init__(self, side: str, friction: float, body_weight_n: float):
-        self.side = side
-        self.frame = SOLE_FRAMES[side]
-        self.body_weight_n = body_weight_n
-        self.stance_weight = 1.0  # set per tick: the share of the body this foot is meant to carry, [0, 1]
+        super().__init__(side, body_weight_n)
         g = corner_wrench_generators(pyramid_edges(friction), SOLE_CORNERS_IN_SOLE)
-        self._cone_in_sole = contact_wrench_cone(g)  # (16, 6), in the sole's axes
+        self._cone_in_sole = contact_wrench_cone(g)  # (32, 6), in the sole's axes
         self._metric_in_sole = np.linalg.inv(g @ g.T)  # (6, 6) (G Gᵀ)⁻¹
-        # Per tick, after update(): as SoleContact's; the cone's rows in world axes.
-        self.generator = np.zeros((0, 0))
-        self.jacobian = np.zeros((6, 0))
-        self.drift = np.zeros(6)
-        self.velocity = np.zeros(6)
-        self.corners_world = np.zeros((4, 3))
+        # Per tick, after update(): the cone's rows, the normal and the metric in world axes.
         self.normal_row = np.zeros(WRENCH_SIZE)
         self.force_rows = np.zeros((len(self._cone_in_sole), WRENCH_SIZE))
         self.force_lower = np.full(len(self._cone_in_sole), -INFINITY)
         self.force_upper = np.zeros(len(self._cone_in_sole))
         self._metric_world = np.zeros((WRENCH_SIZE, WRENCH_SIZE))
-        self._updated_for: tuple[int, int] | None = None  # (model, revision) of the last update
 
-    def update(self, model: CharacterModel) -> None:
-        """The sole's Jacobian, drift, velocity, corners, generator ``Jᵀ`` and wrench cone in world axes at the
-        model's current state (once per model update)."""
-        if self._updated_for == (id(model), model.revision):
-            return
-        self._updated_for = (id(model), model.revision)
-        f = model.frame_id(self.frame)
-        self.jacobian = model.frame_jacobian(f)
-        self.drift = model.frame_drift(f)
-        self.velocity = model.frame_velocity(f)
-        placement = model.frame_placement(f)
+    def _update_forces(self, placement: pin.SE3) -> None:
         r = placement.rotation
         self.corners_world = placement.translation + SOLE_CORNERS_IN_SOLE @ r.T
         self.generator = self.jacobian.T  # (nv, 6): the wrench at the sole's centre, world axes
@@ -105,20 +78,6 @@ class SoleWrenchContact:
         rr[:3, :3] = rr[3:, 3:] = r
         self._metric_world = rr @ self._metric_in_sole @ rr.T
 
-    @property
-    def regularisation(self) -> float:
-        """ε of the corner forces this wrench stands for: larger as its stance weight falls."""
-        return REGULARISATION / max(self.stance_weight, MIN_WEIGHT)
-
     def add_regularisation(self, hessian: np.ndarray, start: int) -> None:
         """Set ``ε wᵀ (G Gᵀ)⁻¹ w`` (world axes) in the QP's ``hessian`` from variable ``start`` on."""
         hessian[start:start + WRENCH_SIZE, start:start + WRENCH_SIZE] = self.regularisation * self._metric_world
-
-    @property
-    def max_normal_force_n(self) -> float:
-        """Upper bound of the normal force [N], ramped down with the stance weight below RAMP_WEIGHT."""
-        return MAX_NORMAL_FORCE_BODY_WEIGHTS * self.body_weight_n * min(1.0, self.stance_weight / RAMP_WEIGHT)
-
-    def constraint_rows(self, velocity_gain: float) -> tuple[np.ndarray, np.ndarray]:
-        """The sole does not move: ``J q̈ = -J̇ q̇ - k_v J q̇``."""
-        return self.jacobian, -self.drift - velocity_gain * self.velocity

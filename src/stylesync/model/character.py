@@ -83,6 +83,7 @@ LINK_PARENT: dict[str, str | None] = {
 }
 FOOT_LINKS: tuple[str, str] = ("left_ankle", "right_ankle")
 SIDES: tuple[str, str] = ("left", "right")
+OTHER_SIDE: dict[str, str] = {"left": "right", "right": "left"}
 
 # Segment geometry of the character [m] (joint offsets of the URDF times its 0.25 scaling).
 THIGH_LENGTH_M = 1.686184 * URDF_GLOBAL_SCALING

@@ -34,6 +34,7 @@ from stylesync.model.character import (
     JOINTS,
     LEG_LINKS,
     LINK_NAMES,
+    OTHER_SIDE,
     SHANK_LENGTH_M,
     THIGH_LENGTH_M,
     JointKind,
@@ -90,7 +91,6 @@ _BALL_JOINTS = [k for k, j in enumerate(JOINTS) if j.kind is JointKind.BALL]
 _HINGE_JOINTS = [k for k, j in enumerate(JOINTS) if j.kind is not JointKind.BALL]
 _VELOCITY_SMOOTHING = 0.2  # per tick, exponential average of the desired COM velocity
 _SIDE_UP = {"left": "LEFT", "right": "RIGHT"}
-_OTHER_SIDE = {"left": "right", "right": "left"}
 _LINK = {n: i for i, n in enumerate(LINK_NAMES)}
 _ROOT_LINK = _LINK["root"]
 CHAR_LEG_LENGTH_M = THIGH_LENGTH_M + SHANK_LENGTH_M
@@ -333,7 +333,7 @@ class MotionOptimizer:
             edge = FOOT_WIDTH_M / 2 + cfg.liftoff_margin_m
         can = {}
         for side in ("left", "right"):
-            stance = _OTHER_SIDE[side]
+            stance = OTHER_SIDE[side]
             ankle = state.link_origin_world[_LINK[f"{stance}_ankle"]]
             foot_q = state.link_quat_wxyz[_LINK[f"{stance}_ankle"]]
             may = not (behind_limit_m is not None and pressing[side] and beyond_sole_towards_m(
@@ -567,7 +567,7 @@ class MotionOptimizer:
         sw = tick.swing = swing_side(tick.ch_state)
         for side in ("left", "right"):
             if side == sw and self.char_fsm.recovery_step:
-                other = _OTHER_SIDE[side]
+                other = OTHER_SIDE[side]
                 com_vel = (mass.com_velocity_carried(state, LEG_LINKS[side], _ROOT_LINK)
                            if self.cfg.recovery_landing_without_swing else tick.com_vel_c)
                 tick.targets[side] = self.recovery.swing_target(
@@ -693,7 +693,7 @@ class MotionOptimizer:
         capture point further out diverges beyond the landing before the foot is down: a long single stance (a slow,
         styled step) keeps it over the stance foot. With "sideways", only the change across the heading is taken."""
         assert tick.swing is not None and tick.swing_landing_xy is not None
-        other = _OTHER_SIDE[tick.swing]
+        other = OTHER_SIDE[tick.swing]
         stance = sole_points_xy(tick.a_c[other], state.link_quat_wxyz[_LINK[f"{other}_ankle"]], self._sole_bound)
         _, omega = capture_point(tick.com_c, tick.com_vel_c, self.g)
         remaining_s = max(self._op_swing_s - (state.time_s - self._swing_t0_s), 0.0)
@@ -716,7 +716,7 @@ class MotionOptimizer:
         the character can stop where he does."""
         if not self._operator_stands(tick):
             return landing
-        other = _OTHER_SIDE[side]
+        other = OTHER_SIDE[side]
         stance_q = state.link_quat_wxyz[_LINK[f"{other}_ankle"]]
         remaining_s = max(self._op_swing_s - (state.time_s - self._swing_t0_s), 0.0)
         capture, xi_land = self.recovery.capture_landing(remaining_s, tick.com_c, tick.com_vel_c, tick.a_c[other],
@@ -811,7 +811,7 @@ class MotionOptimizer:
         if len(on_ground) < 2:
             return True
         return min(self.recovery.capture_residual_m(tick.com_c, tick.com_vel_c, tick.a_c[s], quats[s], tick.R_root_d,
-                                                    _OTHER_SIDE[s]) for s in on_ground) <= 0.0
+                                                    OTHER_SIDE[s]) for s in on_ground) <= 0.0
 
     def _wait_for_his_lift_off_s(self, tick: _Tick, state: CharacterState) -> float:
         """How long until the operator's next lift-off, on his usual timing [s]: the rest of his double stance, or
@@ -840,7 +840,7 @@ class MotionOptimizer:
         if (not cfg.recovery_steps or sw is None or sw != self._swing or self.char_fsm.recovery_step
                 or self.char_fsm.hold_reference):
             return
-        other = _OTHER_SIDE[sw]
+        other = OTHER_SIDE[sw]
         stance_q = state.link_quat_wxyz[_LINK[f"{other}_ankle"]]
         if (overrun_s > 0.0 and cfg.recovery_on_reach_limit
                 and self._capture_beyond_reach_at_his_landing(tick, state, sw, stance_q)):
@@ -860,7 +860,7 @@ class MotionOptimizer:
         before he would (recovery_step.capture_point_after, as a recovery step's landing predicts it). Past his
         usual swing time the landing is predicted a recovery swing from now with ``recovery_overdue_swing_horizon``
         (the soonest any landing can come), and now without."""
-        ankle = tick.a_c[_OTHER_SIDE[side]]
+        ankle = tick.a_c[OTHER_SIDE[side]]
         elapsed_s = state.time_s - self._swing_t0_s
         remaining_s = max(self._op_swing_s - elapsed_s, 0.0)
         if self.cfg.recovery_overdue_swing_horizon and elapsed_s >= self._op_swing_s:
@@ -882,7 +882,7 @@ class MotionOptimizer:
         horizontal reach of its hip, the pelvis at its landing floor.
         """
         cfg = self.cfg
-        other = _OTHER_SIDE[side]
+        other = OTHER_SIDE[side]
         a_h, a_c, scale, R_root_d = tick.a_h, tick.a_c, tick.scale, tick.R_root_d
         first_tick = self._swing != side
         if first_tick and self._aim_at_his_landing:
@@ -964,7 +964,7 @@ class MotionOptimizer:
         than its way to the landing (MotionConfig.free_swing): 1 while his capture point is within the sole he
         stands on and the character's within its own (neither needs the swing foot to land: a kick, a raised leg),
         0 otherwise; it moves between the two over FREE_SWING_BLEND_S, so that the target does not jump."""
-        other = _OTHER_SIDE[side]
+        other = OTHER_SIDE[side]
         free = self._operator_stands(tick, (other,)) and self._capture_near_support(tick, state, 0.0, [other])
         step = self.dt_s / FREE_SWING_BLEND_S
         self._free_share = min(self._free_share + step, 1.0) if free else max(self._free_share - step, 0.0)
@@ -989,7 +989,7 @@ class MotionOptimizer:
                 hip_w = state.link_origin_world[_LINK[f"{side}_hip"]].copy()
                 q_root_frame = state.root_quat_wxyz
             N = features.N_l if side == "left" else features.N_r
-            other = _OTHER_SIDE[side]
+            other = OTHER_SIDE[side]
             ik = solve_leg(hip_w, tick.targets[side], THIGH_LENGTH_M, SHANK_LENGTH_M, N)
             q_thigh = ik.thigh_quat_wxyz
             if side == sw:

@@ -61,6 +61,7 @@ from stylesync.model.character import (
     FOOT_WIDTH_M,
     HIP_HALF_WIDTH_M,
     LINK_NAMES,
+    OTHER_SIDE,
 )
 from stylesync.model.sole import (
     convex_hull_points,
@@ -84,7 +85,6 @@ LANDING_PRESS_M = 0.02  # after the nominal swing time the foot is aimed this fa
 HORIZONTAL_SHARE = 0.8
 ON_GROUND_GAP_M = 0.01  # a sole whose lowest corner is this close to the ground counts in the support polygon [m]
 _SOLE_POINTS = sole_corner_points()  # the character's sole relative to its ankle [m]
-_OTHER = {"left": "right", "right": "left"}
 _ANKLE = {s: LINK_NAMES.index(f"{s}_ankle") for s in ("left", "right")}
 _OUT = {"left": 1.0, "right": -1.0}
 _UP = np.array([0.0, 0.0, 1.0])  # world up (Z)
@@ -304,7 +304,7 @@ class RecoveryStepper:
             # landed where it is it would leave the predicted capture point no further outside the support than its
             # step would, within reach of the sole on the ground, it is landing where the body goes: a step would
             # take it back from there.
-            up = _OTHER[stance]
+            up = OTHER_SIDE[stance]
             landing, xi_land = self.capture_landing(cfg.recovery_swing_s, com_world, com_vel_world,
                                                     ankles_world[stance], feet_quat_wxyz[stance], heading_world, up)
             stepped = outside_step_m(xi_land, ankles_world[stance], feet_quat_wxyz[stance], landing, heading_world)
@@ -314,11 +314,11 @@ class RecoveryStepper:
                 return None
         if heading_world is not None and len(on_ground) == 2:
             residual = {s: self.capture_residual_m(com_world, com_vel_world, ankles_world[s], feet_quat_wxyz[s],
-                                                   heading_world, _OTHER[s]) for s in on_ground}
+                                                   heading_world, OTHER_SIDE[s]) for s in on_ground}
             best = min(residual.values())
             if residual[stance] > best + 1e-3:
                 stance = min(residual, key=lambda s: residual[s])
-        side = _OTHER[stance]
+        side = OTHER_SIDE[stance]
         self.step = RecoveryStep(side, time_s, np.array(ankles_world[side], dtype=float),
                                  np.array(ankles_world[side], dtype=float), cfg.recovery_swing_s)
         self.count += 1

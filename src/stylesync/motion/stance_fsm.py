@@ -17,14 +17,13 @@ from __future__ import annotations
 
 from enum import Enum
 
+from stylesync.model.character import OTHER_SIDE
+
 
 class Stance(Enum):
     LS = "LS"  # left stance (right foot swinging)
     RS = "RS"  # right stance
     DS = "DS"  # double stance
-
-
-_OTHER = {"left": "right", "right": "left"}
 
 
 def swing_side(s: Stance) -> str | None:
@@ -155,7 +154,7 @@ class CharacterStanceFsm:
             return self.state
         sw_op = swing_side(op)
         if (self.lift_needs_other_down and self.state is Stance.DS and sw_op is not None and contact[sw_op]
-                and not contact[_OTHER[sw_op]]):
+                and not contact[OTHER_SIDE[sw_op]]):
             # The foot he lifts is the character's only one on the ground: lifted, it would stand on a foot in the air.
             self.waiting_to_lift = True
             return self.state
