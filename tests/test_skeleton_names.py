@@ -39,6 +39,10 @@ needs_cmu_dev = pytest.mark.skipif(not (MOCAP / "cmu-dev").is_dir(),
     ("hip", None, "hip", False),
     ("LHipJoint", "left", "hipjoint", False),
     ("lFootEnd", "left", "footend", False),
+    ("L_Ankle", "left", "ankle", False),
+    ("left_foot", "left", "foot", False),
+    ("LUArm", "left", "uarm", False),
+    ("RFArm", "right", "farm", False),
 ])
 def test_parse_name(name, side, word, helper):
     assert parse_name(name) == ParsedName(side, word, helper)
@@ -52,32 +56,55 @@ def test_first_ranked_synonym_wins_and_helpers_are_skipped():
     assert match_by_name(["Hips", "LeftCollar", "LeftShoulder"])["SHOULDER_LEFT"][0] == "LeftShoulder"
     m = match_by_name(["lThighBend", "lThighTwist", "lShin"])
     assert m["HIP_LEFT"][0] == "lThighBend" and m["KNEE_LEFT"][0] == "lShin"
+    # SMPL: the ankle is L_Ankle and its child L_Foot the toe; MotionBuilder's LeftFoot is the ankle.
+    m = match_by_name(["Pelvis", "L_Hip", "L_Knee", "L_Ankle", "L_Foot"])
+    assert m["ANKLE_LEFT"][0] == "L_Ankle" and m["FOOT_LEFT"][0] == "L_Foot"
+    # A file joint stands for one canonical joint: a foot joint taken as the ankle is not the toe as well.
+    m = match_by_name(["Hips", "LeftUpLeg", "LeftLeg", "LeftFoot", "LeftFootEnd"])
+    assert m["ANKLE_LEFT"][0] == "LeftFoot" and m["FOOT_LEFT"][0] == "LeftFootEnd"
+    # OptiTrack Motive: LShoulder is the clavicle, LUArm the upper arm, LFArm the forearm.
+    m = match_by_name(["Hip", "LShoulder", "LUArm", "LFArm", "LHand"])
+    assert m["SHOULDER_LEFT"][0] == "LUArm" and m["ELBOW_LEFT"][0] == "LFArm"
 
 
-# Renamings of CMU 02_01's MotionBuilder names into the conventions users bring (toe, clavicle and neck joints kept).
+# Renamings of CMU 02_01's MotionBuilder names into the conventions users bring (toe, clavicle and neck joints kept):
+# SMPL/AMASS exports (an ankle joint and a foot joint below it), Xsens MVN, OptiTrack Motive among them.
 _SEGMENTS = {  # MotionBuilder name (side "Left"/"Right" or none) -> convention -> name pattern ({L}/{Left}: side)
-    "Hips": {"unity": "Hips", "poser": "hip", "blender": "pelvis", "biped": "Bip01 Pelvis", "vrm": "J_Bip_C_Hips"},
+    "Hips": {"unity": "Hips", "poser": "hip", "blender": "pelvis", "biped": "Bip01 Pelvis", "vrm": "J_Bip_C_Hips",
+             "smpl": "Pelvis", "smplx": "pelvis", "xsens": "Hips", "motive": "Hip"},
     "UpLeg": {"unity": "UpperLeg_{L}", "poser": "{l}ThighBend", "blender": "thigh.{L}", "biped": "Bip01 {L} Thigh",
-              "vrm": "J_Bip_{L}_UpperLeg"},
+              "vrm": "J_Bip_{L}_UpperLeg",
+              "smpl": "{L}_Hip", "smplx": "{left}_hip", "xsens": "{Left}Hip", "motive": "{L}Thigh"},
     "Leg": {"unity": "LowerLeg_{L}", "poser": "{l}Shin", "blender": "DEF-shin.{L}", "biped": "Bip01 {L} Calf",
-            "vrm": "J_Bip_{L}_LowerLeg"},
+            "vrm": "J_Bip_{L}_LowerLeg",
+            "smpl": "{L}_Knee", "smplx": "{left}_knee", "xsens": "{Left}Knee", "motive": "{L}Shin"},
     "Foot": {"unity": "Foot_{L}", "poser": "{l}Foot", "blender": "foot.{L}", "biped": "Bip01 {L} Foot",
-             "vrm": "J_Bip_{L}_Foot"},
+             "vrm": "J_Bip_{L}_Foot",
+             "smpl": "{L}_Ankle", "smplx": "{left}_ankle", "xsens": "{Left}Ankle", "motive": "{L}Foot"},
     "ToeBase": {"unity": "Toes_{L}", "poser": "{l}Toe", "blender": "toe.{L}", "biped": "Bip01 {L} Toe0",
-                "vrm": "J_Bip_{L}_ToeBase"},
+                "vrm": "J_Bip_{L}_ToeBase",
+                "smpl": "{L}_Foot", "smplx": "{left}_foot", "xsens": "{Left}Toe", "motive": "{L}Toe"},
     "Arm": {"unity": "UpperArm_{L}", "poser": "{l}ShldrBend", "blender": "upper_arm.{L}",
-            "biped": "Bip01 {L} UpperArm", "vrm": "J_Bip_{L}_UpperArm"},
+            "biped": "Bip01 {L} UpperArm", "vrm": "J_Bip_{L}_UpperArm",
+            "smpl": "{L}_Shoulder", "smplx": "{left}_shoulder", "xsens": "{Left}Shoulder", "motive": "{L}UArm"},
     "ForeArm": {"unity": "LowerArm_{L}", "poser": "{l}ForearmBend", "blender": "forearm.{L}",
-                "biped": "Bip01 {L} Forearm", "vrm": "J_Bip_{L}_LowerArm"},
+                "biped": "Bip01 {L} Forearm", "vrm": "J_Bip_{L}_LowerArm",
+                "smpl": "{L}_Elbow", "smplx": "{left}_elbow", "xsens": "{Left}Elbow", "motive": "{L}FArm"},
     "Hand": {"unity": "Hand_{L}", "poser": "{l}Hand", "blender": "hand.{L}", "biped": "Bip01 {L} Hand",
-             "vrm": "J_Bip_{L}_Hand"},
+             "vrm": "J_Bip_{L}_Hand",
+             "smpl": "{L}_Wrist", "smplx": "{left}_wrist", "xsens": "{Left}Wrist", "motive": "{L}Hand"},
     "Shoulder": {"unity": "Shoulder_{L}", "poser": "{l}Collar", "blender": "shoulder.{L}",
-                 "biped": "Bip01 {L} Clavicle", "vrm": "J_Bip_{L}_Shoulder"},
-    "Spine": {"unity": "Spine", "poser": "abdomen", "blender": "spine", "biped": "Bip01 Spine", "vrm": "J_Bip_C_Spine"},
+                 "biped": "Bip01 {L} Clavicle", "vrm": "J_Bip_{L}_Shoulder",
+                 "smpl": "{L}_Collar", "smplx": "{left}_collar", "xsens": "{Left}Collar", "motive": "{L}Shoulder"},
+    "Spine": {"unity": "Spine", "poser": "abdomen", "blender": "spine", "biped": "Bip01 Spine", "vrm": "J_Bip_C_Spine",
+              "smpl": "Spine1", "smplx": "spine1", "xsens": "Chest", "motive": "Ab"},
     "Spine1": {"unity": "Chest", "poser": "chest", "blender": "chest", "biped": "Bip01 Spine1",
-               "vrm": "J_Bip_C_Chest"},
-    "Neck": {"unity": "Neck", "poser": "neck", "blender": "neck", "biped": "Bip01 Neck", "vrm": "J_Bip_C_Neck"},
-    "Head": {"unity": "Head", "poser": "head", "blender": "head", "biped": "Bip01 Head", "vrm": "J_Bip_C_Head"},
+               "vrm": "J_Bip_C_Chest",
+               "smpl": "Spine2", "smplx": "spine2", "xsens": "Chest2", "motive": "Chest"},
+    "Neck": {"unity": "Neck", "poser": "neck", "blender": "neck", "biped": "Bip01 Neck", "vrm": "J_Bip_C_Neck",
+             "smpl": "Neck", "smplx": "neck", "xsens": "Neck", "motive": "Neck"},
+    "Head": {"unity": "Head", "poser": "head", "blender": "head", "biped": "Bip01 Head", "vrm": "J_Bip_C_Head",
+             "smpl": "Head", "smplx": "head", "xsens": "Head", "motive": "Head"},
 }
 
 
@@ -90,12 +117,13 @@ def _renamed(text: str, convention: str) -> str:
             return f"{kind} x_{name}"  # a joint the convention does not name (finger, hip joint, neck1)
         pattern = _SEGMENTS[base][convention]
         s = side or "Left"
-        return f"{kind} " + pattern.format(L=s[0], l=s[0].lower(), Left=s)
+        return f"{kind} " + pattern.format(L=s[0], l=s[0].lower(), Left=s, left=s.lower())
     return re.sub(r"\b(ROOT|JOINT) (\S+)", one, text)
 
 
 @needs_cmu
-@pytest.mark.parametrize("convention", ["unity", "poser", "blender", "biped", "vrm"])
+@pytest.mark.parametrize("convention", ["unity", "poser", "blender", "biped", "vrm", "smpl", "smplx", "xsens",
+                                        "motive"])
 def test_renamed_cmu_clip_gives_the_same_operator(tmp_path, convention):
     original = (MOCAP / "cmu" / "02_01.bvh").read_text()
     path = tmp_path / f"02_01_{convention}.bvh"

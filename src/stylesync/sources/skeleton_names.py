@@ -16,6 +16,10 @@ its synonyms (``SIDE_SYNONYMS``, ``CENTRE_SYNONYMS``). The ranking resolves name
 conventions: MotionBuilder's ``LeftShoulder`` is the clavicle and ``LeftArm`` the upper arm, 3ds Max's
 ``LeftShoulder`` is the upper arm; "arm" is tried before "shoulder", so each file gets its own meaning. End sites
 appear as words ending in ``end`` (``lFoot`` end site → ``footend``), the toe of a skeleton without toe joints.
+A file joint stands for one canonical joint at most, taken in the order of ``SIDE_SYNONYMS``: where a skeleton has
+an ``Ankle`` joint (SMPL's ``L_Ankle``, Xsens's ``LeftAnkle``), that is the ankle and its ``Foot`` child the toe;
+where it has none (MotionBuilder's ``LeftFoot``), the foot joint is the ankle. OptiTrack Motive's upper arm and
+forearm are ``LUArm`` and ``LFArm`` (its ``LShoulder`` is the clavicle).
 """
 
 from __future__ import annotations
@@ -34,10 +38,10 @@ _LEFT, _RIGHT = frozenset({"l", "left"}), frozenset({"r", "right"})
 SIDE_SYNONYMS: dict[str, tuple[str, ...]] = {
     "HIP": ("upleg", "thigh", "upperleg", "hip"),
     "KNEE": ("leg", "calf", "lowerleg", "shin", "knee", "lowleg"),
-    "ANKLE": ("foot", "ankle"),
-    "FOOT": ("toebase", "toe0", "toes", "toe", "ball", "footend", "ankleend"),
-    "SHOULDER": ("arm", "upperarm", "shldr", "uparm", "shoulder"),
-    "ELBOW": ("forearm", "lowerarm", "elbow", "lowarm"),
+    "ANKLE": ("ankle", "foot"),
+    "FOOT": ("toebase", "toe0", "toes", "toe", "ball", "foot", "footend", "ankleend"),
+    "SHOULDER": ("arm", "upperarm", "shldr", "uparm", "uarm", "shoulder"),
+    "ELBOW": ("forearm", "lowerarm", "elbow", "lowarm", "farm"),
     "WRIST": ("wrist", "hand"),
 }
 CENTRE_SYNONYMS: dict[str, tuple[str, ...]] = {
@@ -103,9 +107,12 @@ def match_by_name(names: list[str]) -> dict[str, tuple[str, str]]:
         if not p.helper:
             by_key.setdefault((p.side, p.word), n)
     out: dict[str, tuple[str, str]] = {}
+    used: set[str] = set()
     for canon, (side, words) in synonyms().items():
         for w in words:
-            if (side, w) in by_key:
-                out[canon] = (by_key[(side, w)], f"name: {side + ' ' if side else ''}{w}")
+            name = by_key.get((side, w))
+            if name is not None and name not in used:
+                out[canon] = (name, f"name: {side + ' ' if side else ''}{w}")
+                used.add(name)
                 break
     return out
