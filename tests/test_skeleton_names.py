@@ -71,40 +71,45 @@ def test_first_ranked_synonym_wins_and_helpers_are_skipped():
 # SMPL/AMASS exports (an ankle joint and a foot joint below it), Xsens MVN, OptiTrack Motive among them.
 _SEGMENTS = {  # MotionBuilder name (side "Left"/"Right" or none) -> convention -> name pattern ({L}/{Left}: side)
     "Hips": {"unity": "Hips", "poser": "hip", "blender": "pelvis", "biped": "Bip01 Pelvis", "vrm": "J_Bip_C_Hips",
-             "smpl": "Pelvis", "smplx": "pelvis", "xsens": "Hips", "motive": "Hip"},
+             "smpl": "Pelvis", "smplx": "pelvis", "xsens": "Hips", "motive": "Hip", "asf": "root"},
     "UpLeg": {"unity": "UpperLeg_{L}", "poser": "{l}ThighBend", "blender": "thigh.{L}", "biped": "Bip01 {L} Thigh",
               "vrm": "J_Bip_{L}_UpperLeg",
-              "smpl": "{L}_Hip", "smplx": "{left}_hip", "xsens": "{Left}Hip", "motive": "{L}Thigh"},
+              "smpl": "{L}_Hip", "smplx": "{left}_hip", "xsens": "{Left}Hip", "motive": "{L}Thigh", "asf": "{l}femur"},
     "Leg": {"unity": "LowerLeg_{L}", "poser": "{l}Shin", "blender": "DEF-shin.{L}", "biped": "Bip01 {L} Calf",
             "vrm": "J_Bip_{L}_LowerLeg",
-            "smpl": "{L}_Knee", "smplx": "{left}_knee", "xsens": "{Left}Knee", "motive": "{L}Shin"},
+            "smpl": "{L}_Knee", "smplx": "{left}_knee", "xsens": "{Left}Knee", "motive": "{L}Shin", "asf": "{l}tibia"},
     "Foot": {"unity": "Foot_{L}", "poser": "{l}Foot", "blender": "foot.{L}", "biped": "Bip01 {L} Foot",
              "vrm": "J_Bip_{L}_Foot",
-             "smpl": "{L}_Ankle", "smplx": "{left}_ankle", "xsens": "{Left}Ankle", "motive": "{L}Foot"},
+             "smpl": "{L}_Ankle", "smplx": "{left}_ankle", "xsens": "{Left}Ankle", "motive": "{L}Foot",
+             "asf": "{l}foot"},
     "ToeBase": {"unity": "Toes_{L}", "poser": "{l}Toe", "blender": "toe.{L}", "biped": "Bip01 {L} Toe0",
                 "vrm": "J_Bip_{L}_ToeBase",
-                "smpl": "{L}_Foot", "smplx": "{left}_foot", "xsens": "{Left}Toe", "motive": "{L}Toe"},
+                "smpl": "{L}_Foot", "smplx": "{left}_foot", "xsens": "{Left}Toe", "motive": "{L}Toe", "asf": "{l}toes"},
     "Arm": {"unity": "UpperArm_{L}", "poser": "{l}ShldrBend", "blender": "upper_arm.{L}",
             "biped": "Bip01 {L} UpperArm", "vrm": "J_Bip_{L}_UpperArm",
-            "smpl": "{L}_Shoulder", "smplx": "{left}_shoulder", "xsens": "{Left}Shoulder", "motive": "{L}UArm"},
+            "smpl": "{L}_Shoulder", "smplx": "{left}_shoulder", "xsens": "{Left}Shoulder", "motive": "{L}UArm",
+            "asf": "{l}humerus"},
     "ForeArm": {"unity": "LowerArm_{L}", "poser": "{l}ForearmBend", "blender": "forearm.{L}",
                 "biped": "Bip01 {L} Forearm", "vrm": "J_Bip_{L}_LowerArm",
-                "smpl": "{L}_Elbow", "smplx": "{left}_elbow", "xsens": "{Left}Elbow", "motive": "{L}FArm"},
+                "smpl": "{L}_Elbow", "smplx": "{left}_elbow", "xsens": "{Left}Elbow", "motive": "{L}FArm",
+                "asf": "{l}radius"},
     "Hand": {"unity": "Hand_{L}", "poser": "{l}Hand", "blender": "hand.{L}", "biped": "Bip01 {L} Hand",
              "vrm": "J_Bip_{L}_Hand",
-             "smpl": "{L}_Wrist", "smplx": "{left}_wrist", "xsens": "{Left}Wrist", "motive": "{L}Hand"},
+             "smpl": "{L}_Wrist", "smplx": "{left}_wrist", "xsens": "{Left}Wrist", "motive": "{L}Hand",
+             "asf": "{l}wrist"},
     "Shoulder": {"unity": "Shoulder_{L}", "poser": "{l}Collar", "blender": "shoulder.{L}",
                  "biped": "Bip01 {L} Clavicle", "vrm": "J_Bip_{L}_Shoulder",
-                 "smpl": "{L}_Collar", "smplx": "{left}_collar", "xsens": "{Left}Collar", "motive": "{L}Shoulder"},
+                 "smpl": "{L}_Collar", "smplx": "{left}_collar", "xsens": "{Left}Collar", "motive": "{L}Shoulder",
+                 "asf": "{l}clavicle"},
     "Spine": {"unity": "Spine", "poser": "abdomen", "blender": "spine", "biped": "Bip01 Spine", "vrm": "J_Bip_C_Spine",
-              "smpl": "Spine1", "smplx": "spine1", "xsens": "Chest", "motive": "Ab"},
+              "smpl": "Spine1", "smplx": "spine1", "xsens": "Chest", "motive": "Ab", "asf": "upperback"},
     "Spine1": {"unity": "Chest", "poser": "chest", "blender": "chest", "biped": "Bip01 Spine1",
                "vrm": "J_Bip_C_Chest",
-               "smpl": "Spine2", "smplx": "spine2", "xsens": "Chest2", "motive": "Chest"},
+               "smpl": "Spine2", "smplx": "spine2", "xsens": "Chest2", "motive": "Chest", "asf": "thorax"},
     "Neck": {"unity": "Neck", "poser": "neck", "blender": "neck", "biped": "Bip01 Neck", "vrm": "J_Bip_C_Neck",
-             "smpl": "Neck", "smplx": "neck", "xsens": "Neck", "motive": "Neck"},
+             "smpl": "Neck", "smplx": "neck", "xsens": "Neck", "motive": "Neck", "asf": "lowerneck"},
     "Head": {"unity": "Head", "poser": "head", "blender": "head", "biped": "Bip01 Head", "vrm": "J_Bip_C_Head",
-             "smpl": "Head", "smplx": "head", "xsens": "Head", "motive": "Head"},
+             "smpl": "Head", "smplx": "head", "xsens": "Head", "motive": "Head", "asf": "head"},
 }
 
 
@@ -123,7 +128,7 @@ def _renamed(text: str, convention: str) -> str:
 
 @needs_cmu
 @pytest.mark.parametrize("convention", ["unity", "poser", "blender", "biped", "vrm", "smpl", "smplx", "xsens",
-                                        "motive"])
+                                        "motive", "asf"])
 def test_renamed_cmu_clip_gives_the_same_operator(tmp_path, convention):
     original = (MOCAP / "cmu" / "02_01.bvh").read_text()
     path = tmp_path / f"02_01_{convention}.bvh"
