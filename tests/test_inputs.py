@@ -226,6 +226,33 @@ def test_cmu_namings(name, upper_arm):
         assert rot.rotate(f.quat(seg), np.array(d0)) @ d / np.linalg.norm(d) > 0.999
 
 
+@pytest.mark.parametrize("cut", ["whole lines", "mid-line"])
+def test_a_bvh_cut_short_reads_the_frames_it_has(tmp_path, caplog, cut):
+    motion = [[0, 95, 3.0 * k] + [0.0] * (_N_CHANNELS - 3) for k in range(12)]
+    for k, row in enumerate(motion):
+        row[6 + 1] = -4.0 * k  # the left thigh swings forward frame by frame
+    whole = BvhRecording(_write_tiny(tmp_path, motion)).performer
+    text = _write_tiny(tmp_path, motion).read_text()
+    lines = text.splitlines()
+    # 12 frames declared; 8 whole frame lines left, and with "mid-line" half of a ninth
+    kept = lines[:len(lines) - 4] + ([lines[-4][:len(lines[-4]) // 2]] if cut == "mid-line" else [])
+    p = tmp_path / "cut.bvh"
+    p.write_text("\n".join(kept) + ("" if cut == "mid-line" else "\n"))
+    with caplog.at_level("WARNING", logger="stylesync.sources"):
+        part = BvhRecording(p).performer
+    assert "12 frames declared, 8 complete" in caplog.text
+    assert part.pos_world.shape[0] == 8
+    np.testing.assert_allclose(part.pos_world, whole.pos_world[:8], atol=1e-9)
+
+
+def test_a_bvh_with_no_complete_frame_fails(tmp_path):
+    text = _write_tiny(tmp_path).read_text()
+    p = tmp_path / "none.bvh"
+    p.write_text(text[:text.index("Frame Time")] + "Frame Time: 0.0333333\n0 95\n")
+    with pytest.raises(SourceError):
+        BvhRecording(p)
+
+
 @given(st.binary(max_size=400))
 @settings(max_examples=40, deadline=None)
 def test_bvh_parser_fails_cleanly_on_garbage(tmp_path_factory, data):

@@ -18,6 +18,8 @@ mean head-minus-ankles, the stature their tallest, and the segment orientations 
 from __future__ import annotations
 
 import logging
+import re
+import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -136,6 +138,56 @@ def _bvhio() -> Any:
     return bvhio
 
 
+def _declared_and_complete_frames(text: str) -> tuple[int, int, int, int] | None:
+    """(frames declared, complete frame lines, the line index of "Frames:", that of the last complete frame line) of
+    a BVH file's text; None when the text has no MOTION section, channel counts or frame count to compare (the parser
+    then says what is wrong). A complete line holds as many values as the hierarchy's channels; counting stops at the
+    first line that does not."""
+    head, sep, motion = text.partition("MOTION")
+    if not sep:
+        return None
+    first = head.count("\n")  # the MOTION line's index: motion.splitlines()[0] is the rest of that line
+    try:
+        n_channels = sum(int(m) for m in re.findall(r"\bCHANNELS\s+(\d+)", head))
+        lines = motion.splitlines()
+        k = next(i for i, ln in enumerate(lines) if ln.strip().lower().startswith("frames:"))
+        declared = int(lines[k].split(":", 1)[1])
+    except (StopIteration, ValueError):
+        return None
+    complete, last = 0, first + k + 1
+    for i in range(k + 2, len(lines)):
+        tokens = lines[i].split()
+        if not tokens:
+            continue
+        if len(tokens) != n_channels:
+            break
+        complete, last = complete + 1, first + i
+    return declared, complete, first + k, last
+
+
+def _read_container(bvhio: Any, p: Path) -> Any:
+    """bvhio's container of the file ``p``. A file cut short (fewer complete frame lines than its "Frames:" count
+    says, the last one perhaps half written, as a capture that stopped) is read with the frames it has, and the
+    shortfall logged: a recording's frames are not thrown away for the ones it lost. Frame lines beyond the count
+    are logged and left out, as the parser reads the count."""
+    text = p.read_text(errors="replace")
+    counts = _declared_and_complete_frames(text)
+    if counts is not None and counts[1] > counts[0]:
+        log.warning("BVH file %s: %d frames declared, %d in the file; the %d declared are read", p, counts[0],
+                    counts[1], counts[0])
+    if counts is None or counts[1] >= counts[0] or counts[1] < 1:
+        return bvhio.readAsBvh(str(p))
+    declared, complete, frames_line, last = counts
+    log.warning("BVH file %s: %d frames declared, %d complete in the file; the %d are read", p, declared, complete,
+                complete)
+    lines = text.splitlines()[:last + 1]
+    lines[frames_line] = f"Frames: {complete}"
+    with tempfile.TemporaryDirectory() as tmp:
+        cut = Path(tmp) / p.name
+        cut.write_text("\n".join(lines) + "\n")
+        return bvhio.readAsBvh(str(cut))
+
+
 def _depth_first(root: Any) -> list[tuple[Any, int]]:
     """(joint, parent index) in depth-first order, parents before children."""
     out: list[tuple[Any, int]] = []
@@ -179,7 +231,7 @@ class BvhRecording:
         if not p.is_file():
             raise SourceError(f"BVH file not found: {p}")
         try:
-            container = bvhio.readAsBvh(str(p))
+            container = _read_container(bvhio, p)
             joints = _depth_first(container.Root)
             frame_time = float(container.FrameTime)
             n_frames = int(container.FrameCount)
