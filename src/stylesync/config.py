@@ -465,6 +465,9 @@ class JacobianTransposeConfig:
                 raise ConfigError(f"JacobianTransposeConfig.pid lacks gains for '{group}'")
 
 
+OWN_STEP_PUSH_BOUNDS = ("off", "he_stands", "always")  # WholeBodyConfig.own_step_push_bound
+
+
 @dataclass(frozen=True)
 class WholeBodyConfig:
     """The whole-body controller (whole_body.py): tasks and sole contacts in one QP per control tick."""
@@ -514,6 +517,12 @@ class WholeBodyConfig:
     # folding swing leg (docs/decisions.md, "A recovery step's landing that is due"). The weight of the press on a
     # stance foot that has not touched yet (whole_body.FOOT_TASK_WEIGHT) [-]
     recovery_foot_landing_weight: float = 1000.0
+    # In a step of the character's own, on one sole, the ground's horizontal force along the capture point's
+    # divergence from that sole is at most the pendulum's with the centre of pressure at the sole's rear edge along
+    # it (control/own_step_push.py): the step's swing is not driven by pushing the body further the way it already
+    # diverges (docs/decisions.md, "A character's own steps that push it on"). "off", "he_stands" (in the steps
+    # taken while the operator stands: the steps that are to stop the body) or "always".
+    own_step_push_bound: str = "off"
     # The joints' no-load speed (control/joint_speed_limit.py): a joint turning faster than this gets no torque along
     # its motion. Human joints peak at about 20-30 rad/s (a kick's knee); the held torques of a control tick spun
     # light links (a lifting stance foot, a hand) to the engine's 100 rad/s within a tick (docs/decisions.md, "The
@@ -549,6 +558,9 @@ class WholeBodyConfig:
             _non_negative(f"WholeBodyConfig.{n}", getattr(self, n))
         if self.joint_speed_limit_rad_s is not None:
             _positive("WholeBodyConfig.joint_speed_limit_rad_s", self.joint_speed_limit_rad_s)
+        if self.own_step_push_bound not in OWN_STEP_PUSH_BOUNDS:
+            raise ConfigError(f"WholeBodyConfig.own_step_push_bound must be one of {', '.join(OWN_STEP_PUSH_BOUNDS)}, "
+                              f"got '{self.own_step_push_bound}'")
 
 
 @dataclass(frozen=True)

@@ -66,6 +66,16 @@ class QpProblem:
 
 
 @dataclass(frozen=True)
+class RowBound:
+    """An inequality of one tick on the joint accelerations: ``lower <= row · q̈ <= upper`` (row (nv,), the
+    character's DOF layout)."""
+
+    row: np.ndarray
+    lower: float
+    upper: float
+
+
+@dataclass(frozen=True)
 class HingeLimit:
     dof: int  # index in the character's DOF layout
     lower_rad: float
@@ -108,7 +118,9 @@ class WholeBodyFormulation:
                 return t
         raise KeyError(f"no task '{name}'; tasks: {', '.join(t.name for t in self.tasks)}")
 
-    def build(self, model: CharacterModel, contacts: Sequence[SoleContactBase]) -> QpProblem:
+    def build(self, model: CharacterModel, contacts: Sequence[SoleContactBase],
+              bounds: Sequence[RowBound] = ()) -> QpProblem:
+        """The QP of this tick; ``bounds``: inequalities on q̈ of this tick alone, put before the hinges' limits."""
         nv = N_DOFS
         n_c = len(contacts)
         n_f = sum(c.n_forces for c in contacts)
@@ -171,6 +183,14 @@ class WholeBodyFormulation:
             first = len(rows) - len(self.limits)
             lower[first:] = np.minimum(2.0 * (self._limit_lower - q - qd * t) / (t * t), 0.0)
             upper[first:] = np.maximum(2.0 * (self._limit_upper - q - qd * t) / (t * t), 0.0)
+        if bounds:
+            at = len(rows) - len(self.limits)
+            extra = np.zeros((len(bounds), n))
+            for i, b in enumerate(bounds):
+                extra[i, :nv] = b.row
+            rows = np.insert(rows, at, extra, axis=0)
+            lower = np.insert(lower, at, [b.lower for b in bounds])
+            upper = np.insert(upper, at, [b.upper for b in bounds])
         return QpProblem(h_mat, g, rows, lower, upper, n_eq, n_f)
 
     def _template(self, contacts: Sequence[SoleContactBase]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

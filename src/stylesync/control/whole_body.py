@@ -40,6 +40,7 @@ from stylesync.control.formulation import WholeBodyFormulation, hinge_limits
 from stylesync.control.gravity_compensation import LEG_JOINTS
 from stylesync.control.joint_speed_limit import limit_joint_speed
 from stylesync.control.model_compensation import bounded_lipm_sync_force
+from stylesync.control.own_step_push import own_step_push_bound
 from stylesync.control.pid import IS_BALL
 from stylesync.control.sole_wrench_contact import SoleWrenchContact
 from stylesync.control.solver import DaqpSolver
@@ -241,7 +242,12 @@ class WholeBodyController(ControllerBase):
         # The supporting legs' posture weighs stance_leg_tracking_share of the rest's (WholeBodyConfig): their joint
         # angles are where the pelvis is over the feet, which the momentum and pelvis tasks already ask for.
         self.posture.dof_scale = self._leg_share[tuple(support)]
-        problem = self.formulation.build(model, contacts)
+        bounds = []
+        own_step = ref.recovery_while_he_stands if wb.own_step_push_bound == "he_stands" else (
+            ref.recovery_ankle_world is not None and wb.own_step_push_bound == "always")
+        if own_step and len(contacts) == 1:
+            bounds.append(own_step_push_bound(model, contacts[0].corners_world, m, self.g))
+        problem = self.formulation.build(model, contacts, bounds)
         result = self.solver.solve(problem)
         if not result.solved and self.wb.relax_limits_when_infeasible:
             failed = result.exitflag
