@@ -521,8 +521,9 @@ class WholeBodyConfig:
     # divergence from that sole is at most the pendulum's with the centre of pressure at the sole's rear edge along
     # it (control/own_step_push.py): the step's swing is not driven by pushing the body further the way it already
     # diverges (docs/decisions.md, "A character's own steps that push it on"). "off", "he_stands" (in the steps
-    # taken while the operator stands: the steps that are to stop the body) or "always".
-    own_step_push_bound: str = "off"
+    # taken while the operator stands: the steps that are to stop the body; traced on a chain of them that ran away
+    # in the rest after a clip) or "always".
+    own_step_push_bound: str = "he_stands"
     # The joints' no-load speed (control/joint_speed_limit.py): a joint turning faster than this gets no torque along
     # its motion. Human joints peak at about 20-30 rad/s (a kick's knee); the held torques of a control tick spun
     # light links (a lifting stance foot, a hand) to the engine's 100 rad/s within a tick (docs/decisions.md, "The

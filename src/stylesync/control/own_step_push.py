@@ -6,7 +6,8 @@ weighs as much as a hundred newtons of that request, and the QP met it by pushin
 point already diverges: traced on CMU-dev 08_08 (seed 11), a chain of such steps took the COM from 1.1 to 3.0 m/s
 while the operator stood (docs/decisions.md, "A character's own steps that push it on").
 
-With WholeBodyConfig.own_step_push_bound the ground's horizontal force along the divergence ``u`` (the capture
+With WholeBodyConfig.own_step_push_bound ("he_stands" by default: in the steps taken while the operator stands,
+the steps that are to stop the body) the ground's horizontal force along the divergence ``u`` (the capture
 point from the sole's centre) is at most the linear inverted pendulum's (the model of Eq. 21) with its centre of
 pressure at the sole's rear edge along ``u``, ``m ω² (u·c - min_k u·p_k)``, and MOMENTUM_ACCEL_ALLOWANCE_MPS2 as in
 contacts.feasible_horizontal_force. The linear momentum's horizontal rate is ``A_g[:2] q̈ + (Ȧ_g q̇)[:2]`` (the
