@@ -8,9 +8,11 @@ from stylesync.model.character import JOINTS, JointKind
 
 # Scenarios traced before a recovery step's due landing weighed more than its swing (WholeBodyConfig.
 # recovery_foot_landing_weight) and before the joints' no-load speed (joint_speed_limit_rad_s): with them, the
-# contrast runs of some of them no longer fall.
+# contrast runs of some of them no longer fall; and before the bound on the push of the character's own steps
+# (own_step_push_bound).
 TRACED_BEFORE_LANDING_WEIGHT = ControlConfig(whole_body=WholeBodyConfig(
-    recovery_foot_landing_weight=WholeBodyConfig().recovery_foot_task_weight, joint_speed_limit_rad_s=None))
+    recovery_foot_landing_weight=WholeBodyConfig().recovery_foot_task_weight, joint_speed_limit_rad_s=None,
+    own_step_push_bound="off"))
 
 
 def random_pose(seed: int, ball_sigma_rad: float = 0.3, hinge_rad: float = 0.6) -> np.ndarray:

@@ -1,5 +1,6 @@
-"""The bound on a character's own step's push (control/own_step_push.py): the pendulum's force with the centre of
-pressure at the sole's rear edge, as one inequality the QP's solution keeps, and only along the divergence."""
+"""The bound on the push of a character's own step (control/own_step_push.py): the pendulum's force with the centre
+of pressure at the sole's rear edge, as one inequality the QP's solution keeps, only along the divergence; and the
+traced chain of own steps that it stops."""
 
 from __future__ import annotations
 
@@ -7,9 +8,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import suite_run
 
 from stylesync import rotations as rot
-from stylesync.config import WorldConfig
+from stylesync.config import ControlConfig, MotionConfig, WholeBodyConfig, WorldConfig
 from stylesync.control.contacts import MOMENTUM_ACCEL_ALLOWANCE_MPS2, SoleContact
 from stylesync.control.formulation import WholeBodyFormulation
 from stylesync.control.own_step_push import own_step_push_bound
@@ -90,28 +92,24 @@ def test_a_qp_with_the_bound_does_not_push_past_it(on_left_foot):
     assert along[-1.0, True] < 0.0
 
 
-needs_cmu_dev = pytest.mark.skipif(not (Path(__file__).resolve().parents[2] / "shared" / "mocap" / "cmu-dev").is_dir(),
+MOCAP = Path(__file__).resolve().parents[2] / "shared" / "mocap"
+needs_cmu_dev = pytest.mark.skipif(not (MOCAP / "cmu-dev").is_dir(),
                                    reason="../shared/mocap/cmu-dev (Poser/DAZ CMU clips) is not present")
 
 
 @needs_cmu_dev
 @pytest.mark.parametrize("push_bound", ["off", "he_stands"])
 def test_a_chain_of_own_steps_in_the_rest_is_not_pushed_on(push_bound):
-    """CMU-dev 08_08, seed 11 (traced): after the clip's end the operator stands; by default the character's own
-    steps push its COM from 1.1 to 3 m/s (horizontally) and it falls 1.4 s into the rest. With the bound in the steps taken while
-    he stands, it comes to rest."""
-    from conftest import suite_run
-
-    from stylesync.config import ControlConfig, MotionConfig, WholeBodyConfig
-
-    mocap = Path(__file__).resolve().parents[2] / "shared" / "mocap"
+    """CMU-dev 08_08, seed 11 (traced): after the clip's end the operator stands; without the bound the character's
+    own steps push its COM from 1.1 to 3 m/s (horizontally) and it falls 1.4 s into the rest. With the bound in the
+    steps taken while he stands (the default), it comes to rest."""
     speeds = []
     control = ControlConfig(whole_body=WholeBodyConfig(own_step_push_bound=push_bound))
 
     def watch(session):
         return lambda state, ref: speeds.append(float(np.hypot(*session.mass.com_velocity(state)[:2])))
 
-    result = suite_run(f"bvh:{mocap / 'cmu-dev' / '08_08.bvh'}", 11, MotionConfig(), control, watch=watch)
+    result = suite_run(f"bvh:{MOCAP / 'cmu-dev' / '08_08.bvh'}", 11, MotionConfig(), control, watch=watch)
     if push_bound == "off":
         assert result.fell and max(speeds) > 2.5
     else:

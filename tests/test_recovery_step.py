@@ -972,7 +972,9 @@ def test_a_landing_foot_out_of_reach_does_not_put_the_pelvis_target_on_the_groun
             if 2.1 <= state.time_s <= 2.45:
                 heights.append(float(ref.pelvis_world[2]))
 
-        result = suite_run("deepmimic:kick", 1, motion, ControlConfig(), on_tick)
+        # traced before the bound on the push of the character's own steps (WholeBodyConfig.own_step_push_bound)
+        result = suite_run("deepmimic:kick", 1, motion, ControlConfig(whole_body=WholeBodyConfig(
+            own_step_push_bound="off")), on_tick)
         assert len(heights) > 20
         return min(heights), result.fell
 
@@ -1303,7 +1305,8 @@ def test_a_recovery_step_whose_landing_is_due_is_pressed_onto_the_ground():
                                                  fraction_needs_feet_in_his_order=False, recovery_swing_min_s=None,
                                                  liftoff_needs_other_foot_down=False),
                            ControlConfig(whole_body=WholeBodyConfig(recovery_foot_landing_weight=landing_weight,
-                                                                    joint_speed_limit_rad_s=None)),
+                                                                    joint_speed_limit_rad_s=None,
+                                                                    own_step_push_bound="off")),
                            on_tick=on_tick)
         if due_since:
             waits.append(last_tick_s[0] - due_since[0])

@@ -278,7 +278,7 @@ def test_a_light_link_does_not_spin_up_within_a_control_tick():
     by side after a step of the character's own (MotionConfig.fraction_needs_feet_in_his_order off) and every
     recovery step's nominal time (MotionConfig.recovery_swing_min_s None)."""
     def run(limit):
-        control = ControlConfig(whole_body=WholeBodyConfig(joint_speed_limit_rad_s=limit))
+        control = ControlConfig(whole_body=WholeBodyConfig(joint_speed_limit_rad_s=limit, own_step_push_bound="off"))
         motion = MotionConfig(fraction_needs_feet_in_his_order=False, recovery_swing_min_s=None)
         return suite_run("builtin:dance_a", 2, motion, control)
 
