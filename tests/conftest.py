@@ -1,10 +1,11 @@
 import dataclasses
 
 import numpy as np
+import pytest
 
 from stylesync import rotations as rot
-from stylesync.config import ControlConfig, MotionConfig, WholeBodyConfig
-from stylesync.model.character import JOINTS, JointKind
+from stylesync.config import ControlConfig, MotionConfig, WholeBodyConfig, WorldConfig
+from stylesync.model.character import JOINTS, STANDING_ROOT_HEIGHT_M, JointKind
 
 # Scenarios traced before a recovery step's due landing weighed more than its swing (WholeBodyConfig.
 # recovery_foot_landing_weight) and before the joints' no-load speed (joint_speed_limit_rad_s): with them, the
@@ -13,6 +14,23 @@ from stylesync.model.character import JOINTS, JointKind
 TRACED_BEFORE_LANDING_WEIGHT = ControlConfig(whole_body=WholeBodyConfig(
     recovery_foot_landing_weight=WholeBodyConfig().recovery_foot_task_weight, joint_speed_limit_rad_s=None,
     own_step_push_bound="off"))
+
+
+@pytest.fixture(scope="module")
+def standing():
+    """(backend, model): the character standing on flat ground after 0.5 s at 600 Hz, its model updated there (one
+    per test module)."""
+    from stylesync.model.character_model import CharacterModel
+    from stylesync.sim.pybullet_backend import PyBulletBackend
+
+    backend = PyBulletBackend(WorldConfig(), 600.0)
+    backend.reset(np.array([0.0, 0.0, STANDING_ROOT_HEIGHT_M]), rot.IDENTITY_WXYZ)
+    for _ in range(300):
+        backend.step()
+    model = CharacterModel(backend.body_description(), 9.8)
+    model.update(backend.read_state(0.5))
+    yield backend, model
+    backend.close()
 
 
 def random_pose(seed: int, ball_sigma_rad: float = 0.3, hinge_rad: float = 0.6) -> np.ndarray:

@@ -10,36 +10,29 @@ import numpy as np
 import pytest
 from conftest import suite_run
 
-from stylesync import rotations as rot
-from stylesync.config import ControlConfig, MotionConfig, WholeBodyConfig, WorldConfig
+from stylesync.config import ControlConfig, MotionConfig, WholeBodyConfig
 from stylesync.control.contacts import MOMENTUM_ACCEL_ALLOWANCE_MPS2, SoleContact
 from stylesync.control.formulation import WholeBodyFormulation
 from stylesync.control.own_step_push import own_step_push_bound
 from stylesync.control.solver import DaqpSolver
 from stylesync.control.tasks import CentroidalMomentumTask, JointPostureTask
 from stylesync.control.whole_body import _TORQUE_LIMIT_FLAT
-from stylesync.model.character import N_DOFS, ROOT_DOFS, STANDING_ROOT_HEIGHT_M
-from stylesync.model.character_model import CharacterModel
-from stylesync.sim.pybullet_backend import PyBulletBackend
+from stylesync.model.character import N_DOFS, ROOT_DOFS
 
 G = 9.8
 
 
 @pytest.fixture(scope="module")
-def on_left_foot():
-    """The character standing, its model's state given a forward and leftward COM velocity; the left sole."""
-    backend = PyBulletBackend(WorldConfig(), 600.0)
-    backend.reset(np.array([0.0, 0.0, STANDING_ROOT_HEIGHT_M]), rot.IDENTITY_WXYZ)
-    for _ in range(300):
-        backend.step()
-    model = CharacterModel(backend.body_description(), G)
+def on_left_foot(standing):
+    """The character standing (conftest.standing), its model's state given a forward and leftward COM velocity; the
+    left sole."""
+    backend, model = standing
     state = backend.read_state(0.5)
     state.root_lin_vel_world = np.array([0.8, 0.3, 0.0])
     model.update(state)
     contact = SoleContact("left", 0.9, model.total_mass_kg * G)
     contact.update(model)
-    yield model, contact
-    backend.close()
+    return model, contact
 
 
 def test_the_bound_is_the_pendulums_force_at_the_soles_rear_edge(on_left_foot):

@@ -11,32 +11,18 @@ import pinocchio as pin
 import pytest
 from conftest import suite_run
 
-from stylesync import rotations as rot
-from stylesync.config import ControlConfig, MotionConfig, OperatorConfig, SessionConfig, WholeBodyConfig, WorldConfig
+from stylesync.config import ControlConfig, MotionConfig, OperatorConfig, SessionConfig, WholeBodyConfig
 from stylesync.control.contacts import FORCES_PER_SOLE, SoleContact
 from stylesync.control.formulation import INFINITY, WholeBodyFormulation, hinge_limits
 from stylesync.control.solver import DaqpSolver
 from stylesync.control.tasks import JointPostureTask, Task, TaskRows
 from stylesync.control.whole_body import _TORQUE_LIMIT_FLAT, HAND_REACH_SHARE
-from stylesync.model.character import N_DOFS, ROOT_DOFS, STANDING_ROOT_HEIGHT_M
+from stylesync.model.character import N_DOFS, ROOT_DOFS
 from stylesync.model.character_model import CharacterModel
 from stylesync.session import Session
-from stylesync.sim.pybullet_backend import PyBulletBackend
 from stylesync.sources.builtin_operator import builtin_operator
 
 MOCAP = Path(__file__).resolve().parents[2] / "shared" / "mocap"
-
-
-@pytest.fixture(scope="module")
-def standing():
-    backend = PyBulletBackend(WorldConfig(), 600.0)
-    backend.reset(np.array([0.0, 0.0, STANDING_ROOT_HEIGHT_M]), rot.IDENTITY_WXYZ)
-    for _ in range(300):
-        backend.step()
-    model = CharacterModel(backend.body_description(), 9.8)
-    model.update(backend.read_state(0.5))
-    yield backend, model
-    backend.close()
 
 
 def test_contact_generator_is_the_corner_forces_power(standing):

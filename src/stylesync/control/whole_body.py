@@ -242,11 +242,11 @@ class WholeBodyController(ControllerBase):
         # The supporting legs' posture weighs stance_leg_tracking_share of the rest's (WholeBodyConfig): their joint
         # angles are where the pelvis is over the feet, which the momentum and pelvis tasks already ask for.
         self.posture.dof_scale = self._leg_share[tuple(support)]
-        bounds = []
-        own_step = ref.recovery_while_he_stands if wb.own_step_push_bound == "he_stands" else (
-            ref.recovery_ankle_world is not None and wb.own_step_push_bound == "always")
-        if own_step and len(contacts) == 1:
-            bounds.append(own_step_push_bound(model, contacts[0].corners_world, m, self.g))
+        # The push of a step of the character's own, on one sole, bounded (WholeBodyConfig.own_step_push_bound)
+        bounded = {"off": False, "he_stands": ref.recovery_while_he_stands,
+                   "always": ref.recovery_ankle_world is not None}[wb.own_step_push_bound]
+        bounds = ([own_step_push_bound(model, contacts[0].corners_world, m, self.g)]
+                  if bounded and len(contacts) == 1 else [])
         problem = self.formulation.build(model, contacts, bounds)
         result = self.solver.solve(problem)
         if not result.solved and self.wb.relax_limits_when_infeasible:
