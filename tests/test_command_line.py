@@ -122,7 +122,7 @@ def test_a_report_on_a_damaged_folder_is_written_and_says_so(tmp_path, capsys, m
 
 
 def test_follow_path_is_taken_and_recorded(tmp_path, capsys):
-    from stylesync.config import FOLLOW_PATH_MOTION
+    from stylesync.config import FOLLOW_PATH_MOTION, FOLLOW_PATH_WHOLE_BODY
     from stylesync.export.session_file import read_session
 
     assert cli_main(["demo", "--follow-path", "--duration", "0.2", "--out", str(tmp_path / "fp")]) == 0
@@ -132,6 +132,8 @@ def test_follow_path_is_taken_and_recorded(tmp_path, capsys):
     assert follow["operator"]["start_with_clip_velocity"] and not plain["operator"]["start_with_clip_velocity"]
     for name, value in FOLLOW_PATH_MOTION.items():
         assert follow["motion"][name] == value != plain["motion"][name]
+    for name, value in FOLLOW_PATH_WHOLE_BODY.items():
+        assert follow["control"]["whole_body"][name] == value != plain["control"]["whole_body"][name]
 
 
 def test_free_swing_is_taken_and_recorded(tmp_path, capsys):

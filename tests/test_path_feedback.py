@@ -1,8 +1,10 @@
-"""Following the operator over the ground by step placement (motion/path_feedback.py)."""
+"""Following the operator over the ground by step placement and by the targets (motion/path_feedback.py)."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -71,12 +73,14 @@ def test_off_by_default_and_validated():
 
 
 def test_follow_path_sets_the_opt_ins_and_the_start_at_speed():
-    from stylesync.config import FOLLOW_PATH_MOTION, SessionConfig, follow_path
+    from stylesync.config import FOLLOW_PATH_MOTION, FOLLOW_PATH_WHOLE_BODY, SessionConfig, follow_path
 
     cfg = follow_path(SessionConfig())
     assert cfg.operator.start_with_clip_velocity and not SessionConfig().operator.start_with_clip_velocity
     for name, value in FOLLOW_PATH_MOTION.items():
         assert getattr(cfg.motion, name) == value != getattr(SessionConfig().motion, name)
+    for name, value in FOLLOW_PATH_WHOLE_BODY.items():
+        assert getattr(cfg.control.whole_body, name) == value != getattr(SessionConfig().control.whole_body, name)
 
 
 @pytest.mark.parametrize("seed", [0, 1])
@@ -106,3 +110,71 @@ def test_the_built_in_walk_keeps_to_its_operators_path_longer_with_follow_path(s
     assert out[False]["uhc_fall_time_s"] < 2.6
     assert out[True]["uhc_fall_time_s"] is None or out[True]["uhc_fall_time_s"] > 2.7
     assert out[True]["path_progress"] > 1.6 * out[False]["path_progress"]
+
+
+def test_the_targets_pull_to_his_com_on_the_characters_path():
+    """The pull is the share of the way from the COM target to his COM scaled about both starts, bounded; none
+    before the origins are fixed or when off."""
+    path = PathReference(share=0.0, max_m=0.2, target_share=0.5, target_max_m=1.0)
+    assert path.enabled
+    assert path.target_pull_xy(np.zeros(3), np.ones(3), 0.8) == pytest.approx([0.0, 0.0])  # no origins yet
+    # first tick: the character's pelvis at (2, 1), his at (10, -3)
+    path.update(np.array([2.0, 1.0, 0.9]), np.array([10.0, -3.0, 1.0]), np.zeros(3), np.zeros(3), 0.8, OMEGA)
+    # his COM 1 m on along x (0.8 m scaled: at (2.8, 1) on the character's path); the COM target at (2.2, 1.2)
+    pull = path.target_pull_xy(np.array([2.2, 1.2, 0.8]), np.array([11.0, -3.0, 0.9]), 0.8)
+    assert pull == pytest.approx([0.3, -0.1])
+    bounded = PathReference(0.0, 0.2, target_share=1.0, target_max_m=0.25)
+    bounded.update(np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), 1.0, OMEGA)
+    pull = bounded.target_pull_xy(np.zeros(3), np.array([-3.0, 4.0, 0.0]), 1.0)
+    assert pull == pytest.approx([-0.15, 0.2])  # 0.25 m along the way to him
+    off = PathReference(0.0, 0.2)
+    off.update(np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3), 1.0, OMEGA)
+    assert not off.enabled
+    assert off.target_pull_xy(np.zeros(3), np.array([5.0, 0.0, 0.0]), 1.0) == pytest.approx([0.0, 0.0])
+
+
+def test_the_target_pull_is_validated():
+    assert MotionConfig().path_target_share == 0.0
+    with pytest.raises(ConfigError, match="path_target_share"):
+        MotionConfig(path_target_share=1.5)
+    with pytest.raises(ConfigError, match="path_target_max_m"):
+        MotionConfig(path_target_max_m=-0.1)
+
+
+_STEALTHY = Path(__file__).resolve().parents[2] / "shared" / "mocap" / "deepmimic" / "humanoid3d_stealthy_walk.txt"
+
+
+@pytest.mark.skipif(not _STEALTHY.is_file(), reason="../shared/mocap/deepmimic (the stealthy walk) is not present")
+def test_targets_on_his_path_keep_the_stealthy_walk_within_the_uhc_distance():
+    """Measured (the development suite's run of the crouched stealthy walk, 12 s, seed 0): with ``--follow-path``'s
+    settings before the targets' pull (path_target_share 0, the push of the character's own steps bounded only while
+    he stands) the UHC termination comes at 3.8 s, the character trailing his path; with them no termination in
+    the 12 s, and no fall either way."""
+    import logging
+
+    from stylesync.config import follow_path
+    from stylesync.metrics.dev_suite import suite_config
+    from stylesync.metrics.summary import summarize
+    from stylesync.session import Session
+    from stylesync.sources.registry import open_source
+
+    logging.disable(logging.WARNING)
+    try:
+        out = {}
+        for pull in (False, True):
+            spec = f"deepmimic:{_STEALTHY}"
+            opened = open_source(spec, seed=0, duration_s=12.0)
+            cfg, _ = suite_config(spec, opened, 0, 12.0)
+            cfg = follow_path(cfg)
+            if not pull:
+                cfg = cfg.replace(motion=dataclasses.replace(cfg.motion, path_target_share=0.0),
+                                  control=dataclasses.replace(cfg.control, whole_body=dataclasses.replace(
+                                      cfg.control.whole_body, own_step_push_bound="he_stands")))
+            out[pull] = summarize(Session(cfg, opened.source).run())
+            opened.source.close()
+    finally:
+        logging.disable(logging.NOTSET)
+    assert not out[False]["fell"] and not out[True]["fell"]
+    assert out[False]["uhc_fall_time_s"] is not None and out[False]["uhc_fall_time_s"] < 5.0
+    assert out[True]["uhc_fall_time_s"] is None
+    assert out[True]["mpjpe_global_mm"] < 0.5 * out[False]["mpjpe_global_mm"]

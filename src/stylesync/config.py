@@ -357,6 +357,13 @@ class MotionConfig:
     # in one step, above 2 it grows), the move at most path_feedback_max_m. 0: off [-], [m].
     path_feedback_share: float = 0.0
     path_feedback_max_m: float = 0.2
+    # Following the operator over the ground by the targets (motion/path_feedback.py, PathReference.target_pull_xy):
+    # the pelvis and COM targets of Eq. 10 are moved this share of the way from the COM target to his COM, scaled
+    # onto the character's path from where both started, the move at most path_target_max_m. The COM task sets the
+    # character's speed over the ground, and targets anchored on its own feet carry every step it falls short of
+    # his as a lag (docs/decisions.md, "Targets on his path"). 0: off [-], [m].
+    path_target_share: float = 0.0
+    path_target_max_m: float = 0.3
     # An operator's ankle higher than this share of his leg above his floor (the lowest his ankles have been, rising
     # slowly) bears no weight (on the ball of his foot an ankle rises by at most its distance to the ball, about
     # 0.15 m for a 0.9 m leg): on a stance foot that high he is in the air, and the pelvis height of Eq. 9 is
@@ -420,6 +427,9 @@ class MotionConfig:
         _non_negative("MotionConfig.reference_follows_operator_s", self.reference_follows_operator_s)
         _non_negative("MotionConfig.path_feedback_share", self.path_feedback_share)
         _non_negative("MotionConfig.path_feedback_max_m", self.path_feedback_max_m)
+        if not 0.0 <= self.path_target_share <= 1.0:
+            raise ConfigError(f"MotionConfig.path_target_share must be within [0, 1], got {self.path_target_share}")
+        _non_negative("MotionConfig.path_target_max_m", self.path_target_max_m)
         for n in ("liftoff_weight_shift_s", "liftoff_after_stand_s", "liftoff_margin_m"):
             _non_negative(f"MotionConfig.{n}", getattr(self, n))
         if self.liftoff_shift_outward_m is not None:
@@ -658,6 +668,11 @@ FOLLOW_PATH_MOTION: dict[str, Any] = {
     "recovery_walk_on_m": 0.1,  # its own steps walk on while he walks
     "recovery_walk_on_his_way": True,  # along his way over the ground, a divergence across it caught
     "gait_min_way_speed_mps": 0.3,  # a gait only while he goes somewhere (not a sway on the spot, not a stop)
+    "path_target_share": 1.0,  # the targets pulled to his path, at most path_target_max_m (0.3 m) ahead
+}
+# ... and in the whole-body controller (docs/decisions.md, "Targets on his path")
+FOLLOW_PATH_WHOLE_BODY: dict[str, Any] = {
+    "own_step_push_bound": "always",  # the push of the character's own steps bounded while he walks too
 }
 
 
@@ -674,9 +689,11 @@ def free_swing(cfg: SessionConfig) -> SessionConfig:
 
 
 def follow_path(cfg: SessionConfig) -> SessionConfig:
-    """``cfg`` with FOLLOW_PATH_MOTION and a recording's start at its own velocities
+    """``cfg`` with FOLLOW_PATH_MOTION, FOLLOW_PATH_WHOLE_BODY and a recording's start at its own velocities
     (OperatorConfig.start_with_clip_velocity)."""
+    whole_body = dataclasses.replace(cfg.control.whole_body, **FOLLOW_PATH_WHOLE_BODY)
     return cfg.replace(motion=dataclasses.replace(cfg.motion, **FOLLOW_PATH_MOTION),
+                       control=dataclasses.replace(cfg.control, whole_body=whole_body),
                        operator=dataclasses.replace(cfg.operator, start_with_clip_velocity=True))
 
 

@@ -14,6 +14,13 @@ keeps δ over the stance that follows. Moved by k δ, the foot stays there for t
 step (deadbeat), s > 2 makes it grow with alternating sign. The gain is set as that share (Englsberger et al.'s DCM
 tracking, in its footstep form), k = s / (e^(ωT) - 1), T the operator's usual step (his swing and double stance).
 The correction is bounded: a character far behind catches up over several steps, not one.
+
+The same scaled path also gives the targets a pull (:meth:`PathReference.target_pull_xy`). The pendulum's relation
+above holds for a body left to its pendulum; the whole-body controller's COM task tracks the COM target instead, and
+the target of Eq. 10 is anchored on the character's own stance foot: within a stance it moves at his speed, and at a
+change of stance it falls back by as much as the character's step was shorter than his. The character's speed over
+the ground is then its target's, and no landing undoes a lag that the target carries. Moving the targets a share of
+the way to his COM on the character's path (bounded) puts the restoring term where the speed is set.
 """
 
 from __future__ import annotations
@@ -26,9 +33,11 @@ import numpy as np
 class PathReference:
     """The operator's capture point scaled onto the character's path, and the landing correction it gives."""
 
-    def __init__(self, share: float, max_m: float):
+    def __init__(self, share: float, max_m: float, target_share: float = 0.0, target_max_m: float = 0.0):
         self.share = share  # s, the share of the error a step removes [-]
         self.max_m = max_m  # the correction's largest horizontal length [m]
+        self.target_share = target_share  # the share of the way the targets are moved to his path [-]
+        self.target_max_m = target_max_m  # the targets' largest move [m]
         self._char_origin_xy: np.ndarray | None = None  # the character's pelvis over the ground at the start [m]
         self._op_origin_xy: np.ndarray | None = None  # the operator's [m]
         self.error_xy = np.zeros(2)  # δ = ξ_c - ξ_ref of the last update, world frame [m]
@@ -36,7 +45,8 @@ class PathReference:
 
     @property
     def enabled(self) -> bool:
-        return self.share > 0.0
+        """Whether the path is tracked: for the landing's correction or the targets' pull."""
+        return self.share > 0.0 or self.target_share > 0.0
 
     def update(self, char_pelvis_world: np.ndarray, op_pelvis_world: np.ndarray, xi_c_world: np.ndarray,
                xi_h_world: np.ndarray, scale: float, omega_per_s: float) -> np.ndarray:
@@ -55,9 +65,23 @@ class PathReference:
     def landing_shift_xy(self, step_s: float) -> np.ndarray:
         """k δ (2,) [m], world frame, k = share / (e^(ω T) - 1) for the last update's ω and ``step_s`` = T [s],
         bounded to ``max_m``: what the landing moves by."""
-        shift = deadbeat_gain(self.omega_per_s, step_s) * self.share * self.error_xy
-        n = float(np.linalg.norm(shift))
-        return shift * (self.max_m / n) if n > self.max_m else shift
+        return _bounded(deadbeat_gain(self.omega_per_s, step_s) * self.share * self.error_xy, self.max_m)
+
+    def target_pull_xy(self, com_target_world: np.ndarray, op_com_world: np.ndarray, scale: float) -> np.ndarray:
+        """(2,) [m], world frame: what the targets move by, ``target_share`` of the way from the COM target
+        ``com_target_world`` to the operator's COM ``op_com_world`` scaled by ``scale`` about his first pelvis
+        ground point onto the character's, at most ``target_max_m``; zero before the first :meth:`update` or when
+        off."""
+        if self.target_share <= 0.0 or self._char_origin_xy is None or self._op_origin_xy is None:
+            return np.zeros(2)
+        his = self._char_origin_xy + scale * (np.asarray(op_com_world, dtype=float)[:2] - self._op_origin_xy)
+        return _bounded(self.target_share * (his - np.asarray(com_target_world, dtype=float)[:2]), self.target_max_m)
+
+
+def _bounded(shift_xy: np.ndarray, max_m: float) -> np.ndarray:
+    """``shift_xy`` (2,) shortened to at most ``max_m`` [m]."""
+    n = float(np.linalg.norm(shift_xy))
+    return shift_xy * (max_m / n) if n > max_m else shift_xy
 
 
 def deadbeat_gain(omega_per_s: float, step_s: float) -> float:

@@ -254,7 +254,8 @@ class MotionOptimizer:
         self._ref_xy: np.ndarray | None = None  # (pelvis, COM) x (x, y) targets that follow the operator [m]
         self._swing: str | None = None
         self._feet_by_own_step = False  # the character's last step was its own (a recovery step), not one of his
-        self.path = PathReference(cfg.path_feedback_share, cfg.path_feedback_max_m)  # path_feedback.py
+        self.path = PathReference(cfg.path_feedback_share, cfg.path_feedback_max_m, cfg.path_target_share,
+                                  cfg.path_target_max_m)  # path_feedback.py
         self._swing_offset = np.zeros(2)  # lift-off foot position minus the first swing target, decaying [m]
         self._free_share = 0.0  # how much the swing foot follows his (_free_swing_share) [0, 1]
         self._swing_t0_s = 0.0  # when the character's current swing began [s]
@@ -490,6 +491,11 @@ class MotionOptimizer:
             else:
                 self._hold_velocity, self._hold_shift = None, np.zeros(2)
         self._last_xy = np.array([pelvis_xy[:2], com_xy[:2]])
+        # Opt-in: both targets moved towards his COM on the character's path (path_feedback.py; after the anchor
+        # offset's continuity, which is the feet's, not the path's)
+        pull = self.path.target_pull_xy(com_xy, com_h, scale)
+        pelvis_xy[:2] += pull
+        com_xy[:2] += pull
         tau = self.cfg.reference_follows_operator_s
         if tau > 0:
             # Opt-in: the targets advance at the operator's COM velocity (scaled), pulled towards the anchored ones
