@@ -101,3 +101,34 @@ def test_bind_pose_blend_frames_are_found():
     assert bind_blend_frames(pos, 1 / 120) == 0
     pos[:4, JOINT_INDEX["WRIST_LEFT"], 2] = [0.8, 0.6, 0.35, 0.1]  # frames blending from an arms-up bind pose
     assert bind_blend_frames(pos, 1 / 120) == 4
+
+
+def test_the_start_speed_share():
+    from stylesync.motion.initial_state import start_velocity_share
+
+    assert start_velocity_share(np.array([3.0, 4.0, 1.0]), None) == 1.0
+    assert start_velocity_share(np.array([3.0, 4.0, 9.0]), 2.5) == pytest.approx(0.5)  # horizontal speed 5 m/s
+    assert start_velocity_share(np.array([0.3, 0.4, 0.0]), 1.0) == 1.0  # slower than the bound: as it is
+    assert start_velocity_share(np.zeros(3), 0.0) == 1.0
+
+
+@needs_cmu_dev
+@pytest.mark.parametrize("max_mps", [None, 1.0])
+def test_a_clip_started_at_its_speed_no_faster_than_the_bound(max_mps):
+    """CMU-dev 08_07 starts at 2.3 m/s (scaled): started with its velocities its root moves that fast; with the bound,
+    at the bound, its joints slowed by the same share."""
+    from stylesync.errors import ConfigError
+
+    op = OperatorConfig(start_with_clip_velocity=True, start_speed_max_mps=max_mps)
+    opened = open_source(f"bvh:{MOCAP / 'cmu-dev' / '08_07.bvh'}", seed=0, operator=op)
+    session = Session(SessionConfig(duration_s=0.1, operator=op), opened.source)
+    session._place_character()
+    state = session.backend.read_state(0.0)
+    speed = float(np.hypot(*state.root_lin_vel_world[:2]))
+    if max_mps is None:
+        assert speed > 2.0
+    else:
+        assert speed == pytest.approx(max_mps, abs=1e-6)
+    session.backend.close()
+    with pytest.raises(ConfigError, match="start_speed_max_mps"):
+        OperatorConfig(start_speed_max_mps=-1.0)

@@ -622,11 +622,17 @@ class OperatorConfig:
     # On, the 1€ filter and the motion stage's COM rates start from the clip's rates too (no lag of a filter that
     # believes the operator at rest); measured on the walk set, 28 of 56 runs complete against 33-37 started at rest.
     start_with_clip_velocity: bool = False
+    # ... at most this fast over the ground: the character's velocities (root and joints) scaled down together so
+    # that its root's horizontal speed is no more (None: the clip's as they are). A body started faster than its steps
+    # can catch falls forward through them (docs/decisions.md) [m/s]
+    start_speed_max_mps: float | None = None
 
     def __post_init__(self) -> None:
         _positive("OperatorConfig.height_m", self.height_m)
         _positive("OperatorConfig.mass_kg", self.mass_kg)
         _non_negative("OperatorConfig.position_noise_m", self.position_noise_m)
+        if self.start_speed_max_mps is not None:
+            _non_negative("OperatorConfig.start_speed_max_mps", self.start_speed_max_mps)
         _non_negative("OperatorConfig.orientation_noise_rad", self.orientation_noise_rad)
         _non_negative("OperatorConfig.timestamp_jitter_s", self.timestamp_jitter_s)
         _non_negative("OperatorConfig.standing_lead_in_s", self.standing_lead_in_s)

@@ -33,7 +33,7 @@ from stylesync.model.character import (
 from stylesync.model.character_model import CharacterModel
 from stylesync.model.state import CharacterState
 from stylesync.motion.bounds import BoundsMonitor
-from stylesync.motion.initial_state import initial_state
+from stylesync.motion.initial_state import initial_state, start_velocity_share
 from stylesync.motion.operator_analysis import analyse_operator
 from stylesync.motion.pose_optimization import MotionOptimizer
 from stylesync.motion.stance_fsm import Stance
@@ -261,10 +261,12 @@ class Session:
         root = init.root_pos_world + np.array([0.0, 0.0, ANKLE_HEIGHT_M + 0.002 - float(ankle_z.min())])
         self.backend.reset(root, init.root_quat_wxyz, init.joint_pos)
         if self.cfg.operator.start_with_clip_velocity:
-            self.backend.set_velocities(init.root_lin_vel_world, init.root_ang_vel_world, init.joint_vel)
+            share = start_velocity_share(init.root_lin_vel_world, self.cfg.operator.start_speed_max_mps)
+            self.backend.set_velocities(share * init.root_lin_vel_world, share * init.root_ang_vel_world,
+                                        share * init.joint_vel)
             self.processing.prime_rates(f0, f1)
             com_vel_h = (s1.com_world - s0.com_world) / (s1.time_s - s0.time_s)
-            self.motion.prime_rates(com_vel_h, init.root_lin_vel_world)
+            self.motion.prime_rates(com_vel_h, share * init.root_lin_vel_world)
         return True
 
     def run(self, progress: Callable[[float, float], None] | None = None,

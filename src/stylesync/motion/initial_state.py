@@ -102,3 +102,13 @@ def initial_state(s0: OperatorSample, a0: OperatorAnalysis, s1: OperatorSample, 
     joint_vel[_HINGE, 0] = (j1[_HINGE, 0] - j0[_HINGE, 0]) / dt
     origin = np.array([s0.pos["PELVIS"][0] - p0[0], s0.pos["PELVIS"][1] - p0[1], 0.0])  # at the operator's pelvis
     return InitialState(p0 + origin, q0, j0, (p1 - p0) / dt, ang_root, joint_vel)
+
+
+def start_velocity_share(root_lin_vel_world: np.ndarray, max_speed_mps: float | None) -> float:
+    """The share [0, 1] of the initial velocities that starts the character with its root's horizontal speed (of
+    ``root_lin_vel_world``, (3,) [m/s]) at most ``max_speed_mps`` [m/s] (None: 1, the clip's velocities as they are).
+    One share for the root and every joint: the pose's motion is slowed as a whole, not reshaped."""
+    if max_speed_mps is None:
+        return 1.0
+    speed = float(np.hypot(root_lin_vel_world[0], root_lin_vel_world[1]))
+    return 1.0 if speed <= max_speed_mps else max_speed_mps / speed
