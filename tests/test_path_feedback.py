@@ -73,10 +73,18 @@ def test_off_by_default_and_validated():
 
 
 def test_follow_path_sets_the_opt_ins_and_the_start_at_speed():
-    from stylesync.config import FOLLOW_PATH_MOTION, FOLLOW_PATH_WHOLE_BODY, SessionConfig, follow_path
+    from stylesync.config import (
+        FOLLOW_PATH_MOTION,
+        FOLLOW_PATH_START_SPEED_MAX_MPS,
+        FOLLOW_PATH_WHOLE_BODY,
+        SessionConfig,
+        follow_path,
+    )
 
     cfg = follow_path(SessionConfig())
     assert cfg.operator.start_with_clip_velocity and not SessionConfig().operator.start_with_clip_velocity
+    assert cfg.operator.start_speed_max_mps == FOLLOW_PATH_START_SPEED_MAX_MPS
+    assert SessionConfig().operator.start_speed_max_mps is None
     for name, value in FOLLOW_PATH_MOTION.items():
         assert getattr(cfg.motion, name) == value != getattr(SessionConfig().motion, name)
     for name, value in FOLLOW_PATH_WHOLE_BODY.items():
