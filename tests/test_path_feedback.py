@@ -157,7 +157,7 @@ def test_targets_on_his_path_keep_the_stealthy_walk_within_the_uhc_distance():
     """Measured (the development suite's run of the crouched stealthy walk, 12 s, seed 0): with ``--follow-path``'s
     settings before the targets' pull (path_target_share 0, the push of the character's own steps bounded only while
     he stands) the UHC termination comes at 3.8 s, the character trailing his path; with them no termination in
-    the 12 s, and no fall either way."""
+    the 12 s, and no fall either way. (The walk starts slower than the start's bound of 1 m/s.)"""
     import logging
 
     from stylesync.config import follow_path
