@@ -45,17 +45,19 @@ def random_pose(seed: int, ball_sigma_rad: float = 0.3, hinge_rad: float = 0.6) 
     return q
 
 
-def suite_run(spec: str, seed: int, motion: MotionConfig, control: ControlConfig, on_tick=None, watch=None):
+def suite_run(spec: str, seed: int, motion: MotionConfig, control: ControlConfig, on_tick=None, watch=None,
+              configure=None):
     """One development-suite run of ``spec`` (its configuration and source as the suite opens them) with ``motion``
-    and ``control``. ``on_tick(state, ref)`` is called each control tick; or ``watch(session)`` returns that
-    callback, for one that reads the session itself."""
+    and ``control``, and then ``configure(cfg) -> cfg`` if given. ``on_tick(state, ref)`` is called each control
+    tick; or ``watch(session)`` returns that callback, for one that reads the session itself."""
     from stylesync.metrics.dev_suite import suite_config
     from stylesync.session import Session
     from stylesync.sources.registry import open_source
 
     opened = open_source(spec, seed=seed, duration_s=12.0)
     cfg, _ = suite_config(spec, opened, seed, 12.0)
-    session = Session(dataclasses.replace(cfg, motion=motion, control=control), opened.source)
+    cfg = dataclasses.replace(cfg, motion=motion, control=control)
+    session = Session(configure(cfg) if configure is not None else cfg, opened.source)
     if watch is not None:
         on_tick = watch(session)
     if on_tick is not None:

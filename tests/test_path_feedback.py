@@ -160,26 +160,22 @@ def test_targets_on_his_path_keep_the_stealthy_walk_within_the_uhc_distance():
     the 12 s, and no fall either way. (The walk starts slower than the start's bound of 1 m/s.)"""
     import logging
 
-    from stylesync.config import follow_path
-    from stylesync.metrics.dev_suite import suite_config
+    from conftest import suite_run
+
+    from stylesync.config import ControlConfig, follow_path
     from stylesync.metrics.summary import summarize
-    from stylesync.session import Session
-    from stylesync.sources.registry import open_source
+
+    def without_pull(cfg):
+        cfg = follow_path(cfg)
+        return cfg.replace(motion=dataclasses.replace(cfg.motion, path_target_share=0.0),
+                           control=dataclasses.replace(cfg.control, whole_body=dataclasses.replace(
+                               cfg.control.whole_body, own_step_push_bound="he_stands")))
 
     logging.disable(logging.WARNING)
     try:
-        out = {}
-        for pull in (False, True):
-            spec = f"deepmimic:{_STEALTHY}"
-            opened = open_source(spec, seed=0, duration_s=12.0)
-            cfg, _ = suite_config(spec, opened, 0, 12.0)
-            cfg = follow_path(cfg)
-            if not pull:
-                cfg = cfg.replace(motion=dataclasses.replace(cfg.motion, path_target_share=0.0),
-                                  control=dataclasses.replace(cfg.control, whole_body=dataclasses.replace(
-                                      cfg.control.whole_body, own_step_push_bound="he_stands")))
-            out[pull] = summarize(Session(cfg, opened.source).run())
-            opened.source.close()
+        out = {pull: summarize(suite_run(f"deepmimic:{_STEALTHY}", 0, MotionConfig(), ControlConfig(),
+                                         configure=follow_path if pull else without_pull))
+               for pull in (False, True)}
     finally:
         logging.disable(logging.NOTSET)
     assert not out[False]["fell"] and not out[True]["fell"]

@@ -696,16 +696,19 @@ def free_swing(cfg: SessionConfig) -> SessionConfig:
 
 # ... and for a recording: started at its own velocities, no faster than this over the ground [m/s]
 FOLLOW_PATH_START_SPEED_MAX_MPS = 1.0
+FOLLOW_PATH_OPERATOR: dict[str, Any] = {
+    "start_with_clip_velocity": True,
+    "start_speed_max_mps": FOLLOW_PATH_START_SPEED_MAX_MPS,
+}
 
 
 def follow_path(cfg: SessionConfig) -> SessionConfig:
-    """``cfg`` with FOLLOW_PATH_MOTION, FOLLOW_PATH_WHOLE_BODY and a recording's start at its own velocities
-    (OperatorConfig.start_with_clip_velocity), at most FOLLOW_PATH_START_SPEED_MAX_MPS."""
+    """``cfg`` with FOLLOW_PATH_MOTION, FOLLOW_PATH_WHOLE_BODY and FOLLOW_PATH_OPERATOR (a recording's start at its
+    own velocities, at most FOLLOW_PATH_START_SPEED_MAX_MPS)."""
     whole_body = dataclasses.replace(cfg.control.whole_body, **FOLLOW_PATH_WHOLE_BODY)
     return cfg.replace(motion=dataclasses.replace(cfg.motion, **FOLLOW_PATH_MOTION),
                        control=dataclasses.replace(cfg.control, whole_body=whole_body),
-                       operator=dataclasses.replace(cfg.operator, start_with_clip_velocity=True,
-                                                    start_speed_max_mps=FOLLOW_PATH_START_SPEED_MAX_MPS))
+                       operator=dataclasses.replace(cfg.operator, **FOLLOW_PATH_OPERATOR))
 
 
 def pid_group(joint_name: str) -> str:

@@ -493,9 +493,10 @@ class MotionOptimizer:
         self._last_xy = np.array([pelvis_xy[:2], com_xy[:2]])
         # Opt-in: both targets moved towards his COM on the character's path (path_feedback.py; after the anchor
         # offset's continuity, which is the feet's, not the path's)
-        pull = self.path.target_pull_xy(com_xy, com_h, scale)
-        pelvis_xy[:2] += pull
-        com_xy[:2] += pull
+        if self.cfg.path_target_share > 0.0:
+            pull = self.path.target_pull_xy(com_xy, com_h, scale)
+            pelvis_xy[:2] += pull
+            com_xy[:2] += pull
         tau = self.cfg.reference_follows_operator_s
         if tau > 0:
             # Opt-in: the targets advance at the operator's COM velocity (scaled), pulled towards the anchored ones
@@ -911,7 +912,7 @@ class MotionOptimizer:
             start = (self._liftoff_xy if self._aim_at_his_landing
                      else (a_c[other] + scale * (a_h[side] - a_h[other]))[:2])
             path_shift = np.zeros(2)
-            if self.path.enabled:
+            if self.cfg.path_feedback_share > 0.0:
                 path_shift = R_root_d.T[:2, :2] @ self.path.landing_shift_xy(self._op_swing_s + self._op_ds_s)
             land[0] += path_shift[0]  # following him over the ground (path_feedback.py), within the bounds below
             land[0] = min(land[0], -cfg.step_behind_capture_point_m)
