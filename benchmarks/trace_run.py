@@ -2,7 +2,7 @@
 point was, what the COM task asked for and what the body did (prints figures; a tool for explaining a fall).
 
     python benchmarks/trace_run.py 05_01 --seed 0 [--from 4.5] [--to 7] [--every 6] [--duration 12] [--past-fall]
-                                         [--feet]
+                                         [--feet] [--yaw] [--follow-path]
 
 The clip is a development-suite name (`stylesync bench --suite dev`: a humanoid3d clip or a file of ../shared/mocap)
 or a source spec (``bvh:PATH``, ``builtin:walk``), run as the suite runs it: the Kinect sensor model with the seed,
@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from stylesync import rotations as rot
+from stylesync.config import follow_path
 from stylesync.metrics.dev_suite import clip_specs, suite_config
 from stylesync.model.character import LINK_NAMES
 from stylesync.model.sole import convex_hull_xy, outside_distance_m, sole_corners_world
@@ -67,12 +68,15 @@ def main() -> None:
     ap.add_argument("--feet", action="store_true", help="also print the ankles' horizontal positions [m]")
     ap.add_argument("--yaw", action="store_true", help="also print the headings of the reference's root, the "
                                                         "character's pelvis and its feet [deg]")
+    ap.add_argument("--follow-path", action="store_true", help="with --follow-path's settings (config.follow_path)")
     ap.add_argument("--past-fall", action="store_true", help="run on after the first fall (to see what follows it)")
     args = ap.parse_args()
     logging.disable(logging.WARNING)
     spec = resolve(args.clip)
     opened = open_source(spec, seed=args.seed, duration_s=args.duration)
     cfg, clip_end = suite_config(spec, opened, args.seed, args.duration)
+    if args.follow_path:
+        cfg = follow_path(cfg)
     length = cfg.duration_s
     session = Session(dataclasses.replace(cfg, duration_s=min(length, args.t1)), opened.source)
     session.stop_on_fall = not args.past_fall
