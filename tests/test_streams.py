@@ -98,13 +98,15 @@ def test_vmc_hostile_packets_are_counted_by_reason_and_never_block_shutdown(capf
         sock.sendto(_bone_bundle(bad), addr)
         zero = [(a, [*args[:4], 0.0, 0.0, 0.0, 0.0]) if a == "/VMC/Ext/Root/Pos" else (a, args) for a, args in good]
         sock.sendto(_bone_bundle(zero), addr)
-        # A burst beyond the queue, nobody polling (in chunks the socket's receive buffer holds: what the kernel
-        # drops never reaches the source).
+        # A burst beyond the queue, nobody polling (in chunks the socket's receive buffer holds, each taken by the
+        # source before the next is sent: what the kernel drops on a busy machine never reaches the source).
         packet = _bone_bundle(good)
         for k in range(600):
             sock.sendto(packet, addr)
             if k % 20 == 19:
-                time.sleep(0.02)
+                taken = time.perf_counter() + 1.0
+                while source.frames_received < k and time.perf_counter() < taken:
+                    time.sleep(0.005)
         seen, deadline = -1, time.perf_counter() + 10.0
         while source.frames_received != seen and time.perf_counter() < deadline:
             seen = source.frames_received
