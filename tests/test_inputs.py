@@ -539,8 +539,8 @@ def test_vmc_from_vmcp_own_sender_arrives_frame_by_frame():
             assert np.linalg.norm(frame.pos("PELVIS")[:2] - np.array([0.3, -0.2])) < 0.01
             # Then at 60 Hz for 30 s (osc4py3 starts once per process, so in the same session): every frame
             # arrives, none is rejected, and each exists (median) within half a frame period of its packet's
-            # receipt: it closes with its own packet, not when the next one comes (16.7 ms later at 60 Hz). Measured:
-            # 1.5-1.8 ms on an idle machine, 2.5 ms with both cores loaded by other runs.
+            # receipt: it closes with its own packet, not when the next one comes (16.7 ms later at 60 Hz). Measured
+            # with both cores loaded by other runs: a median of 2.5 ms.
             n = 30 * 60
             steady = VmcSource("127.0.0.1", 0, max_queue=n)
             bundles = []
