@@ -1,4 +1,5 @@
 import dataclasses
+import time
 
 import numpy as np
 import pytest
@@ -65,3 +66,11 @@ def suite_run(spec: str, seed: int, motion: MotionConfig, control: ControlConfig
     result = session.run()
     opened.source.close()
     return result
+
+
+def wait_frames(source, n: int, timeout_s: float = 1.0) -> int:
+    """Waits until a live ``source`` has received ``n`` frames, at most ``timeout_s``; the count it has then."""
+    t0 = time.perf_counter()
+    while source.frames_received < n and time.perf_counter() - t0 < timeout_s:
+        time.sleep(0.001)
+    return source.frames_received

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import wait_frames
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -456,15 +457,6 @@ def _vmc_bundle(messages):
     return bundle.build()
 
 
-def _wait_frames(source, n, timeout_s=1.0):
-    import time
-
-    t0 = time.perf_counter()
-    while source.frames_received < n and time.perf_counter() - t0 < timeout_s:
-        time.sleep(0.001)
-    return source.frames_received
-
-
 def test_vmc_frames_close_with_their_own_packet_whatever_the_message_order():
     """A frame is complete when its packet has arrived: with /VMC/Ext/T and /VMC/Ext/OK after the bones, before
     them (a sender that stamps the frame first), or absent; a sender that spreads a frame over several packets and
@@ -485,13 +477,13 @@ def test_vmc_frames_close_with_their_own_packet_whatever_the_message_order():
         body = [m for m in msgs if m not in marks]
         for k, order in enumerate((body + marks, marks + body, body), start=1):
             client.send(_vmc_bundle(order))
-            assert _wait_frames(source, k) == k  # no next packet needed
+            assert wait_frames(source, k) == k  # no next packet needed
         # Spread over packets, no T / OK: the next root closes the frame.
         for addr, args in body:
             client.send_message(addr, args)
-        assert _wait_frames(source, 4, timeout_s=0.2) == 3
+        assert wait_frames(source, 4, timeout_s=0.2) == 3
         client.send_message(*body[0])
-        assert _wait_frames(source, 4) == 4
+        assert wait_frames(source, 4) == 4
         assert source.rejected_frames == 0
     finally:
         source.close()

@@ -9,6 +9,7 @@ import time
 
 import numpy as np
 import pytest
+from conftest import wait_frames
 
 from stylesync.config import SessionConfig
 from stylesync.sources.base import QueuedLiveSource
@@ -104,9 +105,7 @@ def test_vmc_hostile_packets_are_counted_by_reason_and_never_block_shutdown(capf
         for k in range(600):
             sock.sendto(packet, addr)
             if k % 20 == 19:
-                taken = time.perf_counter() + 1.0
-                while source.frames_received < k and time.perf_counter() < taken:
-                    time.sleep(0.005)
+                wait_frames(source, k)
         seen, deadline = -1, time.perf_counter() + 10.0
         while source.frames_received != seen and time.perf_counter() < deadline:
             seen = source.frames_received
