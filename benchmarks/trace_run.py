@@ -2,7 +2,7 @@
 point was, what the COM task asked for and what the body did (prints figures; a tool for explaining a fall).
 
     python benchmarks/trace_run.py 05_01 --seed 0 [--from 4.5] [--to 7] [--every 6] [--duration 12] [--past-fall]
-                                         [--feet] [--yaw] [--follow-path]
+                                         [--feet] [--yaw] [--follow-path] [--heights]
 
 The clip is a development-suite name (`stylesync bench --suite dev`: a humanoid3d clip or a file of ../shared/mocap)
 or a source spec (``bvh:PATH``, ``builtin:walk``), run as the suite runs it: the Kinect sensor model with the seed,
@@ -21,6 +21,8 @@ a recorded file started in its first pose and held for the rest after its end. C
     fL fR      the soles' normal forces [N]
     --yaw      the headings [deg]: the reference's root (``ref``), the character's pelvis (``ch``) and feet (``ftL``,
                ``ftR``)
+    --heights  the ankles' heights (``zL``, ``zR``) and, in a step of the character's own, the swing ankle's target
+               (``own``) [m]
 """
 
 from __future__ import annotations
@@ -69,6 +71,8 @@ def main() -> None:
     ap.add_argument("--yaw", action="store_true", help="also print the headings of the reference's root, the "
                                                         "character's pelvis and its feet [deg]")
     ap.add_argument("--follow-path", action="store_true", help="with --follow-path's settings (config.follow_path)")
+    ap.add_argument("--heights", action="store_true", help="also print the ankles' heights and, in a step of the "
+                                                           "character's own, its ankle target [m]")
     ap.add_argument("--past-fall", action="store_true", help="run on after the first fall (to see what follows it)")
     args = ap.parse_args()
     logging.disable(logging.WARNING)
@@ -119,7 +123,11 @@ def main() -> None:
               + (" yaw ref {:+5.0f} ch {:+5.0f} ftL {:+5.0f} ftR {:+5.0f}".format(
                   *np.degrees([rot.yaw_from_quat(ref.root_quat_wxyz), rot.yaw_from_quat(state.root_quat_wxyz),
                                *(rot.yaw_from_quat(state.link_quat_wxyz[_ANKLE[s]]) for s in ("left", "right"))]))
-                 if args.yaw else ""))
+                 if args.yaw else "")
+              + (" zL {:.3f} zR {:.3f}".format(*(state.link_origin_world[_ANKLE[s]][2] for s in ("left", "right")))
+                 + "".join(f" own {s[0]}({p[0]:+5.2f},{p[1]:+5.2f},{p[2]:.3f})"
+                           for s, p in (ref.recovery_ankle_world or {}).items())
+                 if args.heights else ""))
 
     session.on_tick = on_tick
     try:
