@@ -1,0 +1,81 @@
+"""How the character's own steps land in runs of the development suite (prints figures; a tool for explaining falls).
+
+    python benchmarks/own_step_landings.py run:14 jog:8 jog:9 [--window 1.5] [--duration 12]
+
+Each argument is a development-suite clip (`stylesync bench --suite dev`: a humanoid3d clip or a file of
+../shared/mocap) and a sensor seed, run as the suite runs it (benchmarks/trace_run.py). Over the control ticks of the
+character's own steps (motion/recovery_step.py; ``ReferencePose.recovery_ankle_world``), in the last ``--window``
+seconds before a fall, or over the whole run when it completes:
+
+    own ticks   control ticks in a step of the character's own
+    max z       the swing ankle's largest height [m] (0.05 m when the foot is on the ground)
+    due, up     ticks whose landing is due (the target pressed below the ground, whole_body.recovery_landing_due)
+                while the ankle is more than DUE_UP_M high: a foot that should be down and is not
+    hip limit   ticks with the swing hip at its torque limit (any axis)
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+
+import numpy as np
+from trace_run import resolve
+
+from stylesync.control.controller import TORQUE_LIMIT
+from stylesync.control.whole_body import recovery_landing_due
+from stylesync.metrics.dev_suite import suite_config
+from stylesync.model.character import JOINT_NAMES, LINK_NAMES
+from stylesync.session import Session
+from stylesync.sources.registry import open_source
+
+DUE_UP_M = 0.08  # an ankle this high is 3 cm off the ground [m]
+
+
+def landings(clip: str, seed: int, duration_s: float, window_s: float) -> str:
+    """One line of figures for a run of ``clip`` with sensor seed ``seed``."""
+    spec = resolve(clip)
+    opened = open_source(spec, seed=seed, duration_s=duration_s)
+    cfg, _ = suite_config(spec, opened, seed, duration_s)
+    session = Session(cfg, opened.source)
+    ankle = {s: LINK_NAMES.index(f"{s}_ankle") for s in ("left", "right")}
+    hip = {s: JOINT_NAMES.index(f"{s}_hip") for s in ("left", "right")}
+    ticks: list[tuple[float, float, bool, bool]] = []  # time [s], ankle height [m], due, hip at its limit
+
+    def on_tick(state, ref) -> None:
+        tau = session.controller.torques(None).values
+        for side, target in (ref.recovery_ankle_world or {}).items():
+            k = hip[side]
+            ticks.append((state.time_s, float(state.link_origin_world[ankle[side]][2]),
+                          recovery_landing_due(target),
+                          bool(np.any(np.abs(tau[k]) >= 0.999 * TORQUE_LIMIT[k, 0]))))
+
+    session.on_tick = on_tick
+    try:
+        result = session.run()
+    finally:
+        opened.source.close()
+    end_s = result.fall_time_s if result.fell and result.fall_time_s is not None else cfg.duration_s
+    seen = [t for t in ticks if t[0] >= end_s - window_s] if result.fell else ticks
+    head = f"{clip} seed {seed}: " + (f"fell at {end_s:.2f} s, last {window_s:.1f} s" if result.fell
+                                     else f"completed {end_s:.1f} s, whole run")
+    if not seen:
+        return head + ": no step of its own"
+    return (f"{head}: own ticks {len(seen)}, max z {max(t[1] for t in seen):.3f} m, "
+            f"due, up {sum(1 for t in seen if t[2] and t[1] > DUE_UP_M)}, hip limit {sum(1 for t in seen if t[3])}")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("runs", nargs="+", help="CLIP:SEED, e.g. run:14")
+    ap.add_argument("--window", type=float, default=1.5, help="seconds before a fall looked at [s]")
+    ap.add_argument("--duration", type=float, default=12.0, help="the run's length [s]")
+    args = ap.parse_args()
+    logging.disable(logging.WARNING)
+    for run in args.runs:
+        clip, _, seed = run.rpartition(":")
+        print(landings(clip, int(seed), args.duration, args.window), flush=True)
+
+
+if __name__ == "__main__":
+    main()
