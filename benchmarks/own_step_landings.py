@@ -8,7 +8,7 @@ character's own steps (motion/recovery_step.py; ``ReferencePose.recovery_ankle_w
 seconds before a fall, or over the whole run when it completes:
 
     own ticks   control ticks in a step of the character's own
-    max z       the swing ankle's largest height [m] (0.05 m when the foot is on the ground)
+    max z       the swing ankle's largest height [m] (ANKLE_HEIGHT_M, 0.05 m, when the foot is on the ground)
     due, up     ticks whose landing is due (the target pressed below the ground, whole_body.recovery_landing_due)
                 while the ankle is more than DUE_UP_M high: a foot that should be down and is not
     hip limit   ticks with the swing hip at its torque limit (any axis)
@@ -25,11 +25,11 @@ from trace_run import resolve
 from stylesync.control.controller import TORQUE_LIMIT
 from stylesync.control.whole_body import recovery_landing_due
 from stylesync.metrics.dev_suite import suite_config
-from stylesync.model.character import JOINT_NAMES, LINK_NAMES
+from stylesync.model.character import ANKLE_HEIGHT_M, JOINT_NAMES, LINK_NAMES
 from stylesync.session import Session
 from stylesync.sources.registry import open_source
 
-DUE_UP_M = 0.08  # an ankle this high is 3 cm off the ground [m]
+DUE_UP_M = ANKLE_HEIGHT_M + 0.03  # an ankle this high is 3 cm off the ground [m]
 
 
 def landings(clip: str, seed: int, duration_s: float, window_s: float) -> str:
