@@ -11,8 +11,9 @@ given seed. Per category: runs, clips that could be opened, completion (no fall)
 before the clip's end; a fall in the rest after it counts against completion only), runs without a UHC/PHC
 termination, mean fall time, MPJPE (global, root-relative), steps (character / operator), the median of how far
 the character went along its operator's path (metrics/imitation.path_progress) and the median of the runs' largest
-transition delays. Nothing is tuned per clip: the same settings for every run. Writes dev_suite.md
-and dev_suite.json under --out.
+transition delays; then, per category, the runs each version completes and the other does not, with the p-value
+of the difference (stylesync.metrics.paired_outcomes). Nothing is tuned per clip: the same settings for every run.
+Writes dev_suite.md and dev_suite.json under --out.
 """
 
 from __future__ import annotations
@@ -25,8 +26,9 @@ from pathlib import Path
 
 from versions import REPO, checkouts, probe
 
+from stylesync.metrics.dev_suite import ORDER, table
 from stylesync.metrics.dev_suite import clip_specs as suite_clips
-from stylesync.metrics.dev_suite import table
+from stylesync.metrics.paired_outcomes import paired_table
 
 SHARED = REPO.parent / "shared" / "mocap"
 # Run inside each checked-out version, old ones included, which have no stylesync.metrics.dev_suite to call: the
@@ -108,6 +110,8 @@ def main() -> None:
         with ThreadPoolExecutor(max_workers=args.workers) as pool:
             rows = list(pool.map(run, jobs))
     md = table(rows, list(trees))
+    if len(trees) > 1:
+        md += "\n\n" + paired_table(rows, list(trees), ORDER)
     (out / "dev_suite.json").write_text(json.dumps(rows, indent=1))
     (out / "dev_suite.md").write_text(md + "\n")
     print(md)

@@ -28,6 +28,8 @@ def test_the_dev_suite_writes_one_row_per_category_and_controller(tmp_path, caps
     assert all(r["category"] == "kick" and "error" not in r for r in rows)
     md = (out / "dev_suite.md").read_text()
     assert "| kick | stylesync |" in md and "| kick | plain-pd |" in md
+    paired = md.split("p (exact McNemar)", 1)[1]  # then each version paired with the first, run by run
+    assert "| kick | plain-pd | " in paired and "| all | plain-pd | " in paired
     assert "dev_suite.md" in (out / "report.html").read_text()
     assert table(rows, ["stylesync"]).count("| kick |") == 1
 

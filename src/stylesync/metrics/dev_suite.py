@@ -8,9 +8,10 @@ the same run, the same settings for every clip. A run lasts the clip (at most ``
 lead-in of a clip, or the 3 s rest after a recorded file, included). Per category and controller: runs, clips that
 could be opened, completion (no fall through the clip and the rest), runs through the clip (no fall before its
 end), runs without a UHC/PHC termination, mean fall time, MPJPE (global, root-relative), steps (character /
-operator) and the median of the runs' largest transition delays. Written as dev_suite.md, dev_suite.json and
-report.html. The previous version of the code in the same run: ``benchmarks/dev_suite.py --baseline REF`` (git
-worktrees).
+operator) and the median of the runs' largest transition delays; then, per category, the runs each version
+completes and the other does not, with the p-value of the difference (paired_outcomes.py). Written as
+dev_suite.md, dev_suite.json and report.html. The previous version of the code in the same run:
+``benchmarks/dev_suite.py --baseline REF`` (git worktrees).
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ import numpy as np
 from stylesync.config import OperatorConfig, SessionConfig
 from stylesync.errors import StylesyncError
 from stylesync.metrics.bench import CONTROLLERS
+from stylesync.metrics.paired_outcomes import paired_table
 from stylesync.metrics.summary import summarize
 from stylesync.session import FALL_REASON_PREFIXES
 
@@ -176,6 +178,8 @@ def run_dev_suite(out: Path, seeds: int, duration_s: float, mocap: Path | None, 
             for (row, note), (spec, name, cat, seed, ctrl, _) in zip(
                 execute_all(_job, [(j,) for j in jobs], executor, workers), jobs, strict=True)]
     md = table(rows, list(controllers))
+    if len(controllers) > 1:
+        md += "\n\n" + paired_table(rows, list(controllers), ORDER)
     (out / "dev_suite.json").write_text(json.dumps(rows, indent=1))
     (out / "dev_suite.md").write_text(md + "\n")
     return {"rows": rows, "table": md}
