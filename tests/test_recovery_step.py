@@ -19,6 +19,7 @@ from stylesync.model.sole import convex_hull_xy, outside_distance_m, sole_corner
 from stylesync.motion.pose_optimization import CHAR_LEG_LENGTH_M, LANDING_REACH
 from stylesync.motion.recovery_step import (
     MIN_FOOT_SEPARATION_M,
+    RecoveryStep,
     RecoveryStepper,
     WalkOn,
     beyond_sole_towards_m,
@@ -1171,6 +1172,64 @@ def test_the_next_recovery_step_begins_while_both_soles_are_down():
     assert after and after[0][1] == "left" and after[0][2] == 2 and after[0][0] < 3.55
     assert after_old and after_old[0][1] == "right" and after_old[0][2] == 1 and after_old[0][0] > 3.58
     assert result_old.fell and not result.fell
+
+
+def test_the_swing_profiles_velocity_is_its_targets_rate_with_the_landing_held():
+    """RecoveryStep.target_vel_world, set by swing_target, is the time derivative of the target for the landing as
+    planned this tick: with the capture point on the stance sole the landing stays where it is, and the velocity is
+    the targets' central difference, rising, over the landing, coming down, and for a step that took over a swing
+    already in the air."""
+    stepper = RecoveryStepper(traced_motion(), CHAR_LEG_LENGTH_M, G)
+    com, vel = np.array([0.05, 0.1, 0.8]), np.zeros(3)  # over the left sole, at rest: the landing does not move
+    swing_s, h = stepper.cfg.recovery_swing_s, 1e-5
+    for taken_over in (False, True):
+        lift_off = ANKLES["right"] + (np.array([0.0, 0.0, 0.08]) if taken_over else 0.0)
+        stepper.step = RecoveryStep("right", 1.0, lift_off.copy(), lift_off.copy(), swing_s, taken_over=taken_over)
+        rates = []
+        for phase in (0.1, 0.3, 0.5, 0.7, 0.85, 0.95):
+            t = 1.0 + phase * swing_s
+            ahead = stepper.swing_target(t + h, com, vel, ANKLES["left"], IDENTITY, np.eye(3))
+            behind = stepper.swing_target(t - h, com, vel, ANKLES["left"], IDENTITY, np.eye(3))
+            stepper.swing_target(t, com, vel, ANKLES["left"], IDENTITY, np.eye(3))
+            rates.append(np.linalg.norm(stepper.step.target_vel_world))
+            assert np.allclose(stepper.step.target_vel_world, (ahead - behind) / (2 * h), atol=1e-4), phase
+        assert max(rates) > 0.5  # the foot moves (0.2 s to its landing beside the left foot)
+    with pytest.raises(ConfigError, match="recovery_foot_target_rate"):
+        WholeBodyConfig(recovery_foot_target_rate="finite")
+
+
+def test_a_recovery_foot_follows_its_swing_profiles_velocity_not_the_landings_replanning():
+    """The humanoid3d run, seed 14, as the suite runs it. Each tick a recovery step's landing is planned again on the
+    capture point, which the swing leg's own reaction moves; with the foot task's target velocity differenced from
+    tick to tick, those re-plannings alternated each tick once its landing was due (the target 0.05 m back and forth,
+    +-5 m/s), the task asked the leg for +-300 m/s² horizontally, the hip saturated, and the foot went up instead of
+    down: it stayed 5-17 cm above the ground for 0.4 s past its due landing, and the run fell at 4.48 s (measured: the
+    target velocity reversed at more than 2 m/s on 52 ticks). At the swing profile's own velocity, for the landing as
+    planned this tick, no tick reverses, and the run completes."""
+
+    def run(rate: str):
+        reversals = [0]
+        last: dict[str, np.ndarray | None] = {}
+
+        def watch(session):
+            feet = session.controller.recovery_feet
+
+            def tick(state, ref):
+                for side, task in feet.items():
+                    vel = task.target_vel_world[:2].copy() if task.active else None
+                    before = last.get(side)
+                    if vel is not None and before is not None and np.linalg.norm(vel) > 2.0 and vel @ before < 0:
+                        reversals[0] += 1
+                    last[side] = vel
+            return tick
+
+        control = ControlConfig(whole_body=WholeBodyConfig(recovery_foot_target_rate=rate))
+        result = suite_run("builtin:run", 14, MotionConfig(), control, watch=watch)
+        return reversals[0], result
+
+    (differenced, fell), (profile, completed) = run("differenced"), run("profile")
+    assert differenced > 20 and fell.fell and fell.fall_time_s < 5.0
+    assert profile == 0 and not completed.fell
 
 
 def test_the_swing_target_is_back_at_the_ground_by_the_touchdown_share():

@@ -476,6 +476,7 @@ class JacobianTransposeConfig:
 
 
 OWN_STEP_PUSH_BOUNDS = ("off", "he_stands", "always")  # WholeBodyConfig.own_step_push_bound
+RECOVERY_FOOT_TARGET_RATES = ("differenced", "profile")  # WholeBodyConfig.recovery_foot_target_rate
 
 
 @dataclass(frozen=True)
@@ -527,6 +528,12 @@ class WholeBodyConfig:
     # folding swing leg (docs/decisions.md, "A recovery step's landing that is due"). The weight of the press on a
     # stance foot that has not touched yet (whole_body.FOOT_TASK_WEIGHT) [-]
     recovery_foot_landing_weight: float = 1000.0
+    # The velocity the foot task's target is followed with (the task's kd term): "differenced", the target's change
+    # since the last control tick, or "profile", the swing profile's own (recovery_step.RecoveryStepper.swing_target,
+    # the landing held where it is this tick). The landing is re-planned each tick on the capture point, which the
+    # swing leg's own reaction moves: differenced, the re-planning's tick-to-tick jumps became target velocities of
+    # +-5 m/s that alternated each tick and drove the leg (docs/decisions.md, "A due landing's foot that goes up").
+    recovery_foot_target_rate: str = "differenced"
     # In a step of the character's own, on one sole, the ground's horizontal force along the capture point's
     # divergence from that sole is at most the pendulum's with the centre of pressure at the sole's rear edge along
     # it (control/own_step_push.py): the step's swing is not driven by pushing the body further the way it already
@@ -569,6 +576,9 @@ class WholeBodyConfig:
             _non_negative(f"WholeBodyConfig.{n}", getattr(self, n))
         if self.joint_speed_limit_rad_s is not None:
             _positive("WholeBodyConfig.joint_speed_limit_rad_s", self.joint_speed_limit_rad_s)
+        if self.recovery_foot_target_rate not in RECOVERY_FOOT_TARGET_RATES:
+            raise ConfigError(f"WholeBodyConfig.recovery_foot_target_rate must be one of "
+                              f"{', '.join(RECOVERY_FOOT_TARGET_RATES)}, got '{self.recovery_foot_target_rate}'")
         if self.own_step_push_bound not in OWN_STEP_PUSH_BOUNDS:
             raise ConfigError(f"WholeBodyConfig.own_step_push_bound must be one of {', '.join(OWN_STEP_PUSH_BOUNDS)}, "
                               f"got '{self.own_step_push_bound}'")

@@ -224,6 +224,8 @@ class WholeBodyController(ControllerBase):
                 self._recovery_target.pop(s, None)
                 continue
             self._move_target(task, self._recovery_target, s, target, np.zeros(3))  # at rest on the step's first tick
+            if wb.recovery_foot_target_rate == "profile" and ref.recovery_ankle_vel_world is not None:
+                task.target_vel_world = ref.recovery_ankle_vel_world[s]  # the swing profile's, not the re-planning's
             # A target below the ground: the landing is due and the foot has not touched (the step ends when it does)
             due = recovery_landing_due(target)
             task.weight = wb.recovery_foot_landing_weight if due else wb.recovery_foot_task_weight

@@ -1070,6 +1070,9 @@ class MotionOptimizer:
             ankle_world=tick.a_c, lipm=lipm, press_swing_foot=self.char_fsm.hold_reference, hand_world=hands,
             recovery_ankle_world=({tick.swing: tick.targets[tick.swing].copy()}
                                   if tick.swing is not None and self.char_fsm.recovery_step else None),
+            recovery_ankle_vel_world=({tick.swing: self.recovery.step.target_vel_world.copy()}
+                                      if tick.swing is not None and self.char_fsm.recovery_step
+                                      and self.recovery.step is not None else None),
             recovery_while_he_stands=self.char_fsm.recovery_step and self._operator_stands(tick),
         )
 

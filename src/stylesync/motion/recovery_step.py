@@ -33,7 +33,9 @@ own:
   landing, is back at the ground at ``recovery_touchdown_share`` of ``recovery_swing_s`` (it trails its target: so
   it touches down near the swing's end, when its landing is planned for) and is then lowered below the ground until
   it touches (the stance FSM ends the step on its contact); the whole-body controller tracks that target with a
-  task of its own (``ReferencePose.recovery_ankle_world``).
+  task of its own (``ReferencePose.recovery_ankle_world``), and with ``WholeBodyConfig.recovery_foot_target_rate``
+  "profile" at the profile's velocity for the landing as it is planned this tick
+  (``ReferencePose.recovery_ankle_vel_world``), not the landing's own motion from tick to tick.
 
 The step's timing is the nominal swing time (``recovery_swing_s``) as long as its capture landing stays within the
 leg's reach; otherwise it is shortened, each tick, to when that landing would leave the reach
@@ -48,7 +50,7 @@ is.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -268,6 +270,8 @@ class RecoveryStep:
     landing_world: np.ndarray  # (3,) the planned landing of the swing ankle, re-planned each tick
     duration_s: float  # the swing's time: the nominal one, shortened while the capture point runs out of reach
     taken_over: bool = False  # the step took over a swing already in the air (it only lands it)
+    # (3,) the target's velocity along the swing profile, the landing held where it is this tick [m/s]
+    target_vel_world: np.ndarray = field(default_factory=lambda: np.zeros(3))
 
 
 class RecoveryStepper:
@@ -460,16 +464,25 @@ class RecoveryStepper:
                                         stance_foot_quat_wxyz, heading_world, step.side, walk_on)
         step.landing_world = landing
         phase = elapsed / step.duration_s
-        moved = smooth_step(min(phase / HORIZONTAL_SHARE, 1.0))
+        along = phase / HORIZONTAL_SHARE
+        moved = smooth_step(min(along, 1.0))
+        # d(moved)/dt of the smooth step 3x² - 2x³, x = t / (HORIZONTAL_SHARE T) [1/s]
+        moved_rate = 6.0 * along * (1.0 - along) / (HORIZONTAL_SHARE * step.duration_s) if along < 1.0 else 0.0
         target = step.lift_off_world + moved * (landing - step.lift_off_world)
+        vel = moved_rate * (landing - step.lift_off_world)
         if phase < 1.0 and step.taken_over:
             # Already in the air: lowered from where it is to the ground by the time it is over the landing.
             target[2] = step.lift_off_world[2] + moved * (ANKLE_HEIGHT_M - step.lift_off_world[2])
+            vel[2] = moved_rate * (ANKLE_HEIGHT_M - step.lift_off_world[2])
         elif phase < cfg.recovery_touchdown_share:
             # Up and down again by the touchdown share of the swing: the foot trails its target, and reaches the
             # ground near the swing's end, when the landing is planned for.
             touchdown = phase / cfg.recovery_touchdown_share
             target[2] = ANKLE_HEIGHT_M + cfg.recovery_step_height_m * np.sin(np.pi * touchdown)
+            vel[2] = (cfg.recovery_step_height_m * np.pi * np.cos(np.pi * touchdown)
+                      / (cfg.recovery_touchdown_share * step.duration_s))
         else:
             target[2] = ANKLE_HEIGHT_M - LANDING_PRESS_M
+            vel[2] = 0.0
+        step.target_vel_world = vel
         return target

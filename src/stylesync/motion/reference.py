@@ -41,6 +41,8 @@ class ReferencePose:
     # The swing ankle's target during a step the character takes on its own (recovery_step.py); below the ground once
     # its landing is due [m]
     recovery_ankle_world: dict[str, np.ndarray] | None = None
+    # Its velocity along the step's swing profile, the landing held where it is this tick (recovery_step.py) [m/s]
+    recovery_ankle_vel_world: dict[str, np.ndarray] | None = None
     # That step is taken while the operator stands (his capture point within his soles): a step that is to stop the
     # body, not to go anywhere
     recovery_while_he_stands: bool = False
