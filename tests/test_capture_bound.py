@@ -4,9 +4,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import TRACED_BEFORE_LANDING_WEIGHT
+from conftest import TRACED_BEFORE_LANDING_WEIGHT, TRACED_DIFFERENCED
 
-from stylesync.config import ConfigError, ControlConfig, MotionConfig, OperatorConfig, SessionConfig
+from stylesync.config import ConfigError, MotionConfig, OperatorConfig, SessionConfig
 from stylesync.model.character import ANKLE_HEIGHT_M
 from stylesync.model.sole import (
     convex_hull_points,
@@ -203,8 +203,8 @@ def test_a_long_single_stance_keeps_the_capture_point_where_the_landing_catches_
 
     spec = f"deepmimic:{ZOMBIE}"
     then = {"recovery_overdue_swing_horizon": False, "recovery_swing_min_s": None}
-    off = suite_run(spec, 0, MotionConfig(**then), ControlConfig())
-    sideways = suite_run(spec, 0, MotionConfig(landing_capture_bound="sideways", **then), ControlConfig())
+    off = suite_run(spec, 0, MotionConfig(**then), TRACED_DIFFERENCED)
+    sideways = suite_run(spec, 0, MotionConfig(landing_capture_bound="sideways", **then), TRACED_DIFFERENCED)
     assert off.fell and off.fall_time_s < 6.0
     assert not sideways.fell
 

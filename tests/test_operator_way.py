@@ -53,17 +53,17 @@ def test_the_zombie_walk_goes_his_way_when_its_own_steps_walk_on_only_along_it()
     it goes 0.37 of his way (measured), with no fall either way."""
     import logging
 
-    from conftest import suite_run
+    from conftest import TRACED_DIFFERENCED, suite_run
 
-    from stylesync.config import ControlConfig, MotionConfig
+    from stylesync.config import MotionConfig
     from stylesync.metrics.summary import summarize
 
     logging.disable(logging.WARNING)
     try:
         spec = f"deepmimic:{ZOMBIE}"
-        own = summarize(suite_run(spec, 0, MotionConfig(**PATH_OPT_INS), ControlConfig()))
+        own = summarize(suite_run(spec, 0, MotionConfig(**PATH_OPT_INS), TRACED_DIFFERENCED))
         his = summarize(suite_run(spec, 0, MotionConfig(**PATH_OPT_INS, recovery_walk_on_his_way=True,
-                                                        gait_min_way_speed_mps=0.3), ControlConfig()))
+                                                        gait_min_way_speed_mps=0.3), TRACED_DIFFERENCED))
     finally:
         logging.disable(logging.NOTSET)
     assert not own["fell"] and not his["fell"]

@@ -97,7 +97,8 @@ def test_a_chain_of_own_steps_in_the_rest_is_not_pushed_on(push_bound):
     own steps push its COM from 1.1 to 3 m/s (horizontally) and it falls 1.4 s into the rest. With the bound in the
     steps taken while he stands (the default), it comes to rest."""
     speeds = []
-    control = ControlConfig(whole_body=WholeBodyConfig(own_step_push_bound=push_bound))
+    control = ControlConfig(whole_body=WholeBodyConfig(own_step_push_bound=push_bound,
+                                                       recovery_foot_target_rate="differenced"))
 
     def watch(session):
         return lambda state, ref: speeds.append(float(np.hypot(*session.mass.com_velocity(state)[:2])))

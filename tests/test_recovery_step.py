@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import TRACED_BEFORE_LANDING_WEIGHT, suite_run
+from conftest import TRACED_BEFORE_LANDING_WEIGHT, TRACED_DIFFERENCED, suite_run
 
 from stylesync import rotations as rot
 from stylesync.config import ControlConfig, MotionConfig, OperatorConfig, SessionConfig, WholeBodyConfig
@@ -317,7 +317,7 @@ def _run(spec: str, seconds: float, motion: MotionConfig, seed: int = 0, control
 
     opened = open_source(spec, seed=seed, duration_s=seconds)
     cfg = SessionConfig(duration_s=seconds, seed=seed, operator=OperatorConfig(), motion=motion,
-                        control=control or ControlConfig(),
+                        control=control or TRACED_DIFFERENCED,
                         clocks=dataclasses.replace(SessionConfig().clocks, mocap_hz=opened.mocap_hz))
     session = Session(cfg, opened.source)
     result = session.run()
@@ -376,12 +376,12 @@ def test_a_run_that_stops_comes_to_rest_on_steps_that_land_before_the_capture_po
 
     monkeypatch.setattr(RecoveryStepper, "end", recorded)
     spec = f"bvh:{MOCAP / 'cmu-dev' / '02_03.bvh'}"
-    timed = suite_run(spec, 0, MotionConfig(), ControlConfig())
+    timed = suite_run(spec, 0, MotionConfig(), TRACED_DIFFERENCED)
     assert not timed.fell
     assert any(d < MotionConfig().recovery_swing_s - 1e-9 for d in durations)
     assert all(d >= MotionConfig().recovery_swing_min_s - 1e-9 for d in durations)
     durations.clear()
-    nominal = suite_run(spec, 0, MotionConfig(recovery_swing_min_s=None), ControlConfig())
+    nominal = suite_run(spec, 0, MotionConfig(recovery_swing_min_s=None), TRACED_DIFFERENCED)
     assert nominal.fell and nominal.fall_time_s is not None and nominal.fall_time_s > 1.41
     assert all(d == MotionConfig().recovery_swing_s for d in durations)
 
@@ -1086,7 +1086,8 @@ def test_a_swing_past_its_usual_time_is_landed_before_the_capture_point_runs_out
         # traced before the joints' no-load speed (with it, the late swing's run also comes to rest), before Eq.
         # 10's fraction from the rear foot to the front one after the character's own step (with it, too) and before
         # a recovery step's timing adapted to its reach (with it, too)
-        control = ControlConfig(whole_body=WholeBodyConfig(joint_speed_limit_rad_s=None))
+        control = ControlConfig(whole_body=WholeBodyConfig(joint_speed_limit_rad_s=None,
+                                                           recovery_foot_target_rate="differenced"))
         motion = MotionConfig(recovery_overdue_swing_horizon=flag, fraction_needs_feet_in_his_order=False,
                               recovery_swing_min_s=None)
         return taken, suite_run(spec, 7, motion, control, watch=watch)
@@ -1364,6 +1365,7 @@ def test_a_recovery_step_whose_landing_is_due_is_pressed_onto_the_ground():
                                                  fraction_needs_feet_in_his_order=False, recovery_swing_min_s=None,
                                                  liftoff_needs_other_foot_down=False),
                            ControlConfig(whole_body=WholeBodyConfig(recovery_foot_landing_weight=landing_weight,
+                                                                        recovery_foot_target_rate="differenced",
                                                                     joint_speed_limit_rad_s=None,
                                                                     own_step_push_bound="off")),
                            on_tick=on_tick)

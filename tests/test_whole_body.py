@@ -161,7 +161,8 @@ def test_a_qp_with_no_feasible_point_does_not_throw_the_limbs():
             return None
 
         control = ControlConfig(whole_body=WholeBodyConfig(relax_limits_when_infeasible=relax,
-                                                           joint_speed_limit_rad_s=None))
+                                                           joint_speed_limit_rad_s=None,
+                                                           recovery_foot_target_rate="differenced"))
         # traced before the joints' no-load speed, the crossover steps, the earlier touchdown of a recovery step's
         # foot and the swing aimed at the operator's last landing
         motion = MotionConfig(recovery_cross_clear_m=None, recovery_touchdown_share=1.0, recovery_landing_gap_m=None,
@@ -264,7 +265,8 @@ def test_a_light_link_does_not_spin_up_within_a_control_tick():
     by side after a step of the character's own (MotionConfig.fraction_needs_feet_in_his_order off) and every
     recovery step's nominal time (MotionConfig.recovery_swing_min_s None)."""
     def run(limit):
-        control = ControlConfig(whole_body=WholeBodyConfig(joint_speed_limit_rad_s=limit, own_step_push_bound="off"))
+        control = ControlConfig(whole_body=WholeBodyConfig(joint_speed_limit_rad_s=limit, own_step_push_bound="off",
+                                                            recovery_foot_target_rate="differenced"))
         motion = MotionConfig(fraction_needs_feet_in_his_order=False, recovery_swing_min_s=None)
         return suite_run("builtin:dance_a", 2, motion, control)
 

@@ -528,12 +528,13 @@ class WholeBodyConfig:
     # folding swing leg (docs/decisions.md, "A recovery step's landing that is due"). The weight of the press on a
     # stance foot that has not touched yet (whole_body.FOOT_TASK_WEIGHT) [-]
     recovery_foot_landing_weight: float = 1000.0
-    # The velocity the foot task's target is followed with (the task's kd term): "differenced", the target's change
-    # since the last control tick, or "profile", the swing profile's own (recovery_step.RecoveryStepper.swing_target,
-    # the landing held where it is this tick). The landing is re-planned each tick on the capture point, which the
-    # swing leg's own reaction moves: differenced, the re-planning's tick-to-tick jumps became target velocities of
-    # +-5 m/s that alternated each tick and drove the leg (docs/decisions.md, "A due landing's foot that goes up").
-    recovery_foot_target_rate: str = "differenced"
+    # The velocity the foot task's target is followed with (the task's kd term): "profile", the swing profile's own
+    # (recovery_step.RecoveryStepper.swing_target, the landing held where it is this tick), or "differenced", the
+    # target's change since the last control tick. The landing is re-planned each tick on the capture point, which the
+    # swing leg's own reaction moves: differenced, the re-plannings alternated each tick, became target velocities of
+    # +-5 m/s and drove the leg, whose foot went up instead of landing (docs/decisions.md, "A due landing's foot that
+    # goes up").
+    recovery_foot_target_rate: str = "profile"
     # In a step of the character's own, on one sole, the ground's horizontal force along the capture point's
     # divergence from that sole is at most the pendulum's with the centre of pressure at the sole's rear edge along
     # it (control/own_step_push.py): the step's swing is not driven by pushing the body further the way it already

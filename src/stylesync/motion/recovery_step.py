@@ -33,9 +33,9 @@ own:
   landing, is back at the ground at ``recovery_touchdown_share`` of ``recovery_swing_s`` (it trails its target: so
   it touches down near the swing's end, when its landing is planned for) and is then lowered below the ground until
   it touches (the stance FSM ends the step on its contact); the whole-body controller tracks that target with a
-  task of its own (``ReferencePose.recovery_ankle_world``), and with ``WholeBodyConfig.recovery_foot_target_rate``
-  "profile" at the profile's velocity for the landing as it is planned this tick
-  (``ReferencePose.recovery_ankle_vel_world``), not the landing's own motion from tick to tick.
+  task of its own (``ReferencePose.recovery_ankle_world``), at the profile's velocity for the landing as it is
+  planned this tick (``ReferencePose.recovery_ankle_vel_world``; ``WholeBodyConfig.recovery_foot_target_rate``), not
+  the landing's own motion from tick to tick.
 
 The step's timing is the nominal swing time (``recovery_swing_s``) as long as its capture landing stays within the
 leg's reach; otherwise it is shortened, each tick, to when that landing would leave the reach
