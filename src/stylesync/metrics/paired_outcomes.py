@@ -4,7 +4,7 @@ McNemar test).
 A run of the development suite is a clip with a sensor seed, and every version runs the same runs. Two versions'
 completion counts differ by ``gained - lost``: ``gained`` the runs the other version completes and the first does
 not, ``lost`` the other way round (the discordant runs). A fall of the character is sensitive to small differences:
-a change of no physical meaning (a task weight changed in its sixth digit) moves some runs from falling to
+a change of no physical meaning (a task weight changed in its seventh digit) moves some runs from falling to
 completing and others the other way (docs/decisions.md, "How far apart two versions' counts are by chance"). So a
 difference of the counts is read against the discordant runs. If the change does not alter a run's chance of
 completing, each discordant run goes either way with probability 1/2; the two-sided p-value of the difference is
@@ -39,7 +39,7 @@ def mcnemar_exact_p(gained: int, lost: int) -> float:
 class PairedOutcome:
     """Two versions' outcomes over the runs both could run (a clip and a seed each) [runs]."""
 
-    runs: int  # runs of both versions (neither could not open its clip)
+    runs: int  # runs both versions ran (each opened its clip)
     both_complete: int
     gained: int  # the second version completes, the first falls
     lost: int  # the first completes, the second falls
