@@ -26,7 +26,7 @@ def _rows(path: str) -> list[dict]:
     rows = json.loads(Path(path).read_text())
     if isinstance(rows, dict):
         rows = rows.get("rows", [])
-    if not isinstance(rows, list) or not all(isinstance(r, dict) and {"category", "seed", "fell"} <= r.keys()
+    if not isinstance(rows, list) or not all(isinstance(r, dict) and {"category", "clip", "seed", "fell"} <= r.keys()
                                              for r in rows if "error" not in r):
         raise SystemExit(f"{path}: not a development suite's dev_suite.json (a list of runs)")
     return rows
