@@ -1064,15 +1064,14 @@ class MotionOptimizer:
             com_d, com_vel_d = self._landing_bounded_com_target(tick, state, com_d, com_vel_d)
         self.reading = MotionReading(tick.op_state, tick.analysis.features, self.char_fsm.hold_reference, tick.scale,
                                      tick.step_exceeded)
+        own = tick.swing if self.char_fsm.recovery_step else None  # the swing side of a step of the character's own
+        step = self.recovery.step
         return ReferencePose(
             time_s=state.time_s, joint_pos=joint_pos, root_quat_wxyz=tick.q_root_d, pelvis_world=tick.pelvis_d,
             com_world=com_d, com_vel_world=com_vel_d, character_stance=tick.ch_state, stance_weight=tick.weights,
             ankle_world=tick.a_c, lipm=lipm, press_swing_foot=self.char_fsm.hold_reference, hand_world=hands,
-            recovery_ankle_world=({tick.swing: tick.targets[tick.swing].copy()}
-                                  if tick.swing is not None and self.char_fsm.recovery_step else None),
-            recovery_ankle_vel_world=({tick.swing: self.recovery.step.target_vel_world.copy()}
-                                      if tick.swing is not None and self.char_fsm.recovery_step
-                                      and self.recovery.step is not None else None),
+            recovery_ankle_world=None if own is None else {own: tick.targets[own].copy()},
+            recovery_ankle_vel_world=None if own is None or step is None else {own: step.target_vel_world},
             recovery_while_he_stands=self.char_fsm.recovery_step and self._operator_stands(tick),
         )
 

@@ -270,7 +270,8 @@ class RecoveryStep:
     landing_world: np.ndarray  # (3,) the planned landing of the swing ankle, re-planned each tick
     duration_s: float  # the swing's time: the nominal one, shortened while the capture point runs out of reach
     taken_over: bool = False  # the step took over a swing already in the air (it only lands it)
-    # (3,) the target's velocity along the swing profile, the landing held where it is this tick [m/s]
+    # (3,) the target's velocity along the swing profile, the landing held where it is this tick (a new array each
+    # tick: the reference pose passes it on as it is) [m/s]
     target_vel_world: np.ndarray = field(default_factory=lambda: np.zeros(3))
 
 
