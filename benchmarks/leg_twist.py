@@ -13,17 +13,11 @@ its fall: the 95th percentile and the largest of its magnitude [deg], left hip, 
 
 from __future__ import annotations
 
-import argparse
-import logging
-
 import numpy as np
-from trace_run import resolve
+from trace_run import run_suite_clip, runs_main
 
 from stylesync import rotations as rot
-from stylesync.metrics.dev_suite import suite_config
 from stylesync.model.character import JOINT_NAMES
-from stylesync.session import Session
-from stylesync.sources.registry import open_source
 
 TWISTING = ("left_hip", "right_hip", "left_ankle", "right_ankle")
 SEGMENT_AXIS = np.array([0.0, 1.0, 0.0])  # a leg segment's long axis in its model frame (the model is Y-up)
@@ -39,21 +33,13 @@ def _fmt(x: np.ndarray) -> str:
 
 def twist_figures(clip: str, seed: int, duration_s: float) -> str:
     """One line of figures for a run of ``clip`` with sensor seed ``seed``."""
-    spec = resolve(clip)
-    opened = open_source(spec, seed=seed, duration_s=duration_s)
-    cfg, _ = suite_config(spec, opened, seed, duration_s)
-    session = Session(cfg, opened.source)
     joints = [JOINT_NAMES.index(name) for name in TWISTING]
     rows: list[list[float]] = []  # per control tick: time [s], the joints' twists, the reference's [deg]
 
     def on_tick(state, ref) -> None:
         rows.append([state.time_s, *_twists_deg(state.joint_pos, joints), *_twists_deg(ref.joint_pos, joints)])
 
-    session.on_tick = on_tick
-    try:
-        result = session.run()
-    finally:
-        opened.source.close()
+    result, _ = run_suite_clip(clip, seed, duration_s, lambda session: on_tick)
     a = np.abs(np.array(rows))
     if result.fell and result.fall_time_s is not None:
         a = a[a[:, 0] <= result.fall_time_s]
@@ -63,14 +49,7 @@ def twist_figures(clip: str, seed: int, duration_s: float) -> str:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("runs", nargs="+", help="CLIP:SEED, e.g. spin:0")
-    ap.add_argument("--duration", type=float, default=12.0, help="the run's length [s]")
-    args = ap.parse_args()
-    logging.disable(logging.WARNING)
-    for run in args.runs:
-        clip, _, seed = run.rpartition(":")
-        print(twist_figures(clip, int(seed), args.duration), flush=True)
+    runs_main(__doc__, lambda clip, seed, args: twist_figures(clip, seed, args.duration), "spin:0")
 
 
 if __name__ == "__main__":

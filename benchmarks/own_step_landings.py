@@ -17,45 +17,36 @@ seconds before a fall, or over the whole run when it completes:
 from __future__ import annotations
 
 import argparse
-import logging
 
 import numpy as np
-from trace_run import resolve
+from trace_run import run_suite_clip, runs_main
 
 from stylesync.control.controller import TORQUE_LIMIT
 from stylesync.control.whole_body import recovery_landing_due
-from stylesync.metrics.dev_suite import suite_config
 from stylesync.model.character import ANKLE_HEIGHT_M, JOINT_NAMES, LINK_NAMES
 from stylesync.session import Session
-from stylesync.sources.registry import open_source
 
 DUE_UP_M = ANKLE_HEIGHT_M + 0.03  # an ankle this high is 3 cm off the ground [m]
 
 
 def landings(clip: str, seed: int, duration_s: float, window_s: float) -> str:
     """One line of figures for a run of ``clip`` with sensor seed ``seed``."""
-    spec = resolve(clip)
-    opened = open_source(spec, seed=seed, duration_s=duration_s)
-    cfg, _ = suite_config(spec, opened, seed, duration_s)
-    session = Session(cfg, opened.source)
     ankle = {s: LINK_NAMES.index(f"{s}_ankle") for s in ("left", "right")}
     hip = {s: JOINT_NAMES.index(f"{s}_hip") for s in ("left", "right")}
     ticks: list[tuple[float, float, bool, bool]] = []  # time [s], ankle height [m], due, hip at its limit
 
-    def on_tick(state, ref) -> None:
-        tau = session.controller.torques(None).values
-        for side, target in (ref.recovery_ankle_world or {}).items():
-            k = hip[side]
-            ticks.append((state.time_s, float(state.link_origin_world[ankle[side]][2]),
-                          recovery_landing_due(target),
-                          bool(np.any(np.abs(tau[k]) >= 0.999 * TORQUE_LIMIT[k, 0]))))
+    def on_tick_for(session: Session):
+        def on_tick(state, ref) -> None:
+            tau = session.controller.torques(None).values
+            for side, target in (ref.recovery_ankle_world or {}).items():
+                k = hip[side]
+                ticks.append((state.time_s, float(state.link_origin_world[ankle[side]][2]),
+                              recovery_landing_due(target),
+                              bool(np.any(np.abs(tau[k]) >= 0.999 * TORQUE_LIMIT[k, 0]))))
+        return on_tick
 
-    session.on_tick = on_tick
-    try:
-        result = session.run()
-    finally:
-        opened.source.close()
-    end_s = result.fall_time_s if result.fell and result.fall_time_s is not None else cfg.duration_s
+    result, planned_s = run_suite_clip(clip, seed, duration_s, on_tick_for)
+    end_s = result.fall_time_s if result.fell and result.fall_time_s is not None else planned_s
     seen = [t for t in ticks if t[0] >= end_s - window_s] if result.fell else ticks
     head = f"{clip} seed {seed}: " + (f"fell at {end_s:.2f} s, last {window_s:.1f} s" if result.fell
                                      else f"completed {end_s:.1f} s, whole run")
@@ -65,16 +56,13 @@ def landings(clip: str, seed: int, duration_s: float, window_s: float) -> str:
             f"due, up {sum(1 for t in seen if t[2] and t[1] > DUE_UP_M)}, hip limit {sum(1 for t in seen if t[3])}")
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("runs", nargs="+", help="CLIP:SEED, e.g. run:14")
+def _window_argument(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--window", type=float, default=1.5, help="seconds before a fall looked at [s]")
-    ap.add_argument("--duration", type=float, default=12.0, help="the run's length [s]")
-    args = ap.parse_args()
-    logging.disable(logging.WARNING)
-    for run in args.runs:
-        clip, _, seed = run.rpartition(":")
-        print(landings(clip, int(seed), args.duration, args.window), flush=True)
+
+
+def main() -> None:
+    runs_main(__doc__, lambda clip, seed, args: landings(clip, seed, args.duration, args.window), "run:14",
+              _window_argument)
 
 
 if __name__ == "__main__":

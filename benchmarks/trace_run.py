@@ -30,6 +30,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import logging
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -40,7 +41,7 @@ from stylesync.metrics.dev_suite import clip_specs, suite_config
 from stylesync.model.character import LINK_NAMES
 from stylesync.model.sole import convex_hull_xy, outside_distance_m, sole_corners_world
 from stylesync.motion.recovery_step import capture_point, soles_on_ground
-from stylesync.session import Session
+from stylesync.session import Session, SessionResult
 from stylesync.sources.registry import open_source
 
 MOCAP = Path(__file__).resolve().parents[2] / "shared" / "mocap"
@@ -55,6 +56,35 @@ def resolve(clip: str) -> str:
     if clip not in specs:
         raise SystemExit(f"no clip '{clip}' in the development suite; clips: {', '.join(sorted(specs))}")
     return specs[clip]
+
+
+def run_suite_clip(clip: str, seed: int, duration_s: float,
+                   on_tick_for: Callable[[Session], Callable]) -> tuple[SessionResult, float]:
+    """Run ``clip`` with sensor seed ``seed`` as the development suite runs it, ``on_tick_for(session)`` called on
+    each control tick; the result and the run's planned duration [s]."""
+    spec = resolve(clip)
+    opened = open_source(spec, seed=seed, duration_s=duration_s)
+    cfg, _ = suite_config(spec, opened, seed, duration_s)
+    session = Session(cfg, opened.source)
+    session.on_tick = on_tick_for(session)
+    try:
+        return session.run(), cfg.duration_s
+    finally:
+        opened.source.close()
+
+
+def runs_main(doc: str, figures: Callable[[str, int, argparse.Namespace], str], example: str,
+              add_arguments: Callable[[argparse.ArgumentParser], None] = lambda ap: None) -> None:
+    """The command line of a script that prints one line of ``figures(clip, seed, args)`` per CLIP:SEED run."""
+    ap = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("runs", nargs="+", help=f"CLIP:SEED, e.g. {example}")
+    add_arguments(ap)
+    ap.add_argument("--duration", type=float, default=12.0, help="the run's length [s]")
+    args = ap.parse_args()
+    logging.disable(logging.WARNING)
+    for run in args.runs:
+        clip, _, seed = run.rpartition(":")
+        print(figures(clip, int(seed), args), flush=True)
 
 
 def main() -> None:
