@@ -144,3 +144,57 @@ def test_a_looping_clip_costs_work_in_its_cycles_not_their_square(monkeypatch):
         real(n * clip.cycle_yaw)) @ (clip.root_pos[0] - start)
     assert np.allclose(pose.root_pos_world, expected, atol=1e-9)
     assert np.linalg.norm(poses[-1].root_pos_world - poses[0].root_pos_world) > 0.5
+
+
+def _straight_walker(speed_mps: float):
+    """A pose function: the pelvis at 0.9 m going along +x at ``speed_mps``, the left ankle 0.1 m to its left and
+    0.2 m ahead, every segment facing +x."""
+    from stylesync import rotations as rot
+    from stylesync.sources.frame import JOINT_INDEX, N_JOINTS, OperatorFrame
+
+    def pose_at(t_s: float) -> OperatorFrame:
+        pos = np.zeros((N_JOINTS, 3))
+        pos[:] = [speed_mps * t_s, 0.0, 0.9]
+        pos[JOINT_INDEX["ANKLE_LEFT"]] = [speed_mps * t_s + 0.2, 0.1, 0.05]
+        quats = np.tile(rot.IDENTITY_WXYZ, (N_JOINTS, 1))
+        return OperatorFrame(t_s, pos, quats, np.ones(N_JOINTS), com_world=pos[JOINT_INDEX["PELVIS"]].copy())
+    return pose_at
+
+
+def test_turning_path_bends_a_straight_walk_into_a_circle_at_its_own_speed():
+    from stylesync import rotations as rot
+    from stylesync.sources.frame import JOINT_INDEX
+    from stylesync.sources.turning_path import TurningPath
+
+    speed, rate, start = 1.0, 0.5, 1.0
+    straight = _straight_walker(speed)
+    bent = TurningPath(straight, rate, start_s=start, end_s=start + 2 * np.pi / rate + 0.5)
+    assert bent(0.5) is not None and np.array_equal(bent(0.5).joint_pos_world, straight(0.5).joint_pos_world)
+    pelvis, ankle = JOINT_INDEX["PELVIS"], JOINT_INDEX["ANKLE_LEFT"]
+    for t in (2.0, 4.5, 9.0):
+        f, g = bent(t), bent(t + 0.01)
+        step = g.joint_pos_world[pelvis, :2] - f.joint_pos_world[pelvis, :2]
+        theta = rate * (t - start)
+        # his speed over the ground as recorded, his way turned by the heading
+        assert np.linalg.norm(step) / 0.01 == pytest.approx(speed, rel=1e-3)
+        assert np.degrees(np.arctan2(step[1], step[0])) == pytest.approx(
+            np.degrees((theta + np.pi) % (2 * np.pi) - np.pi), abs=0.5)
+        # the body turned about the vertical with him: the ankle's offset and every segment's orientation
+        offset = f.joint_pos_world[ankle] - f.joint_pos_world[pelvis]
+        assert offset == pytest.approx([0.2 * np.cos(theta) - 0.1 * np.sin(theta),
+                                        0.2 * np.sin(theta) + 0.1 * np.cos(theta), 0.05 - 0.9], abs=1e-9)
+        assert f.quat("PELVIS") == pytest.approx(rot.quat_from_yaw(theta), abs=1e-9)
+        assert f.com_world == pytest.approx(f.joint_pos_world[pelvis], abs=1e-9)
+    # a full turn closes a circle of radius speed / rate
+    a, b = bent(start).joint_pos_world[pelvis], bent(start + 2 * np.pi / rate).joint_pos_world[pelvis]
+    assert np.linalg.norm(b[:2] - a[:2]) < 0.02
+    half = bent(start + np.pi / rate).joint_pos_world[pelvis]
+    assert np.linalg.norm(half[:2] - a[:2]) == pytest.approx(2 * speed / rate, rel=0.01)
+
+
+def test_a_turn_rate_that_is_not_finite_is_refused():
+    from stylesync.config import OperatorConfig
+    from stylesync.errors import ConfigError
+
+    with pytest.raises(ConfigError, match="turn_rate_rad_s"):
+        OperatorConfig(turn_rate_rad_s=float("nan"))

@@ -163,12 +163,14 @@ def _replay_viewer(args: argparse.Namespace, session) -> None:
 def _demo(args: argparse.Namespace) -> int:
     from stylesync.sources.builtin_operator import builtin_operator
 
+    operator = OperatorConfig(clip=args.clip, turn_rate_rad_s=args.turn_rate)
     cfg = SessionConfig(duration_s=args.duration, seed=args.seed, gui=args.gui,
-                        realtime=args.realtime or args.viewer != "none", operator=OperatorConfig(clip=args.clip),
+                        realtime=args.realtime or args.viewer != "none", operator=operator,
                         control=ControlConfig(lipm_time_sync=not args.no_lipm))
     cfg = _motion_options(cfg, args)
     source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
-    return _run_session(cfg, source, Path(args.out), {"clip": args.clip, "lipm_time_sync": not args.no_lipm,
+    return _run_session(cfg, source, Path(args.out), {"clip": args.clip, "turn_rate_rad_s": args.turn_rate,
+                                                      "lipm_time_sync": not args.no_lipm,
                                                       "follow_path": args.follow_path,
                                                       "free_swing": args.free_swing}, args)
 
@@ -416,6 +418,8 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument("--clip", default="walk", help="pybullet_data humanoid3d clip, or 'stand'")
     demo.add_argument("--duration", type=typed.duration_s, default=12.0, help="simulated seconds")
     demo.add_argument("--seed", type=typed.seed, default=0)
+    demo.add_argument("--turn-rate", type=typed.turn_rate_rad_s, default=0.0,
+                      help="the clip's path bent into a turn at this rate after the lead-in [rad/s] (+: to the left)")
     _add_session_args(demo, "out/demo", "pace to the wall clock")
     demo.set_defaults(func=_demo)
     run = sub.add_parser("run", help="drive the character from an operator source")

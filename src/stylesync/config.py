@@ -7,6 +7,7 @@ the paper, the comment says how and why (see also docs/decisions.md).
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -621,6 +622,9 @@ class OperatorConfig:
     start_ramp_s: float = 1.5  # a looping clip's strides grow from standing to full over this time [s]
     # The clip played this many times faster after the lead-in (the operator walks faster: cadence and speed) [-]
     playback_speed: float = 1.0
+    # The clip's path bent into a turn at this rate after the lead-in (+: counter-clockwise seen from above;
+    # sources/turning_path.py): the built-in walks go straight, people turn. 0: as recorded [rad/s]
+    turn_rate_rad_s: float = 0.0
     # A recorded file (BVH, k4a JSON) starts the character in its first frame's pose (motion/initial_state.py)
     # instead of the standing lead-in, and the operator holds the last frame for
     # rest_after_clip_s while the character comes to rest (part of the run).
@@ -649,6 +653,8 @@ class OperatorConfig:
         _non_negative("OperatorConfig.standing_lead_in_s", self.standing_lead_in_s)
         _non_negative("OperatorConfig.start_ramp_s", self.start_ramp_s)
         _positive("OperatorConfig.playback_speed", self.playback_speed)
+        if not math.isfinite(self.turn_rate_rad_s):
+            raise ConfigError(f"OperatorConfig.turn_rate_rad_s must be finite, got {self.turn_rate_rad_s}")
         _non_negative("OperatorConfig.rest_after_clip_s", self.rest_after_clip_s)
 
 

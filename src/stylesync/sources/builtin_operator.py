@@ -5,7 +5,8 @@ The clip (pybullet_data ``humanoid3d_<name>.txt``, from DeepMimic's motion captu
 :class:`HumanModel` gives the operator its own size and mass distribution (Table 2 human column), its pelvis
 path is scaled by the ratio of its leg length to the clip character's so that its feet do not slide, and the
 :class:`SensorModel` samples it at 16 Hz with noise and jitter from a fixed seed. The operator first stands for
-``standing_lead_in_s`` in the clip's first pose.
+``standing_lead_in_s`` in the clip's first pose. With ``turn_rate_rad_s`` his path is bent into a turn after the
+lead-in (turning_path.py).
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from stylesync.sources.deepmimic_clip import CLIP_CHARACTER_LEG_LENGTH_M, DeepMi
 from stylesync.sources.frame import OperatorFrame
 from stylesync.sources.human_model import HumanModel
 from stylesync.sources.sensor_model import SensorModel
+from stylesync.sources.turning_path import TurningPath
 
 STAND_CLIP = "stand"  # an operator standing still, for balance checks
 _RAMP_GRID_HZ = 240.0  # grid of the ramped pelvis path's integral
@@ -104,5 +106,8 @@ def builtin_operator(
     human = HumanModel(operator.height_m, operator.mass_kg)
     performer = ClipPerformer(clip, human, operator.standing_lead_in_s, start_ramp_s=operator.start_ramp_s,
                               speed=operator.playback_speed)
-    return sensed(performer.frame_at, operator, clocks, duration_s, seed, f"builtin:{operator.clip}"), performer
+    pose_at: Callable[[float], OperatorFrame] = performer.frame_at
+    if operator.turn_rate_rad_s != 0.0:
+        pose_at = TurningPath(pose_at, operator.turn_rate_rad_s, operator.standing_lead_in_s, duration_s)
+    return sensed(pose_at, operator, clocks, duration_s, seed, f"builtin:{operator.clip}"), performer
 
