@@ -323,7 +323,7 @@ def test_the_feet_land_and_stay_along_the_body_not_turned_on_their_ankles():
 def test_the_walk_turns_with_an_operator_who_walks_a_circle():
     # The built-in walk bent into a turn at 0.6 rad/s after the lead-in (a circle of about 1.7 m radius; 0.6 * 7 s
     # is 240 degrees). Measured (benchmarks/turning_walk.py, seeds 0-1, 12 s, up to 1.0 rad/s): no fall, every
-    # step, the character's facing within 18 degrees of his; a character that did not turn would be 240 off.
+    # step, the character's facing within 17 degrees of his; a character that did not turn would be 240 off.
     from stylesync.metrics.imitation import OPERATOR_JOINTS
     from stylesync.metrics.summary import summarize
 
