@@ -328,7 +328,6 @@ def test_the_walk_turns_with_an_operator_who_walks_a_circle():
     # percentile, 45 at most.
     from stylesync.metrics.imitation import OPERATOR_JOINTS
     from stylesync.metrics.summary import summarize
-
     from stylesync.model.character import LINK_NAMES
 
     cfg = SessionConfig(duration_s=8.0, seed=0, operator=OperatorConfig(turn_rate_rad_s=0.6))
