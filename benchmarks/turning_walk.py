@@ -18,18 +18,10 @@ import logging
 import numpy as np
 
 from stylesync.config import OperatorConfig, SessionConfig
-from stylesync.metrics.imitation import OPERATOR_JOINTS
+from stylesync.metrics.imitation import facing_error_deg
 from stylesync.metrics.summary import summarize
 from stylesync.session import Session
 from stylesync.sources.builtin_operator import builtin_operator
-
-_LEFT_HIP, _RIGHT_HIP = OPERATOR_JOINTS.index("HIP_LEFT"), OPERATOR_JOINTS.index("HIP_RIGHT")
-
-
-def hip_heading_deg(joints: np.ndarray) -> np.ndarray:
-    """(n,) the heading [deg] of each (n, k, 3) row's hip line turned a quarter to the left (the facing)."""
-    d = joints[:, _LEFT_HIP] - joints[:, _RIGHT_HIP]
-    return np.degrees(np.arctan2(d[:, 1], d[:, 0])) - 90.0
 
 
 def main() -> None:
@@ -49,8 +41,7 @@ def main() -> None:
             m = summarize(result)
             cols = result.log.columns
             t = np.asarray(cols["t"])
-            err = (hip_heading_deg(np.asarray(cols["ch_joints"])) - hip_heading_deg(np.asarray(cols["op_joints"]))
-                   + 180.0) % 360.0 - 180.0
+            err = facing_error_deg(np.asarray(cols["ch_joints"]), np.asarray(cols["op_joints"]))
             after = np.abs(err[t >= op.standing_lead_in_s])
             turn_deg = np.degrees(rate * max(float(t[-1]) - op.standing_lead_in_s, 0.0))
             uhc = m.get("uhc_fall_time_s")

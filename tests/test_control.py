@@ -286,10 +286,10 @@ def test_the_built_in_walk_exceeds_no_movement_bound_and_logs_no_warning(caplog)
     assert not [r for r in caplog.records if r.levelno >= logging.WARNING]
 
 
-def _planted_foot_yaw_off_deg(motion: MotionConfig, seconds: float) -> np.ndarray:
-    """Over a built-in walk (seed 0): each pressing foot's yaw from the pelvis's, per control tick [deg]."""
+def _record_feet_yaw_off_pelvis_deg(session: Session, pressing_only: bool) -> list[float]:
+    """The list that ``session``'s control ticks fill with each foot's yaw from the pelvis's [deg] (with
+    ``pressing_only``, the feet that press the ground)."""
     from stylesync.model.character import LINK_NAMES, Q_WORLD_MODEL
-    from stylesync.sources.registry import open_source
 
     up = np.array([0.0, 0.0, 1.0])
     ankle = {s: LINK_NAMES.index(f"{s}_ankle") for s in ("left", "right")}
@@ -298,13 +298,21 @@ def _planted_foot_yaw_off_deg(motion: MotionConfig, seconds: float) -> np.ndarra
     def on_tick(state, ref) -> None:
         pelvis = rot.twist_angle(rot.multiply(state.root_quat_wxyz, rot.conjugate(Q_WORLD_MODEL)), up)
         for side, pressing in state.feet_pressing().items():
-            if pressing:
+            if pressing or not pressing_only:
                 d = rot.twist_angle(state.link_quat_wxyz[ankle[side]], up) - pelvis
                 off.append(abs(np.degrees((d + np.pi) % (2 * np.pi) - np.pi)))
 
+    session.on_tick = on_tick
+    return off
+
+
+def _planted_foot_yaw_off_deg(motion: MotionConfig, seconds: float) -> np.ndarray:
+    """Over a built-in walk (seed 0): each pressing foot's yaw from the pelvis's, per control tick [deg]."""
+    from stylesync.sources.registry import open_source
+
     opened = open_source("builtin:walk", seed=0, duration_s=seconds)
     session = Session(SessionConfig(duration_s=seconds, seed=0, motion=motion), opened.source)
-    session.on_tick = on_tick
+    off = _record_feet_yaw_off_pelvis_deg(session, pressing_only=True)
     assert not session.run().fell
     opened.source.close()
     return np.array(off)
@@ -326,38 +334,22 @@ def test_the_walk_turns_with_an_operator_who_walks_a_circle():
     # step, the character's facing within 17 degrees of his; a character that did not turn would be 240 off. Its
     # feet turn with it: at 0.6 rad/s each foot's heading is within 24-27 degrees of the pelvis's at the 95th
     # percentile, 45 at most.
-    from stylesync.metrics.imitation import OPERATOR_JOINTS
+    from stylesync.metrics.imitation import facing_error_deg, facing_rad
     from stylesync.metrics.summary import summarize
-    from stylesync.model.character import LINK_NAMES
 
     cfg = SessionConfig(duration_s=8.0, seed=0, operator=OperatorConfig(turn_rate_rad_s=0.6))
     source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
     session = Session(cfg, source)
-    feet = [LINK_NAMES.index(f"{s}_ankle") for s in ("left", "right")]
-    feet_from_pelvis_deg: list[float] = []
-
-    def on_tick(state, ref) -> None:
-        # Each foot's heading against the pelvis's: the feet turn with the body by its steps (a turret on planted
-        # feet, its legs twisted about their own axes, would reach 180)
-        pelvis = rot.yaw_from_quat(state.root_quat_wxyz)
-        feet_from_pelvis_deg.extend(abs(np.degrees((rot.yaw_from_quat(state.link_quat_wxyz[f]) - pelvis + np.pi)
-                                                   % (2 * np.pi) - np.pi)) for f in feet)
-
-    session.on_tick = on_tick
+    # Each foot's heading against the pelvis's: the feet turn with the body by its steps (a turret on planted feet,
+    # its legs twisted about their own axes, would reach 180)
+    feet_from_pelvis_deg = _record_feet_yaw_off_pelvis_deg(session, pressing_only=False)
     result = session.run()
     assert not result.fell
     assert max(feet_from_pelvis_deg) < 60.0  # measured 45 (12 s)
     m = summarize(result)
     assert m["character_steps"] >= m["operator_steps"] - 1 >= 8
-    left, right = OPERATOR_JOINTS.index("HIP_LEFT"), OPERATOR_JOINTS.index("HIP_RIGHT")
-
-    def facing_deg(key: str) -> np.ndarray:
-        j = np.asarray(result.log.columns[key])
-        d = j[:, left] - j[:, right]
-        return np.degrees(np.unwrap(np.arctan2(d[:, 1], d[:, 0])))
-
-    his, its = facing_deg("op_joints"), facing_deg("ch_joints")
+    his = np.degrees(np.unwrap(facing_rad(np.asarray(result.log.columns["op_joints"]))))
     assert his[-1] - his[0] == pytest.approx(np.degrees(0.6 * 7.0), abs=25.0)  # he turned
     t = result.log.array("t")
-    err = (its - his + 180.0) % 360.0 - 180.0
+    err = facing_error_deg(np.asarray(result.log.columns["ch_joints"]), np.asarray(result.log.columns["op_joints"]))
     assert np.abs(err[t >= 1.0]).max() < 25.0

@@ -14,6 +14,7 @@ from stylesync.model.character import CHARACTER_LINKS, JOINT_PAIRS, OPERATOR_JOI
 __all__ = ["CHARACTER_LINKS", "JOINT_PAIRS", "OPERATOR_JOINTS"]
 
 UHC_FALL_DISTANCE_M = 0.5  # termination when the mean joint distance exceeds this (UHC/PHC) [m]
+_LEFT_HIP, _RIGHT_HIP = OPERATOR_JOINTS.index("HIP_LEFT"), OPERATOR_JOINTS.index("HIP_RIGHT")
 
 
 def scale_operator_to_character(op_pos: np.ndarray, scale: np.ndarray | float, char_root0: np.ndarray) -> np.ndarray:
@@ -33,6 +34,19 @@ def mpjpe_mm(char_pos: np.ndarray, ref_pos: np.ndarray, root_relative: bool = Fa
         a = a - a[:, :1]
         b = b - b[:, :1]
     return float(np.linalg.norm(a - b, axis=-1).mean() * 1e3)
+
+
+def facing_rad(pos: np.ndarray) -> np.ndarray:
+    """(T,) the facing [rad] of each tick's (T, J, 3) joints in JOINT_PAIRS order: the hip line from right to left,
+    turned a quarter to the right (the heading the pelvis faces), about world z."""
+    d = np.asarray(pos, dtype=float)
+    d = d[:, _LEFT_HIP] - d[:, _RIGHT_HIP]
+    return np.arctan2(d[:, 1], d[:, 0]) - 0.5 * np.pi
+
+
+def facing_error_deg(char_pos: np.ndarray, ref_pos: np.ndarray) -> np.ndarray:
+    """(T,) the character's facing against the reference's [deg], within [-180, 180) (:func:`facing_rad`)."""
+    return (np.degrees(facing_rad(char_pos) - facing_rad(ref_pos)) + 180.0) % 360.0 - 180.0
 
 
 def uhc_fall_index(char_pos: np.ndarray, ref_pos: np.ndarray, limit_m: float = UHC_FALL_DISTANCE_M) -> int | None:
