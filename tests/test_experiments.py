@@ -1,10 +1,11 @@
-"""The experiments' building blocks: scripted operator kinematics, the tuning ramp, the ball placement."""
+"""The experiments' building blocks: scripted operator kinematics, the tuning ramp, the ball placement, the sync
+experiment's sweeps."""
 
 import numpy as np
 import pytest
 
 from stylesync.config import ControlConfig, JacobianTransposeConfig, MotionConfig, PidGains
-from stylesync.experiments import kick, push, squat_jump, tune
+from stylesync.experiments import kick, push, squat_jump, sync, tune
 from stylesync.experiments.scripted_operator import pose_frame, sagittal_leg, standing_ankles
 from stylesync.sources.deepmimic_clip import DeepMimicClip
 from stylesync.sources.frame import JOINT_INDEX
@@ -153,3 +154,24 @@ def test_a_stance_foot_off_the_ground_is_held_where_it_came_off():
         out[hold] = (float(np.linalg.norm(right - right[0], axis=1).max()), m)
     assert out[False][0] > 0.1 and not out[False][1]["kicked"]
     assert out[True][0] < 0.03 and out[True][1]["kicked"] and not out[True][1]["fell"]
+
+
+def test_the_sync_sensor_rate_sweep_runs_each_rate_both_ways_and_finds_where_the_term_decides(monkeypatch):
+    """The sweep's runs (fake: the walk without the term falls at 6 Hz and below on seeds but the last, with it
+    never): every rate of SENSOR_RATES_HZ at the operator's own speed, with and without the term, on SWEEP_SEEDS seeds
+    from the run's; the term decides where no run with it falls and most without it do."""
+    calls = []
+
+    def fake_walk(lipm, speed, duration_s, seed, sensor_hz=None):
+        calls.append((lipm, speed, seed, sensor_hz))
+        return {"fell": (not lipm) and sensor_hz <= 6.0 and seed < 10 + sync.SWEEP_SEEDS - 1, "fall_time_s": None,
+                "state_transition_delay_s": {"max": 0.1}}
+
+    monkeypatch.setattr(sync, "_walk", fake_walk)
+    monkeypatch.setattr(sync, "summarize", lambda m: m)
+    rows = sync.sensor_rate_sweep(12.0, 10)
+    assert [r["sensor_hz"] for r in rows] == list(sync.SENSOR_RATES_HZ)
+    assert sorted(calls) == sorted((lipm, 1.0, 10 + k, hz) for hz in sync.SENSOR_RATES_HZ for lipm in (True, False)
+                                   for k in range(sync.SWEEP_SEEDS))
+    assert [x["seed"] for x in rows[0]["without"]] == [10 + k for k in range(sync.SWEEP_SEEDS)]
+    assert sync.deciding_settings(rows, "sensor_hz") == [hz for hz in sync.SENSOR_RATES_HZ if hz <= 6.0]
