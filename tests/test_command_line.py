@@ -147,3 +147,15 @@ def test_free_swing_is_taken_and_recorded(tmp_path, capsys):
     plain = read_session(tmp_path / "plain" / "session.jsonl").header["config"]
     for name, value in FREE_SWING_MOTION.items():
         assert free["motion"][name] == value != plain["motion"][name]
+
+
+def test_track_rise_is_taken_and_recorded(tmp_path, capsys):
+    from stylesync.config import TRACK_RISE_WHOLE_BODY
+    from stylesync.export.session_file import read_session
+
+    assert cli_main(["demo", "--track-rise", "--duration", "0.2", "--out", str(tmp_path / "tr")]) == 0
+    assert cli_main(["demo", "--duration", "0.2", "--out", str(tmp_path / "plain")]) == 0
+    rise = read_session(tmp_path / "tr" / "session.jsonl").header["config"]
+    plain = read_session(tmp_path / "plain" / "session.jsonl").header["config"]
+    for name, value in TRACK_RISE_WHOLE_BODY.items():
+        assert rise["control"]["whole_body"][name] == value != plain["control"]["whole_body"][name]

@@ -240,6 +240,27 @@ def test_hand_tasks_bring_the_hands_to_the_operators():
     assert with_tasks < 0.7 * without, (with_tasks, without)
 
 
+def _jump_run(share: float) -> dict:
+    """CMU-dev 13_39 (jumps in place off both feet), seed 0, as the development suite runs it, with
+    WholeBodyConfig.pelvis_rate_share ``share``: the run's summary."""
+    from stylesync.metrics.summary import summarize
+
+    control = ControlConfig(whole_body=WholeBodyConfig(pelvis_rate_share=share))
+    return summarize(suite_run(f"bvh:{MOCAP / 'cmu-dev' / '13_39.bvh'}", 0, MotionConfig(), control))
+
+
+@pytest.mark.skipif(not (MOCAP / "cmu-dev" / "13_39.bvh").exists(), reason="../shared/mocap/cmu-dev is not present")
+def test_a_jump_off_both_feet_is_followed_up_when_the_pelvis_rise_is_tracked():
+    """The pelvis height's law with the target's rise on both feet (pelvis_rate_share 0.5) against the regulator
+    alone. He springs up from his crouch; the damped regulator rose 0.7 s behind him and his pelvis went 0.5 m above
+    the character's (the UHC termination, at about 1.4 s); tracking his rise, the character rises with him and is
+    never that far from him. No fall either way."""
+    regulated, tracked = _jump_run(0.0), _jump_run(0.5)
+    assert not regulated["fell"] and not tracked["fell"]
+    assert regulated["uhc_fall_time_s"] is not None and regulated["uhc_fall_time_s"] < 2.0, regulated["uhc_fall_time_s"]
+    assert tracked["uhc_fall_time_s"] is None, tracked["uhc_fall_time_s"]
+
+
 def test_a_joint_past_its_no_load_speed_gets_no_torque_along_its_motion():
     """limit_joint_speed: the torque along a fast joint's motion is removed where it would speed it up; a torque
     that brakes it or turns it across its motion is kept, and slower joints are untouched."""

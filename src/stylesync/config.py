@@ -565,6 +565,11 @@ class WholeBodyConfig:
     # chain whose contact rows then ask for more than the limits allow, and the last iterate of the failed solve,
     # applied as torques, threw the limbs at 30-40 m/s (docs/decisions.md, "A QP with no feasible point")
     relax_limits_when_infeasible: bool = True
+    # The pelvis height's law also tracks the target's rise on both feet: force_z = m (kp (z_d - z) + kd (share ż_d -
+    # ż)), ż_d the operator's pelvis's upward speed scaled (Eq. 9; ReferencePose.pelvis_vel_z_mps). 0: the regulator
+    # as before, which damps every vertical speed: from a crouch before a jump the character rose over 0.7 s where he
+    # sprang up in 0.43 s (docs/decisions.md, "A jump's rise"; `--track-rise`: 0.5) [-]
+    pelvis_rate_share: float = 0.0
 
     def __post_init__(self) -> None:
         for n in ("joint_tracking_omega_rad_s", "joint_tracking_damping_ratio", "momentum_moment_weight_per_m",
@@ -574,7 +579,7 @@ class WholeBodyConfig:
                   "contact_velocity_gain", "sole_contact_gap_m", "joint_tracking_weight", "hand_task_kp",
                   "hand_task_kd", "hand_task_weight", "stance_leg_tracking_share", "single_stance_pelvis_share",
                   "recovery_foot_task_kp", "recovery_foot_task_kd", "recovery_foot_task_weight",
-                  "recovery_foot_landing_weight"):
+                  "recovery_foot_landing_weight", "pelvis_rate_share"):
             _non_negative(f"WholeBodyConfig.{n}", getattr(self, n))
         if self.joint_speed_limit_rad_s is not None:
             _positive("WholeBodyConfig.joint_speed_limit_rad_s", self.joint_speed_limit_rad_s)
@@ -709,6 +714,19 @@ FREE_SWING_MOTION: dict[str, Any] = {
 def free_swing(cfg: SessionConfig) -> SessionConfig:
     """``cfg`` with FREE_SWING_MOTION."""
     return cfg.replace(motion=dataclasses.replace(cfg.motion, **FREE_SWING_MOTION))
+
+
+# The opt-in that lets the pelvis rise with the operator's on both feet (docs/decisions.md, "A jump's rise"):
+# `--track-rise`.
+TRACK_RISE_WHOLE_BODY: dict[str, Any] = {
+    "pelvis_rate_share": 0.5,  # half his pelvis's rise is tracked; the regulator does the rest
+}
+
+
+def track_rise(cfg: SessionConfig) -> SessionConfig:
+    """``cfg`` with TRACK_RISE_WHOLE_BODY."""
+    whole_body = dataclasses.replace(cfg.control.whole_body, **TRACK_RISE_WHOLE_BODY)
+    return cfg.replace(control=dataclasses.replace(cfg.control, whole_body=whole_body))
 
 
 # ... and for a recording: started at its own velocities, no faster than this over the ground [m/s]

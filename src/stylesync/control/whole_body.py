@@ -170,8 +170,11 @@ class WholeBodyController(ControllerBase):
         ankle_z = (sum(float(state.link_origin_world[_FOOT_LINK[s], 2]) for s in support) / len(support) if support
                    else ANKLE_HEIGHT_M)
         pelvis_z_d = ref.pelvis_world[2] - ANKLE_HEIGHT_M + ankle_z
+        # The target's rise on both feet, shared (WholeBodyConfig.pelvis_rate_share); its descent is left to the
+        # regulator, and so is the rise over one foot (a gait's vault over its stance leg)
+        pelvis_vz_d = wb.pelvis_rate_share * max(ref.pelvis_vel_z_mps, 0.0) if len(support) == 2 else 0.0
         force[2] = m * (wb.momentum_com_kp * (pelvis_z_d - state.root_pos_world[2])
-                        - wb.momentum_com_kd * state.root_lin_vel_world[2])
+                        + wb.momentum_com_kd * (pelvis_vz_d - state.root_lin_vel_world[2]))
         f_lipm = np.zeros(3)
         if cfg.lipm_time_sync and ref.lipm is not None:  # Eq. 21-23, bounded by Eq. 26
             f_lipm = bounded_lipm_sync_force(ref.lipm, m, self.g, cfg.lipm_force_limit_n, cfg.enforce_bounds,

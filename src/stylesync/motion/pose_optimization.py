@@ -208,6 +208,7 @@ class _Tick:
     com_vel_h: np.ndarray = field(default_factory=lambda: np.zeros(3))
     ankle_h_z: float = 0.0
     pelvis_d: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    pelvis_vel_z: float = 0.0  # the pelvis target's vertical speed [m/s]
     com_d: np.ndarray = field(default_factory=lambda: np.zeros(3))
     com_vel_d: np.ndarray = field(default_factory=lambda: np.zeros(3))
     weights: dict[str, float] = field(default_factory=dict)  # stance weights
@@ -238,6 +239,7 @@ class MotionOptimizer:
         self._held: OperatorSample | None = None
         self._com_d_rate = _SmoothedRate(self.dt_s)  # desired COM velocity [m/s]
         self._com_h_rate = _SmoothedRate(self.dt_s)  # operator COM velocity [m/s]
+        self._pelvis_h_rate = _SmoothedRate(self.dt_s)  # operator pelvis velocity [m/s]
         self.way = OperatorWay(cfg.operator_way_time_s, self.dt_s)  # his way over the ground (operator_way.py)
         # only a gait's speed or a walk-on along his way reads it: otherwise it is not kept up each tick
         self._tracks_way = cfg.gait_min_way_speed_mps is not None or cfg.recovery_walk_on_his_way
@@ -514,6 +516,7 @@ class MotionOptimizer:
                 self._ref_xy = pred + (self.dt_s / tau) * (raw - pred)
             pelvis_xy[:2], com_xy[:2] = self._ref_xy[0], self._ref_xy[1]
         tick.pelvis_d = np.array([pelvis_xy[0], pelvis_xy[1], ANKLE_HEIGHT_M + scale * (p_h[2] - ankle_h_z)])  # Eq. 9
+        tick.pelvis_vel_z = scale * float(self._pelvis_h_rate(p_h)[2])
         # The operator's COM height reflects his own mass distribution, not the character's: the vertical is left
         # to the pelvis height (Eq. 9) through the leg IK, and the COM target keeps the character's own height.
         tick.com_d = np.array([com_xy[0], com_xy[1], com_c[2]])
@@ -620,7 +623,10 @@ class MotionOptimizer:
                 d2 = float(np.sum((tick.targets[side][:2] - hip_xy) ** 2))
                 above_foot = max(float(np.sqrt(max(_LANDING_REACH_M * _LANDING_REACH_M - d2, 0.0))),
                                  self._landing_pelvis_floor_m)
-                tick.pelvis_d[2] = min(tick.pelvis_d[2], tick.targets[side][2] + above_foot)
+                lowered = tick.targets[side][2] + above_foot
+                if lowered < tick.pelvis_d[2]:
+                    tick.pelvis_d[2] = lowered
+                    tick.pelvis_vel_z = 0.0
 
     def _his_gait(self, tick: _Tick, his_ankles_world: dict[str, np.ndarray]) -> bool:
         """Whether the operator's double stance on ``his_ankles_world`` is a gait's: his COM moves from one foot
@@ -1073,6 +1079,7 @@ class MotionOptimizer:
             recovery_ankle_world=None if own is None else {own: tick.targets[own].copy()},
             recovery_ankle_vel_world=None if own is None or step is None else {own: step.target_vel_world},
             recovery_while_he_stands=self.char_fsm.recovery_step and self._operator_stands(tick),
+            pelvis_vel_z_mps=tick.pelvis_vel_z,
         )
 
     @staticmethod

@@ -46,6 +46,9 @@ class ReferencePose:
     # That step is taken while the operator stands (his capture point within his soles): a step that is to stop the
     # body, not to go anywhere
     recovery_while_he_stands: bool = False
+    # The pelvis target's vertical speed: the operator's pelvis's, scaled (Eq. 9), smoothed; 0 while the target is
+    # lowered for a foot to reach the ground [m/s]
+    pelvis_vel_z_mps: float = 0.0
 
 
 @dataclass(frozen=True)
