@@ -8,8 +8,9 @@ speed or a sensor rate at which the term decides a fall. The speed sweep plays t
 ``SENSOR_RATES_HZ`` instead of the Kinect's 16 Hz (``ClockConfig.mocap_hz``: the pipeline then interpolates between
 frames further apart, as a slower sensor or a lossy link gives it), each over ``SWEEP_SEEDS`` sensor seeds from the
 run's; the term decides a fall at a setting where no walk with it falls and most walks without it do. A constant
-sensor latency is not swept: a recorded operator's frames all delayed alike give the character the same motion later,
-and the run is the same. Exit status 0 only when the claim holds.
+sensor latency is not swept: it delays the whole operator alike, and the character follows the delayed stream as it
+follows the live one (measured once at 0.1-0.4 s, no fall either way: docs/decisions.md). Exit status 0 only when the
+claim holds.
 """
 
 from __future__ import annotations
@@ -94,7 +95,7 @@ def _sweep(key: str, values: tuple[float, ...], summary_of: Callable[[bool, floa
     return rows
 
 
-# The sweeps' settings: (key in a sweep's rows, axis label, bar width in the setting's unit)
+# The swept settings, by their key in a sweep's rows: (axis label, bar width in the setting's unit)
 _SWEPT = {"speed": ("operator speed [x clip]", 0.08), "sensor_hz": ("operator's sensor rate [Hz]", 0.8)}
 
 
