@@ -136,26 +136,20 @@ def test_follow_path_is_taken_and_recorded(tmp_path, capsys):
         assert follow["control"]["whole_body"][name] == value != plain["control"]["whole_body"][name]
 
 
-def test_free_swing_is_taken_and_recorded(tmp_path, capsys):
+@pytest.mark.parametrize("flag, settings, section", [("--free-swing", "FREE_SWING_MOTION", ("motion",)),
+                                                     ("--track-rise", "TRACK_RISE_WHOLE_BODY",
+                                                      ("control", "whole_body"))])
+def test_an_opt_in_flag_is_taken_and_recorded(tmp_path, capsys, flag, settings, section):
+    """``--free-swing`` and ``--track-rise`` set their settings (config.FREE_SWING_MOTION, TRACK_RISE_WHOLE_BODY),
+    and the run's session file records them; without the flag the defaults differ."""
+    from stylesync import config
     from stylesync.export.session_file import read_session
 
-    assert cli_main(["demo", "--free-swing", "--duration", "0.2", "--out", str(tmp_path / "fs")]) == 0
+    assert cli_main(["demo", flag, "--duration", "0.2", "--out", str(tmp_path / "on")]) == 0
     assert cli_main(["demo", "--duration", "0.2", "--out", str(tmp_path / "plain")]) == 0
-    from stylesync.config import FREE_SWING_MOTION
-
-    free = read_session(tmp_path / "fs" / "session.jsonl").header["config"]
+    on = read_session(tmp_path / "on" / "session.jsonl").header["config"]
     plain = read_session(tmp_path / "plain" / "session.jsonl").header["config"]
-    for name, value in FREE_SWING_MOTION.items():
-        assert free["motion"][name] == value != plain["motion"][name]
-
-
-def test_track_rise_is_taken_and_recorded(tmp_path, capsys):
-    from stylesync.config import TRACK_RISE_WHOLE_BODY
-    from stylesync.export.session_file import read_session
-
-    assert cli_main(["demo", "--track-rise", "--duration", "0.2", "--out", str(tmp_path / "tr")]) == 0
-    assert cli_main(["demo", "--duration", "0.2", "--out", str(tmp_path / "plain")]) == 0
-    rise = read_session(tmp_path / "tr" / "session.jsonl").header["config"]
-    plain = read_session(tmp_path / "plain" / "session.jsonl").header["config"]
-    for name, value in TRACK_RISE_WHOLE_BODY.items():
-        assert rise["control"]["whole_body"][name] == value != plain["control"]["whole_body"][name]
+    for key in section:
+        on, plain = on[key], plain[key]
+    for name, value in getattr(config, settings).items():
+        assert on[name] == value != plain[name]
