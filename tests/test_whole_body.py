@@ -252,9 +252,9 @@ def _jump_run(share: float) -> dict:
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "13_39.bvh").exists(), reason="../shared/mocap/cmu-dev is not present")
 def test_a_jump_off_both_feet_is_followed_up_when_the_pelvis_rise_is_tracked():
     """The pelvis height's law with the target's rise on both feet (pelvis_rate_share 0.5) against the regulator
-    alone. He springs up from his crouch; the damped regulator rose 0.7 s behind him and his pelvis went 0.5 m above
-    the character's (the UHC termination, at about 1.4 s); tracking his rise, the character rises with him and is
-    never that far from him. No fall either way."""
+    alone. He springs up from his crouch in 0.43 s; under the damped regulator the character rose over 0.7 s and his
+    pelvis went 0.5 m above the character's (the UHC termination, at about 1.4 s); tracking his rise, the character
+    rises with him and is never that far from him. No fall either way."""
     regulated, tracked = _jump_run(0.0), _jump_run(0.5)
     assert not regulated["fell"] and not tracked["fell"]
     assert regulated["uhc_fall_time_s"] is not None and regulated["uhc_fall_time_s"] < 2.0, regulated["uhc_fall_time_s"]
