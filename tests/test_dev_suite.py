@@ -18,9 +18,10 @@ def test_every_shared_clip_has_a_category(tmp_path):
 
 def test_the_dev_suite_writes_one_row_per_category_and_controller(tmp_path, capsys):
     out = tmp_path / "dev"
-    assert cli_main(["bench", "--suite", "dev", "--only", "kick", "--seeds", "1", "--duration", "1.5",
+    assert cli_main(["bench", "--suite", "dev", "--only", "kick", "--seeds", "1", "--seed", "3", "--duration", "1.5",
                      "--workers", "1", "--out", str(out)]) == 0
     rows = json.loads((out / "dev_suite.json").read_text())
+    assert {r["seed"] for r in rows} == {3}  # --seed is the first sensor seed run (held-out seeds)
     clips = {r["clip"] for r in rows}
     assert {"kick", "spinkick"} <= clips
     for clip in clips:

@@ -267,7 +267,7 @@ def _bench(args: argparse.Namespace) -> int:
             raise ConfigError(f"unknown categories {', '.join(unknown)}; expected some of {', '.join(ORDER)}")
         mocap = shared / "mocap"
         report = run_dev_suite(Path(args.out), args.seeds, args.duration, mocap if mocap.is_dir() else None, only,
-                               workers=args.workers, executor=args.executor)
+                               workers=args.workers, executor=args.executor, first_seed=args.seed)
     else:
         report = run_bench(Path(args.out), args.duration, args.seed, shared if shared.is_dir() else None,
                            executor=args.executor or "inline", workers=args.workers)
@@ -454,14 +454,15 @@ def build_parser() -> argparse.ArgumentParser:
     report.set_defaults(func=_report)
     bench = sub.add_parser("bench", help="stylesync vs plain PD vs no model-based compensation over the clip suite")
     bench.add_argument("--duration", type=typed.duration_s, default=10.0, help="simulated seconds per clip")
-    bench.add_argument("--seed", type=typed.seed, default=0)
+    bench.add_argument("--seed", type=typed.seed, default=0,
+                       help="sensor seed; the dev suite's first (other seeds than those measured: held-out runs)")
     bench.add_argument("--out", type=typed.out_dir, default="out/bench", help="output folder (bench.md, bench.json)")
     bench.add_argument("--shared", type=typed.in_dir,
                        help="folder holding mocap/cmu (default: ../shared beside the checkout)")
     bench.add_argument("--suite", choices=("bench", "dev"), default="bench",
                        help="bench: the humanoid3d clips and CMU BVH against two baselines; dev: every shared clip "
                             "per category, several seeds, stylesync and the plain PD tracker (dev_suite.md/json)")
-    bench.add_argument("--seeds", type=typed.integer(1, 1000), default=2, help="dev suite: sensor seeds 0 .. N-1")
+    bench.add_argument("--seeds", type=typed.integer(1, 1000), default=2, help="dev suite: sensor seeds SEED .. SEED+N-1")
     bench.add_argument("--only", help="dev suite: comma-separated categories (default: all)")
     bench.add_argument("--workers", type=typed.integer(1, 256), default=2,
                        help="runs in parallel (with --executor processes or ray, and for the dev suite)")

@@ -163,14 +163,16 @@ def table(rows: list[dict], versions: list[str]) -> str:
 
 def run_dev_suite(out: Path, seeds: int, duration_s: float, mocap: Path | None, only: tuple[str, ...] = (),
                   controllers: tuple[str, ...] = SUITE_CONTROLLERS, workers: int = 2,
-                  executor: str | None = None) -> dict:
-    """Run the suite on the executors of parallel.py ("processes" by default, "ray", or "inline"
-    when ``workers`` is 1); writes dev_suite.md and dev_suite.json under ``out`` and returns {"rows", "table"}."""
+                  executor: str | None = None, first_seed: int = 0) -> dict:
+    """Run the suite on the sensor seeds ``first_seed`` .. ``first_seed + seeds - 1`` on the executors of
+    parallel.py ("processes" by default, "ray", or "inline" when ``workers`` is 1); writes dev_suite.md and
+    dev_suite.json under ``out`` and returns {"rows", "table"}."""
     from stylesync.parallel import execute_all
 
     out.mkdir(parents=True, exist_ok=True)
     clips = [c for c in clip_specs(mocap) if not only or c[2] in only]
-    jobs = [(spec, name, cat, seed, ctrl, duration_s) for spec, name, cat in clips for seed in range(seeds)
+    jobs = [(spec, name, cat, seed, ctrl, duration_s) for spec, name, cat in clips
+            for seed in range(first_seed, first_seed + seeds)
             for ctrl in controllers]
     executor = executor or ("processes" if workers > 1 else "inline")
     rows = [row if isinstance(row, dict) else {"clip": name, "spec": spec, "category": cat, "seed": seed,
