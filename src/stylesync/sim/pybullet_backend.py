@@ -211,7 +211,8 @@ class PyBulletBackend(PhysicsBackend):
         links = c.getLinkStates(self.body, self._link_idx, computeLinkVelocity=1, computeForwardKinematics=1)
         # One array of each link's COM (3), frame origin (3), orientation xyzw (4), COM velocity (3), angular
         # velocity (3), split into views.
-        table = np.array([ls[0] + ls[4] + ls[5] + ls[6] + ls[7] for ls in links])
+        table = np.fromiter(itertools.chain.from_iterable(ls[0] + ls[4] + ls[5] + ls[6] + ls[7] for ls in links), float,
+                            16 * len(links)).reshape(-1, 16)
         com, origin, quat_xyzw = table[:, 0:3], table[:, 3:6], table[:, 6:10]
         com_vel, ang = table[:, 10:13], table[:, 13:16]
         quat = quat_xyzw @ _CANONICAL_FROM_LINK_XYZW_T
