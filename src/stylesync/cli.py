@@ -462,7 +462,8 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--suite", choices=("bench", "dev"), default="bench",
                        help="bench: the humanoid3d clips and CMU BVH against two baselines; dev: every shared clip "
                             "per category, several seeds, stylesync and the plain PD tracker (dev_suite.md/json)")
-    bench.add_argument("--seeds", type=typed.integer(1, 1000), default=2, help="dev suite: sensor seeds SEED .. SEED+N-1")
+    bench.add_argument("--seeds", type=typed.integer(1, 1000), default=2,
+                       help="dev suite: sensor seeds SEED .. SEED+N-1")
     bench.add_argument("--only", help="dev suite: comma-separated categories (default: all)")
     bench.add_argument("--workers", type=typed.integer(1, 256), default=2,
                        help="runs in parallel (with --executor processes or ray, and for the dev suite)")
