@@ -455,7 +455,7 @@ def build_parser() -> argparse.ArgumentParser:
     bench = sub.add_parser("bench", help="stylesync vs plain PD vs no model-based compensation over the clip suite")
     bench.add_argument("--duration", type=typed.duration_s, default=10.0, help="simulated seconds per clip")
     bench.add_argument("--seed", type=typed.seed, default=0,
-                       help="sensor seed; the dev suite's first (other seeds than those measured: held-out runs)")
+                       help="sensor seed (the dev suite's first: --seed 8 --seeds 8 runs seeds 8-15)")
     bench.add_argument("--out", type=typed.out_dir, default="out/bench", help="output folder (bench.md, bench.json)")
     bench.add_argument("--shared", type=typed.in_dir,
                        help="folder holding mocap/cmu (default: ../shared beside the checkout)")
