@@ -570,6 +570,12 @@ class WholeBodyConfig:
     # as before, which damps every vertical speed: from a crouch before a jump the character rose over 0.7 s where he
     # sprang up in 0.43 s (docs/decisions.md, "A jump's rise"; `--track-rise`: 0.5) [-]
     pelvis_rate_share: float = 0.0
+    # A rear sole goes onto its toes (control/toe_contact.py): on two feet, the foot behind the body whose leg is
+    # stretched to this share of its length (hip to ankle) or more stands on its toe line, its heel free to rise, as a
+    # walker's heel rises before his rear foot lifts; held flat, a straight rear leg pinned the pelvis to its arc and
+    # brought it down by 0.1-0.15 m in a long stride (docs/decisions.md, "A rear foot on its toes"). None: the soles
+    # stay flat [-]
+    toe_off_leg_stretch: float | None = None
 
     def __post_init__(self) -> None:
         for n in ("joint_tracking_omega_rad_s", "joint_tracking_damping_ratio", "momentum_moment_weight_per_m",
@@ -583,6 +589,8 @@ class WholeBodyConfig:
             _non_negative(f"WholeBodyConfig.{n}", getattr(self, n))
         if self.joint_speed_limit_rad_s is not None:
             _positive("WholeBodyConfig.joint_speed_limit_rad_s", self.joint_speed_limit_rad_s)
+        if self.toe_off_leg_stretch is not None:
+            _positive("WholeBodyConfig.toe_off_leg_stretch", self.toe_off_leg_stretch)
         if self.recovery_foot_target_rate not in RECOVERY_FOOT_TARGET_RATES:
             raise ConfigError(f"WholeBodyConfig.recovery_foot_target_rate must be one of "
                               f"{', '.join(RECOVERY_FOOT_TARGET_RATES)}, got '{self.recovery_foot_target_rate}'")

@@ -91,12 +91,13 @@ class SoleContactBase(ABC):
     regularisation's weight and its normal force's bound, whatever its force variables.
 
     What the formulation reads of a contact: ``n_forces`` variables, their ``generator`` (nv, n_forces) in the
-    equations of motion, their regularisation (:meth:`add_regularisation`), the ``normal_row`` (n_forces,) that gives
-    the normal force, and ``force_rows`` (k, n_forces) with ``force_lower``/``force_upper`` (k,): the force variables'
-    own inequalities, the same at every tick when ``force_rows_constant``. A subclass fills those from the sole's
-    placement (:meth:`_update_forces`)."""
+    equations of motion, ``n_rows`` constraint rows (:meth:`constraint_rows`), their regularisation
+    (:meth:`add_regularisation`), the ``normal_row`` (n_forces,) that gives the normal force, and ``force_rows``
+    (k, n_forces) with ``force_lower``/``force_upper`` (k,): the force variables' own inequalities, the same at every
+    tick when ``force_rows_constant``. A subclass fills those from the sole's placement (:meth:`_update_forces`)."""
 
     n_forces: int
+    n_rows = 6  # the constraint rows that keep the sole where it is (constraint_rows)
     force_rows_constant: bool
     normal_row: np.ndarray
     force_rows: np.ndarray

@@ -7,7 +7,8 @@ metric ``ε λᵀ (G Gᵀ)⁻¹ λ``). The problem is
 
     min_x  ½ Σ_tasks Σ_rows w (A q̈ - b)² + ½ Σ_contacts ε |λ|²
     s.t.   M_root q̈ + h_root = (B λ)_root                     (the floating root's six equations of motion)
-           J_c q̈ + J̇_c q̇ = -k_v J_c q̇                          (each supporting sole stays where it is)
+           J_c q̈ + J̇_c q̇ = -k_v J_c q̇                          (each supporting sole stays where it is; a sole on
+                                                                its toes turns about its toe line, toe_contact.py)
            -τ_max <= M_j q̈ + h_j - (B λ)_j <= τ_max           (joint torque limits)
            0 <= Σ n·f_c <= f_max(c)                            (each sole's normal force, ramped with its weight)
            λ >= 0,  q̈_lo <= q̈_hinge <= q̈_hi                  (friction pyramids; hinge limits over a horizon)
@@ -145,7 +146,7 @@ class WholeBodyFormulation:
         # joint torques, each sole's normal force, each sole's own force rows (the pyramids' λ >= 0 or the wrench
         # cone), the hinges' limits. What does not change from one tick to the next (the pyramids' and the hinges'
         # unit rows, the bounds of the force rows) comes from a template.
-        n_eq = ROOT_DOFS + 6 * n_c
+        n_eq = ROOT_DOFS + sum(c.n_rows for c in contacts)
         n_tau = nv - ROOT_DOFS
         key = tuple(type(c) for c in contacts)
         template = self._templates.get(key)
@@ -157,7 +158,7 @@ class WholeBodyFormulation:
         lower[:ROOT_DOFS] = -h[:ROOT_DOFS]
         tau_rows = slice(n_eq, n_eq + n_tau)
         rows[tau_rows, :nv] = m[ROOT_DOFS:]
-        start, force_row = nv, n_eq + n_tau + n_c
+        start, force_row, eq_row = nv, n_eq + n_tau + n_c, ROOT_DOFS
         for i, c in enumerate(contacts):
             c.update(model)
             sl = slice(start, start + c.n_forces)
@@ -165,8 +166,9 @@ class WholeBodyFormulation:
             rows[:ROOT_DOFS, sl] = -c.generator[:ROOT_DOFS]  # -B of the equations of motion
             rows[tau_rows, sl] = -c.generator[ROOT_DOFS:]
             jac, acc = c.constraint_rows(self.contact_velocity_gain)
-            rows[ROOT_DOFS + 6 * i:ROOT_DOFS + 6 * (i + 1), :nv] = jac
-            lower[ROOT_DOFS + 6 * i:ROOT_DOFS + 6 * (i + 1)] = acc
+            rows[eq_row:eq_row + c.n_rows, :nv] = jac
+            lower[eq_row:eq_row + c.n_rows] = acc
+            eq_row += c.n_rows
             normal = n_eq + n_tau + i
             rows[normal, sl] = c.normal_row
             upper[normal] = c.max_normal_force_n
@@ -199,7 +201,7 @@ class WholeBodyFormulation:
         and the hinges' unit rows; the rest is zero."""
         nv, n_c = N_DOFS, len(contacts)
         n_f = sum(c.n_forces for c in contacts)
-        n_eq = ROOT_DOFS + 6 * n_c
+        n_eq = ROOT_DOFS + sum(c.n_rows for c in contacts)
         n_force_rows = sum(len(c.force_rows) for c in contacts)
         n_in = nv - ROOT_DOFS + n_c + n_force_rows + len(self.limits)
         rows = np.zeros((n_eq + n_in, nv + n_f))

@@ -46,6 +46,7 @@ from stylesync.control.sole_wrench_contact import SoleWrenchContact
 from stylesync.control.solver import DaqpSolver
 from stylesync.control.stable_pd import flatten_joint_values, unflatten_joint_values
 from stylesync.control.tasks import CentroidalMomentumTask, FrameOrientationTask, FramePositionTask, JointPostureTask
+from stylesync.control.toe_contact import ToeContact, toe_off_sides
 from stylesync.model.character import (
     ANKLE_HEIGHT_M,
     JOINT_DOF_COUNT,
@@ -64,6 +65,7 @@ from stylesync.motion.stance_fsm import swing_side
 
 log = logging.getLogger("stylesync.control")
 _FOOT_LINK = {s: LINK_NAMES.index(f"{s}_ankle") for s in SIDES}
+_HIP_LINK = {s: LINK_NAMES.index(f"{s}_hip") for s in SIDES}
 # Each leg's hip, knee and ankle DOFs, in the joint-DOF layout of the posture task.
 _LEG_DOFS = {s: np.concatenate([JOINT_DOF_START[k] + np.arange(JOINT_DOF_COUNT[k]) for k in LEG_JOINTS[s]])
              for s in SIDES}
@@ -149,6 +151,11 @@ class WholeBodyController(ControllerBase):
                            for support in ((), ("left",), ("right",), ("left", "right"))}
         contact = SoleWrenchContact if wb.sole_wrench_cone else SoleContact
         self.contacts = {s: contact(s, friction, mass.total_kg * gravity_mps2) for s in SIDES}
+        # A rear sole on its toes (WholeBodyConfig.toe_off_leg_stretch)
+        self.toe_contacts = {s: ToeContact(s, friction, mass.total_kg * gravity_mps2) for s in SIDES}
+        self._leg_length_m = model.rest_distance("left_hip", "left_knee") + model.rest_distance("left_knee",
+                                                                                               "left_ankle")
+        self.on_toes: set[str] = set()  # the supporting feet on their toes this tick
         self.solver = DaqpSolver()
 
     def update(self, state: CharacterState, ref: ReferencePose) -> None:
@@ -180,7 +187,8 @@ class WholeBodyController(ControllerBase):
             f_lipm = bounded_lipm_sync_force(ref.lipm, m, self.g, cfg.lipm_force_limit_n, cfg.enforce_bounds,
                                              self.bounds, state.time_s)
             force += f_lipm
-        contacts = [self.contacts[s] for s in support]
+        self.on_toes = self._toe_off(state, support, com)
+        contacts = [self.toe_contacts[s] if s in self.on_toes else self.contacts[s] for s in support]
         for c in contacts:
             c.stance_weight = w[c.side]
             c.update(model)  # its corners bound the force here; the formulation reads the rest of it
@@ -269,6 +277,17 @@ class WholeBodyController(ControllerBase):
             limit_joint_speed(tau, state.joint_vel, wb.joint_speed_limit_rad_s)
         self._tau = Torques(np.minimum(np.maximum(tau, -TORQUE_LIMIT), TORQUE_LIMIT))
         self.telemetry = ControlTelemetry(force, f_lipm, moment)
+
+    def _toe_off(self, state: CharacterState, support: list[str], com_world: np.ndarray) -> set[str]:
+        """The supporting feet that stand on their toes this tick (toe_contact.toe_off_sides)."""
+        share = self.wb.toe_off_leg_stretch
+        if len(support) != 2 or share is None:
+            return set()
+        link, quat = state.link_origin_world, state.link_quat_wxyz
+        stretch = {s: float(np.linalg.norm(link[_HIP_LINK[s]] - link[_FOOT_LINK[s]])) / self._leg_length_m
+                   for s in support}
+        return toe_off_sides(support, stretch, com_world, {s: link[_FOOT_LINK[s]] for s in support},
+                             {s: quat[_FOOT_LINK[s]] for s in support}, share)
 
     def _move_target(self, task: FramePositionTask, last: dict[str, np.ndarray], side: str, target: np.ndarray,
                      first_vel_world: np.ndarray) -> None:

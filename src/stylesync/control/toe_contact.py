@@ -1,0 +1,116 @@
+"""A rear sole on its toes: the contact of a foot whose heel has left the ground, and when a foot goes onto it.
+
+Walking, a person's rear heel rises before the rear foot lifts (heel-off, late in the stance): the foot turns about
+the line of its toes, the leg is the foot's length longer, and the pelvis need not come down as the body passes over
+the front foot. A flat sole contact (contacts.py) holds the whole sole on the ground: a rear leg stretched to its
+full length then pins the pelvis to the arc of a straight leg about the rear ankle. Traced on the built-in walk with
+``--follow-path`` (seed 2): the rear leg straight (hip to ankle 1.00 of its length) from 2.77 s to the lift-off at
+3.04 s while the pelvis went 0.21 m forward over it and came down from 0.81 m to 0.68 m, and stayed there, on a bent
+front leg, through the next single stance (docs/decisions.md, "A rear foot on its toes").
+
+:class:`ToeContact` passes forces at the sole's two front corners only (their friction pyramids, as contacts.py's)
+and keeps the toe line where it is: the toe line's midpoint does not move (3 rows) and the sole does not turn about
+its forward axis or the vertical (2 rows); its turn about the toe line (its lateral axis) is free, so the heel rises
+as the leg asks. :func:`toe_off_sides` decides which supporting foot stands so: on two feet, the foot behind the
+body whose leg is stretched to ``stretch_share`` of its length (hip to ankle), and a foot whose heel is still raised
+while both feet support.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from stylesync.control.contacts import INFINITY, SOLE_CORNERS_IN_SOLE, SoleContactBase, pyramid_edges
+from stylesync.model.sole import sole_corners_world
+
+TOE_CORNERS = 2  # the sole's front-left and front-right corners (SOLE_CORNERS_IN_SOLE's first two rows)
+FORCES_PER_TOE = 4 * TOE_CORNERS  # 4 pyramid edges per corner
+CONSTRAINT_ROWS = 5  # the toe line's midpoint (3) and the sole's turn about its forward axis and the vertical (2)
+# The toe line's midpoint relative to the sole's centre, in the foot's canonical frame (x forward, y left, z up) [m]
+_TOE_MID_IN_SOLE = SOLE_CORNERS_IN_SOLE[:TOE_CORNERS].mean(axis=0)
+# A heel this much higher than the toes (the sole's rear corners against its front ones) is raised [m]
+HEEL_RAISED_M = 0.005
+# The COM at least this far ahead of an ankle, along that foot's own forward axis, puts the foot behind the body [m]
+BEHIND_BODY_M = 0.1
+
+
+def _skew(v: np.ndarray) -> np.ndarray:
+    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+
+
+class ToeContact(SoleContactBase):
+    """A sole standing on the line of its toes: forces at its two front corners, its turn about that line free."""
+
+    n_forces = FORCES_PER_TOE
+    n_rows = CONSTRAINT_ROWS
+    force_rows_constant = True  # λ >= 0: unit rows
+
+    def __init__(self, side: str, friction: float, body_weight_n: float):
+        super().__init__(side, body_weight_n)
+        self.edges = pyramid_edges(friction)  # (4, 3)
+        self.force_rows = np.eye(FORCES_PER_TOE)
+        self.force_lower, self.force_upper = np.zeros(FORCES_PER_TOE), np.full(FORCES_PER_TOE, INFINITY)
+        self.normal_row = np.tile(self.edges[:, 2], TOE_CORNERS)
+        self._forces = np.tile(self.edges.T, TOE_CORNERS)  # (3, 8): the unit forces, corner by corner
+        self.corners_world = np.zeros((TOE_CORNERS, 3))
+        self._rotation = np.eye(3)
+
+    def _update_forces(self, placement: pin.SE3) -> None:
+        r = placement.rotation
+        self._rotation = r
+        levers = SOLE_CORNERS_IN_SOLE[:TOE_CORNERS] @ r.T  # (2, 3) corner - sole centre, world axes
+        self.corners_world = placement.translation + levers
+        # B = Σ_c J_cᵀ β_e = J_linᵀ β_e + J_angᵀ (r_c × β_e), corner by corner, edge by edge.
+        moments = np.concatenate([np.cross(lever, self.edges).T for lever in levers], axis=1)  # (3, 8)
+        self.generator = self.jacobian[:3].T @ self._forces + self.jacobian[3:].T @ moments
+
+    def add_regularisation(self, hessian: np.ndarray, start: int) -> None:
+        """Set ``ε λ²`` on the diagonal of the QP's ``hessian`` (n, n) from variable ``start`` on."""
+        n = len(hessian)
+        hessian.ravel()[start * (n + 1):(start + self.n_forces) * (n + 1):n + 1] = self.regularisation
+
+    def constraint_rows(self, velocity_gain: float) -> tuple[np.ndarray, np.ndarray]:
+        """The toe line stays: its midpoint p = o + r does not move (``a_p = a_o + α × r + ω × (ω × r)``, world axes)
+        and the sole does not turn about its forward axis or the vertical; each with its residual velocity damped at
+        ``velocity_gain``. (5, nv) rows and (5,) right-hand sides."""
+        r_world = self._rotation @ _TOE_MID_IN_SOLE
+        j_lin, j_ang = self.jacobian[:3], self.jacobian[3:]
+        omega = self.velocity[3:]
+        j_point = j_lin - _skew(r_world) @ j_ang  # v_p = v_o + ω × r = v_o - [r]× ω
+        drift_point = self.drift[:3] + np.cross(self.drift[3:], r_world) + np.cross(omega, np.cross(omega, r_world))
+        vel_point = self.velocity[:3] + np.cross(omega, r_world)
+        axes = np.array([self._rotation[:, 0], [0.0, 0.0, 1.0]])  # the sole's forward axis and the vertical
+        rows = np.vstack([j_point, axes @ j_ang])
+        rhs = np.concatenate([-drift_point - velocity_gain * vel_point,
+                              -(axes @ self.drift[3:]) - velocity_gain * (axes @ omega)])
+        return rows, rhs
+
+
+def heel_raised(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray) -> bool:
+    """Whether a foot's heel is higher than its toes by more than HEEL_RAISED_M (its sole's rear corners against its
+    front ones)."""
+    z = sole_corners_world(ankle_world, foot_quat_wxyz)[:, 2]
+    return bool(0.5 * (z[2] + z[3]) - 0.5 * (z[0] + z[1]) > HEEL_RAISED_M)
+
+
+def toe_off_sides(support: list[str], stretch: dict[str, float], com_world: np.ndarray,
+                  ankles_world: dict[str, np.ndarray], feet_quat_wxyz: dict[str, np.ndarray],
+                  stretch_share: float) -> set[str]:
+    """The supporting feet that stand on their toes this tick. Only on two feet: a foot whose heel is raised, and the
+    foot behind the body (the COM at least BEHIND_BODY_M ahead of its ankle along the foot's forward axis) whose leg
+    is stretched to ``stretch_share`` of its length or more (``stretch``: hip to ankle over the leg's length)."""
+    if len(support) != 2:
+        return set()
+    out = set()
+    for s in support:
+        ankle, quat = ankles_world[s], feet_quat_wxyz[s]
+        if heel_raised(ankle, quat):
+            out.add(s)
+            continue
+        forward = sole_corners_world(ankle, quat)
+        ahead = 0.5 * (forward[0] + forward[1]) - 0.5 * (forward[2] + forward[3])  # the sole's forward axis, scaled
+        ahead_xy = ahead[:2] / max(float(np.hypot(ahead[0], ahead[1])), 1e-9)
+        if stretch[s] >= stretch_share and float((com_world[:2] - ankle[:2]) @ ahead_xy) >= BEHIND_BODY_M:
+            out.add(s)
+    return out

@@ -1,0 +1,157 @@
+"""A rear sole on its toes (control/toe_contact.py): its rows keep the toe line where it is and leave the turn about
+it free, its forces act at the front corners, a QP with it obeys the dynamics, and which feet go onto their toes."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from stylesync import rotations as rot
+from stylesync.config import ConfigError, WholeBodyConfig, WorldConfig
+from stylesync.control.contacts import SOLE_CORNERS_IN_SOLE, SoleContact
+from stylesync.control.formulation import WholeBodyFormulation
+from stylesync.control.solver import DaqpSolver
+from stylesync.control.tasks import JointPostureTask
+from stylesync.control.toe_contact import (
+    CONSTRAINT_ROWS,
+    FORCES_PER_TOE,
+    HEEL_RAISED_M,
+    ToeContact,
+    heel_raised,
+    toe_off_sides,
+)
+from stylesync.control.whole_body import _TORQUE_LIMIT_FLAT
+from stylesync.model.character import ANKLE_HEIGHT_M, N_DOFS, ROOT_DOFS, STANDING_ROOT_HEIGHT_M
+from stylesync.model.character_model import CharacterModel
+from stylesync.sim.pybullet_backend import PyBulletBackend
+
+
+@pytest.fixture(scope="module")
+def standing():
+    backend = PyBulletBackend(WorldConfig(), 600.0)
+    backend.reset(np.array([0.0, 0.0, STANDING_ROOT_HEIGHT_M]), rot.quat_from_axis_angle(np.array([0, 0, 1.0]), 0.6))
+    for _ in range(300):
+        backend.step()
+    model = CharacterModel(backend.body_description(), 9.8)
+    model.update(backend.read_state(0.5))
+    yield model
+    backend.close()
+
+
+def _toe_mid_world(model: CharacterModel, frame: int) -> np.ndarray:
+    p = model.frame_placement(frame)
+    return p.translation + p.rotation @ SOLE_CORNERS_IN_SOLE[:2].mean(axis=0)
+
+
+def test_the_rows_are_the_toe_lines_velocity_and_leave_its_turn_free(standing):
+    """At a random velocity, the rows times v are the toe line's midpoint velocity (finite differences of the
+    configuration) and the sole's angular velocity about its forward axis and the vertical; a turn of the sole about
+    its own lateral axis alone meets the angular rows with zero."""
+    model = standing
+    q0, v0 = model.q.copy(), model.v.copy()
+    contact = ToeContact("left", 0.9, 45.0 * 9.8)
+    contact.update(model)
+    f = model.frame_id(contact.frame)
+    rows, _ = contact.constraint_rows(10.0)
+    assert rows.shape == (CONSTRAINT_ROWS, N_DOFS)
+    rng = np.random.default_rng(1)
+    v_pin = rng.normal(size=model.nv)  # Pinocchio's layout
+    v_ours = v_pin.take(model._perm)
+    dt = 1e-7
+    p0 = _toe_mid_world(model, f)
+    r0 = model.frame_placement(f).rotation.copy()
+    model.update_qv(pin.integrate(model.model, q0, v_pin * dt), v0)
+    p1 = _toe_mid_world(model, f)
+    r1 = model.frame_placement(f).rotation.copy()
+    model.update_qv(q0, v0)
+    np.testing.assert_allclose(rows[:3] @ v_ours, (p1 - p0) / dt, rtol=1e-5, atol=1e-5)
+    omega = pin.log3(r1 @ r0.T) / dt  # world axes
+    np.testing.assert_allclose(rows[3:] @ v_ours, [r0[:, 0] @ omega, omega[2]], rtol=1e-5, atol=1e-5)
+    lateral = r0[:, 1]
+    pitch_only = np.concatenate([np.zeros(3), lateral])
+    jac_ang = contact.jacobian[3:]
+    v_pitch = np.linalg.lstsq(jac_ang, pitch_only[3:], rcond=None)[0]  # some joint motion turning the sole so
+    np.testing.assert_allclose(jac_ang @ v_pitch, lateral, atol=1e-9)
+    np.testing.assert_allclose(rows[3:] @ v_pitch, [0.0, lateral[2]], atol=1e-9)
+    assert abs(lateral[2]) < 0.1  # a foot flat on the ground: its lateral axis is near horizontal
+
+
+def test_the_forces_act_at_the_front_corners(standing):
+    """The generator's columns are the front corners' Jacobians (the sole's, moved to the corner) times the pyramid
+    edges; the normal row sums their normal parts."""
+    model = standing
+    contact = ToeContact("right", 0.9, 45.0 * 9.8)
+    contact.update(model)
+    assert contact.generator.shape == (N_DOFS, FORCES_PER_TOE)
+    placement = model.frame_placement(model.frame_id(contact.frame))
+    for c in range(2):
+        lever = placement.rotation @ SOLE_CORNERS_IN_SOLE[c]
+        np.testing.assert_allclose(contact.corners_world[c], placement.translation + lever, atol=1e-12)
+        skew = np.array([[0, -lever[2], lever[1]], [lever[2], 0, -lever[0]], [-lever[1], lever[0], 0]])
+        j_corner = contact.jacobian[:3] - skew @ contact.jacobian[3:]
+        for e in range(4):
+            np.testing.assert_allclose(contact.generator[:, 4 * c + e], j_corner.T @ contact.edges[e], atol=1e-9)
+    assert contact.normal_row @ np.ones(FORCES_PER_TOE) == pytest.approx(2 * contact.edges[:, 2].sum())
+
+
+def test_a_qp_with_one_sole_on_its_toes_obeys_the_dynamics_and_the_contacts(standing):
+    """One flat sole and one on its toes: the solution satisfies the root's equations of motion, the toe line's rows
+    and the flat sole's, with forces inside the pyramids that push on the body (sinking onto its feet)."""
+    model = standing
+    formulation = WholeBodyFormulation(_TORQUE_LIMIT_FLAT, (), 10.0, 0.05)
+    posture = formulation.add_task(JointPostureTask(10.0, 0.05))
+    posture.desired_accel = np.zeros(N_DOFS - ROOT_DOFS)
+    contacts = [SoleContact("left", 0.9, 45.0 * 9.8), ToeContact("right", 0.9, 45.0 * 9.8)]
+    problem = formulation.build(model, contacts)
+    assert problem.n_eq == ROOT_DOFS + 6 + CONSTRAINT_ROWS
+    assert problem.H.shape == (N_DOFS + 16 + FORCES_PER_TOE,) * 2
+    result = DaqpSolver().solve(problem)
+    assert result.solved
+    qdd, lam = result.x[:N_DOFS], result.x[N_DOFS:]
+    gen = np.hstack([c.generator for c in contacts])
+    residual = model.mass_matrix @ qdd + model.bias_forces - gen @ lam
+    np.testing.assert_allclose(residual[:ROOT_DOFS], 0.0, atol=1e-6)
+    for c in contacts:
+        jac, acc = c.constraint_rows(10.0)
+        np.testing.assert_allclose(jac @ qdd, acc, atol=1e-6)
+    assert lam.min() >= -1e-9
+    normal = float(contacts[0].normal_row @ lam[:16]) + float(contacts[1].normal_row @ lam[16:])
+    assert normal > 0.1 * model.total_mass_kg * 9.8  # the soles push on the sinking body
+
+
+def _flat_foot(x: float, y: float, yaw: float = 0.0, pitch: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    q = rot.multiply(rot.quat_from_axis_angle(np.array([0.0, 0.0, 1.0]), yaw),
+                     rot.quat_from_axis_angle(np.array([0.0, 1.0, 0.0]), pitch))
+    return np.array([x, y, ANKLE_HEIGHT_M]), q
+
+
+def test_which_feet_go_onto_their_toes():
+    """On two feet, the stretched leg behind the body goes onto its toes, the front one and a bent rear leg do not;
+    on one foot none does; a raised heel stays on its toes while both feet support."""
+    left, ql = _flat_foot(0.0, 0.1)
+    right, qr = _flat_foot(0.6, -0.1)
+    ankles, quats = {"left": left, "right": right}, {"left": ql, "right": qr}
+    com = np.array([0.45, 0.0, 0.8])
+    both = ["left", "right"]
+    assert toe_off_sides(both, {"left": 0.99, "right": 0.99}, com, ankles, quats, 0.97) == {"left"}
+    assert toe_off_sides(both, {"left": 0.95, "right": 0.99}, com, ankles, quats, 0.97) == set()
+    assert toe_off_sides(["left"], {"left": 0.99}, com, ankles, quats, 0.97) == set()
+    # Turned round (the body goes the other way): the left foot is in front, the right one behind the body
+    turned = {s: rot.quat_from_axis_angle(np.array([0.0, 0.0, 1.0]), np.pi) for s in both}
+    com_back = np.array([0.15, 0.0, 0.8])
+    assert toe_off_sides(both, {"left": 0.99, "right": 0.99}, com_back, ankles, turned, 0.97) == {"right"}
+    # A heel raised by 20° about the lateral axis (the toes down): on its toes whatever its leg
+    _, raised = _flat_foot(0.0, 0.1, pitch=np.radians(20.0))
+    assert heel_raised(left, raised) and not heel_raised(left, ql)
+    assert toe_off_sides(both, {"left": 0.5, "right": 0.5}, com, ankles, {"left": raised, "right": qr},
+                         0.97) == {"left"}
+    assert HEEL_RAISED_M > 0
+
+
+def test_the_setting_is_checked():
+    assert WholeBodyConfig().toe_off_leg_stretch is None
+    with pytest.raises(ConfigError):
+        WholeBodyConfig(toe_off_leg_stretch=0.0)
+    with pytest.raises(ConfigError):
+        WholeBodyConfig(toe_off_leg_stretch=float("nan"))
