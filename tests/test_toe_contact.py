@@ -3,12 +3,15 @@ it free, its forces act at the front corners, a QP with it obeys the dynamics, a
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pinocchio as pin
 import pytest
+from conftest import suite_run
 
 from stylesync import rotations as rot
-from stylesync.config import ConfigError, WholeBodyConfig, WorldConfig
+from stylesync.config import ConfigError, ControlConfig, MotionConfig, WholeBodyConfig, WorldConfig, follow_path
 from stylesync.control.contacts import SOLE_CORNERS_IN_SOLE, SoleContact
 from stylesync.control.formulation import WholeBodyFormulation
 from stylesync.control.solver import DaqpSolver
@@ -128,7 +131,7 @@ def _flat_foot(x: float, y: float, yaw: float = 0.0, pitch: float = 0.0) -> tupl
 
 def test_which_feet_go_onto_their_toes():
     """On two feet, the stretched leg behind the body goes onto its toes, the front one and a bent rear leg do not;
-    on one foot none does; a raised heel stays on its toes while both feet support."""
+    on one foot none does; a raised heel behind the body stays on its toes, a raised heel in front does not."""
     left, ql = _flat_foot(0.0, 0.1)
     right, qr = _flat_foot(0.6, -0.1)
     ankles, quats = {"left": left, "right": right}, {"left": ql, "right": qr}
@@ -146,6 +149,9 @@ def test_which_feet_go_onto_their_toes():
     assert heel_raised(left, raised) and not heel_raised(left, ql)
     assert toe_off_sides(both, {"left": 0.5, "right": 0.5}, com, ankles, {"left": raised, "right": qr},
                          0.97) == {"left"}
+    _, raised_front = _flat_foot(0.6, -0.1, pitch=np.radians(20.0))
+    assert toe_off_sides(both, {"left": 0.5, "right": 0.5}, com, ankles, {"left": ql, "right": raised_front},
+                         0.97) == set()
     assert HEEL_RAISED_M > 0
 
 
@@ -155,3 +161,43 @@ def test_the_setting_is_checked():
         WholeBodyConfig(toe_off_leg_stretch=0.0)
     with pytest.raises(ConfigError):
         WholeBodyConfig(toe_off_leg_stretch=float("nan"))
+    with pytest.raises(ConfigError):
+        WholeBodyConfig(toe_off_min_way_speed_mps=-0.1)
+
+
+MOCAP = Path(__file__).resolve().parents[2] / "shared" / "mocap"
+WALK = MOCAP / "deepmimic" / "humanoid3d_walk.txt"
+
+
+def _walk_pelvis(stretch: float | None) -> tuple[bool, float, int]:
+    """The development suite's walk, seed 2, with --follow-path's settings for 3.4 s and toe_off_leg_stretch
+    ``stretch``: whether it fell, its pelvis's lowest height from 2.6 s on [m], and the ticks with a sole on its
+    toes."""
+    low, toes = [np.inf], [0]
+
+    def watch(session):
+        def tick(state, ref):
+            if state.time_s >= 2.6:
+                low[0] = min(low[0], float(state.root_pos_world[2]))
+            toes[0] += bool(session.controller.on_toes)
+        return tick
+
+    def configure(cfg):
+        return follow_path(cfg).replace(duration_s=3.4)
+
+    control = ControlConfig(whole_body=WholeBodyConfig(toe_off_leg_stretch=stretch))
+    result = suite_run(f"deepmimic:{WALK}", 2, MotionConfig(), control, watch=watch, configure=configure)
+    return result.fell, low[0], toes[0]
+
+
+@pytest.mark.skipif(not WALK.exists(), reason="../shared/mocap/deepmimic is not present")
+def test_a_rear_foot_on_its_toes_keeps_the_pelvis_up_in_a_long_stride():
+    """Traced on this walk: with flat soles the rear leg is straight from 2.77 s to its lift-off at 3.04 s while the
+    pelvis passes over it, and the pelvis comes down from 0.81 m to below 0.7 m; with the rear sole on its toes its
+    heel rises and the pelvis stays 8 cm or more higher. Neither falls."""
+    flat_fell, flat_low, flat_toes = _walk_pelvis(None)
+    toe_fell, toe_low, toe_toes = _walk_pelvis(0.97)
+    assert not flat_fell and not toe_fell
+    assert flat_toes == 0 and toe_toes > 10
+    assert flat_low < 0.7, flat_low
+    assert toe_low > flat_low + 0.08, (toe_low, flat_low)

@@ -576,6 +576,9 @@ class WholeBodyConfig:
     # brought it down by 0.1-0.15 m in a long stride (docs/decisions.md, "A rear foot on its toes"). None: the soles
     # stay flat [-]
     toe_off_leg_stretch: float | None = None
+    # ... while the operator goes somewhere at least this fast (ReferencePose.his_way_speed_mps): a gait's heel-off,
+    # not a stretched leg in a jump's landing or a lunge on the spot [m/s]
+    toe_off_min_way_speed_mps: float = 0.3
 
     def __post_init__(self) -> None:
         for n in ("joint_tracking_omega_rad_s", "joint_tracking_damping_ratio", "momentum_moment_weight_per_m",
@@ -585,7 +588,7 @@ class WholeBodyConfig:
                   "contact_velocity_gain", "sole_contact_gap_m", "joint_tracking_weight", "hand_task_kp",
                   "hand_task_kd", "hand_task_weight", "stance_leg_tracking_share", "single_stance_pelvis_share",
                   "recovery_foot_task_kp", "recovery_foot_task_kd", "recovery_foot_task_weight",
-                  "recovery_foot_landing_weight", "pelvis_rate_share"):
+                  "recovery_foot_landing_weight", "pelvis_rate_share", "toe_off_min_way_speed_mps"):
             _non_negative(f"WholeBodyConfig.{n}", getattr(self, n))
         if self.joint_speed_limit_rad_s is not None:
             _positive("WholeBodyConfig.joint_speed_limit_rad_s", self.joint_speed_limit_rad_s)

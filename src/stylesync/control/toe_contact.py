@@ -12,8 +12,7 @@ front leg, through the next single stance (docs/decisions.md, "A rear foot on it
 and keeps the toe line where it is: the toe line's midpoint does not move (3 rows) and the sole does not turn about
 its forward axis or the vertical (2 rows); its turn about the toe line (its lateral axis) is free, so the heel rises
 as the leg asks. :func:`toe_off_sides` decides which supporting foot stands so: on two feet, the foot behind the
-body whose leg is stretched to ``stretch_share`` of its length (hip to ankle), and a foot whose heel is still raised
-while both feet support.
+body whose leg is stretched to ``stretch_share`` of its length (hip to ankle) or whose heel is raised already.
 """
 
 from __future__ import annotations
@@ -97,20 +96,19 @@ def heel_raised(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray) -> bool:
 def toe_off_sides(support: list[str], stretch: dict[str, float], com_world: np.ndarray,
                   ankles_world: dict[str, np.ndarray], feet_quat_wxyz: dict[str, np.ndarray],
                   stretch_share: float) -> set[str]:
-    """The supporting feet that stand on their toes this tick. Only on two feet: a foot whose heel is raised, and the
-    foot behind the body (the COM at least BEHIND_BODY_M ahead of its ankle along the foot's forward axis) whose leg
-    is stretched to ``stretch_share`` of its length or more (``stretch``: hip to ankle over the leg's length)."""
+    """The supporting feet that stand on their toes this tick: only on two feet, the foot behind the body (the COM at
+    least BEHIND_BODY_M ahead of its ankle along the foot's forward axis) whose leg is stretched to ``stretch_share``
+    of its length or more (``stretch``: hip to ankle over the leg's length) or whose heel is raised already."""
     if len(support) != 2:
         return set()
     out = set()
     for s in support:
         ankle, quat = ankles_world[s], feet_quat_wxyz[s]
-        if heel_raised(ankle, quat):
-            out.add(s)
-            continue
-        forward = sole_corners_world(ankle, quat)
-        ahead = 0.5 * (forward[0] + forward[1]) - 0.5 * (forward[2] + forward[3])  # the sole's forward axis, scaled
+        corners = sole_corners_world(ankle, quat)
+        ahead = 0.5 * (corners[0] + corners[1]) - 0.5 * (corners[2] + corners[3])  # the sole's forward axis, scaled
         ahead_xy = ahead[:2] / max(float(np.hypot(ahead[0], ahead[1])), 1e-9)
-        if stretch[s] >= stretch_share and float((com_world[:2] - ankle[:2]) @ ahead_xy) >= BEHIND_BODY_M:
+        if float((com_world[:2] - ankle[:2]) @ ahead_xy) < BEHIND_BODY_M:
+            continue
+        if stretch[s] >= stretch_share or heel_raised(ankle, quat):
             out.add(s)
     return out

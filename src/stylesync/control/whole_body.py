@@ -187,7 +187,8 @@ class WholeBodyController(ControllerBase):
             f_lipm = bounded_lipm_sync_force(ref.lipm, m, self.g, cfg.lipm_force_limit_n, cfg.enforce_bounds,
                                              self.bounds, state.time_s)
             force += f_lipm
-        self.on_toes = self._toe_off(state, support, com)
+        self.on_toes = (self._toe_off(state, support, com) if ref.his_way_speed_mps >= wb.toe_off_min_way_speed_mps
+                        else set())
         contacts = [self.toe_contacts[s] if s in self.on_toes else self.contacts[s] for s in support]
         for c in contacts:
             c.stance_weight = w[c.side]

@@ -1080,6 +1080,8 @@ class MotionOptimizer:
             recovery_ankle_vel_world=None if own is None or step is None else {own: step.target_vel_world},
             recovery_while_he_stands=self.char_fsm.recovery_step and self._operator_stands(tick),
             pelvis_vel_z_mps=tick.pelvis_vel_z,
+            his_way_speed_mps=min(float(np.hypot(*self.way.velocity_world[:2])),
+                                  tick.scale * float(np.hypot(tick.com_vel_h[0], tick.com_vel_h[1]))),
         )
 
     @staticmethod

@@ -49,6 +49,9 @@ class ReferencePose:
     # The pelvis target's vertical speed: the operator's pelvis's, scaled (Eq. 9), smoothed; 0 while the target is
     # lowered for a foot to reach the ground [m/s]
     pelvis_vel_z_mps: float = 0.0
+    # How fast the operator goes somewhere over the ground: the lower of his way's average speed (operator_way.py)
+    # and his COM's horizontal speed now, scaled (a gait, not a stand, a sway or a jump in place) [m/s]
+    his_way_speed_mps: float = 0.0
 
 
 @dataclass(frozen=True)
