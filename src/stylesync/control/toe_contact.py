@@ -3,10 +3,10 @@
 Walking, a person's rear heel rises before the rear foot lifts (heel-off, late in the stance): the foot turns about
 the line of its toes, the leg is the foot's length longer, and the pelvis need not come down as the body passes over
 the front foot. A flat sole contact (contacts.py) holds the whole sole on the ground: a rear leg stretched to its
-full length then pins the pelvis to the arc of a straight leg about the rear ankle. Traced on the built-in walk with
-``--follow-path`` (seed 2): the rear leg straight (hip to ankle 1.00 of its length) from 2.77 s to the lift-off at
-3.04 s while the pelvis went 0.21 m forward over it and came down from 0.81 m to 0.68 m, and stayed there, on a bent
-front leg, through the next single stance (docs/decisions.md, "A rear foot on its toes").
+full length then pins the pelvis to the arc of a straight leg about the rear ankle. Traced on the development
+suite's walk with ``--follow-path`` (seed 2): the rear leg straight (hip to ankle 1.00 of its length) from 2.77 s to
+the lift-off at 3.04 s while the pelvis went 0.21 m forward over it and came down from 0.81 m to 0.67 m, and stayed
+there, on a bent front leg, through the next single stance (docs/decisions.md, "A rear foot on its toes").
 
 :class:`ToeContact` passes forces at the sole's two front corners only (their friction pyramids, as contacts.py's)
 and keeps the toe line where it is: the toe line's midpoint does not move (3 rows) and the sole does not turn about
