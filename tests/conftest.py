@@ -20,21 +20,35 @@ TRACED_BEFORE_LANDING_WEIGHT = ControlConfig(whole_body=WholeBodyConfig(
 TRACED_DIFFERENCED = ControlConfig(whole_body=WholeBodyConfig(recovery_foot_target_rate="differenced"))
 
 
-@pytest.fixture(scope="module")
-def standing():
-    """(backend, model): the character standing on flat ground after 0.5 s at 600 Hz, its model updated there (one
-    per test module)."""
+def _standing(root_quat_wxyz: np.ndarray):
+    """(backend, model): the character put on flat ground with the root orientation ``root_quat_wxyz`` and left
+    0.5 s at 600 Hz, its model updated there; the backend is closed when the generator ends."""
     from stylesync.model.character_model import CharacterModel
     from stylesync.sim.pybullet_backend import PyBulletBackend
 
     backend = PyBulletBackend(WorldConfig(), 600.0)
-    backend.reset(np.array([0.0, 0.0, STANDING_ROOT_HEIGHT_M]), rot.IDENTITY_WXYZ)
+    backend.reset(np.array([0.0, 0.0, STANDING_ROOT_HEIGHT_M]), root_quat_wxyz)
     for _ in range(300):
         backend.step()
     model = CharacterModel(backend.body_description(), 9.8)
     model.update(backend.read_state(0.5))
     yield backend, model
     backend.close()
+
+
+@pytest.fixture(scope="module")
+def standing():
+    """(backend, model): the character standing on flat ground after 0.5 s at 600 Hz, its model updated there (one
+    per test module)."""
+    yield from _standing(rot.IDENTITY_WXYZ)
+
+
+@pytest.fixture(scope="module")
+def turned_model():
+    """The model of the character put on flat ground turned by 0.6 rad about the vertical and left 0.5 s at 600 Hz
+    (sinking onto its feet; one per test module)."""
+    for _, model in _standing(rot.quat_from_axis_angle(np.array([0, 0, 1.0]), 0.6)):
+        yield model
 
 
 def random_pose(seed: int, ball_sigma_rad: float = 0.3, hinge_rad: float = 0.6) -> np.ndarray:

@@ -8,8 +8,6 @@ import numpy as np
 import pytest
 from scipy.optimize import nnls
 
-from stylesync import rotations as rot
-from stylesync.config import WorldConfig
 from stylesync.control.contacts import REGULARISATION, SOLE_CORNERS_IN_SOLE, SoleContact, pyramid_edges
 from stylesync.control.formulation import WholeBodyFormulation
 from stylesync.control.sole_wrench_contact import (
@@ -21,21 +19,7 @@ from stylesync.control.sole_wrench_contact import (
 from stylesync.control.solver import DaqpSolver
 from stylesync.control.tasks import JointPostureTask
 from stylesync.control.whole_body import _TORQUE_LIMIT_FLAT
-from stylesync.model.character import N_DOFS, ROOT_DOFS, STANDING_ROOT_HEIGHT_M
-from stylesync.model.character_model import CharacterModel
-from stylesync.sim.pybullet_backend import PyBulletBackend
-
-
-@pytest.fixture(scope="module")
-def standing():
-    backend = PyBulletBackend(WorldConfig(), 600.0)
-    backend.reset(np.array([0.0, 0.0, STANDING_ROOT_HEIGHT_M]), rot.quat_from_axis_angle(np.array([0, 0, 1.0]), 0.6))
-    for _ in range(300):
-        backend.step()
-    model = CharacterModel(backend.body_description(), 9.8)
-    model.update(backend.read_state(0.5))
-    yield model
-    backend.close()
+from stylesync.model.character import N_DOFS, ROOT_DOFS
 
 
 def test_the_cone_holds_exactly_what_the_corner_pyramids_give():
@@ -76,11 +60,11 @@ def test_the_regularisation_is_the_least_norm_corner_forces():
     assert np.count_nonzero(h[:2]) == 0 and np.count_nonzero(h[:, :2]) == 0
 
 
-def test_a_qp_with_wrench_contacts_obeys_the_dynamics_the_contacts_and_the_cone(standing):
+def test_a_qp_with_wrench_contacts_obeys_the_dynamics_the_contacts_and_the_cone(turned_model):
     """A character turned by 0.6 rad, sinking onto its feet: the solution's torques and wrenches satisfy the
     equations of motion, the soles do not accelerate, each wrench is inside its sole's cone turned with the sole,
     and the soles push as hard as the corner pyramids' QP of the same state has them push."""
-    model = standing
+    model = turned_model
     formulation = WholeBodyFormulation(_TORQUE_LIMIT_FLAT, (), 10.0, 0.05)
     posture = formulation.add_task(JointPostureTask(10.0, 0.05))
     posture.desired_accel = np.zeros(N_DOFS - ROOT_DOFS)

@@ -155,33 +155,37 @@ class SoleContactBase(ABC):
 
 
 class SoleContact(SoleContactBase):
-    """A sole whose force variables are the magnitudes λ of the unit forces along its four corners' friction pyramids
-    (world axes)."""
+    """A sole whose force variables are the magnitudes λ of the unit forces along its corners' friction pyramids
+    (world axes): its four corners (``corners_in_sole``, relative to the sole's centre in the foot's frame; a
+    subclass may stand on fewer, toe_contact.py)."""
 
-    n_forces = FORCES_PER_SOLE
+    corners_in_sole = SOLE_CORNERS_IN_SOLE
+    n_forces = FORCES_PER_SOLE  # 4 pyramid edges per corner
     force_rows_constant = True  # λ >= 0: unit rows
 
     def __init__(self, side: str, friction: float, body_weight_n: float):
         super().__init__(side, body_weight_n)
+        k = len(self.corners_in_sole)
         self.edges = pyramid_edges(friction)  # (4, 3)
-        self.force_rows = np.eye(FORCES_PER_SOLE)
-        self.force_lower, self.force_upper = np.zeros(FORCES_PER_SOLE), np.full(FORCES_PER_SOLE, INFINITY)
-        # Normal components of the 16 unit forces (the same at every corner): Σ_e n_e λ_e is the normal force.
-        self.normal_row = np.tile(self.edges[:, 2], 4)
-        self._forces = np.tile(self.edges.T, 4)  # (3, 16): the unit forces, corner by corner, edge by edge
-        # The map (3 * 16, 4 corners x 3) from the four corners' levers r_c, stacked, to every unit force's moment
-        # r_c × β_e, (3, 16) flattened: corner by corner, edge by edge as in _forces.
-        lever_to_moments = np.zeros((3, FORCES_PER_SOLE, 4, 3))
-        for c in range(4):
+        self.force_rows = np.eye(self.n_forces)
+        self.force_lower, self.force_upper = np.zeros(self.n_forces), np.full(self.n_forces, INFINITY)
+        # Normal components of the unit forces (the same at every corner): Σ_e n_e λ_e is the normal force.
+        self.normal_row = np.tile(self.edges[:, 2], k)
+        self._forces = np.tile(self.edges.T, k)  # (3, 4 k): the unit forces, corner by corner, edge by edge
+        self.corners_world = np.zeros((k, 3))
+        # The map (3 * 4 k, k corners x 3) from the corners' levers r_c, stacked, to every unit force's moment
+        # r_c × β_e, (3, 4 k) flattened: corner by corner, edge by edge as in _forces.
+        lever_to_moments = np.zeros((3, self.n_forces, k, 3))
+        for c in range(k):
             for e, b in enumerate(self.edges):
                 lever_to_moments[:, 4 * c + e, c, :] = np.cross(np.eye(3), b).T  # K r = r × b
-        self._lever_to_moments = lever_to_moments.reshape(3 * FORCES_PER_SOLE, 12)
+        self._lever_to_moments = lever_to_moments.reshape(3 * self.n_forces, 3 * k)
 
     def _update_forces(self, placement: pin.SE3) -> None:
-        levers = SOLE_CORNERS_IN_SOLE @ placement.rotation.T  # (4, 3) corner - sole centre, world axes
+        levers = self.corners_in_sole @ placement.rotation.T  # (k, 3) corner - sole centre, world axes
         self.corners_world = placement.translation + levers
         # B = Σ_c J_cᵀ β_e = J_linᵀ β_e + J_angᵀ (r_c × β_e), corner by corner, edge by edge.
-        moments = (self._lever_to_moments @ levers.reshape(12)).reshape(3, FORCES_PER_SOLE)
+        moments = (self._lever_to_moments @ levers.reshape(-1)).reshape(3, self.n_forces)
         self.generator = self.jacobian[:3].T @ self._forces + self.jacobian[3:].T @ moments
 
     def add_regularisation(self, hessian: np.ndarray, start: int) -> None:

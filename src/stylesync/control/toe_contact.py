@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from stylesync.control.contacts import INFINITY, SOLE_CORNERS_IN_SOLE, SoleContactBase, pyramid_edges
+from stylesync.control.contacts import SOLE_CORNERS_IN_SOLE, SoleContact
 from stylesync.model.sole import sole_corners_world
 
 TOE_CORNERS = 2  # the sole's front-left and front-right corners (SOLE_CORNERS_IN_SOLE's first two rows)
@@ -34,63 +34,47 @@ HEEL_RAISED_M = 0.005
 BEHIND_BODY_M = 0.1
 
 
-def _skew(v: np.ndarray) -> np.ndarray:
-    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+class ToeContact(SoleContact):
+    """A sole standing on the line of its toes: forces at its two front corners (the pyramids of contacts.py), its
+    turn about that line free."""
 
-
-class ToeContact(SoleContactBase):
-    """A sole standing on the line of its toes: forces at its two front corners, its turn about that line free."""
-
+    corners_in_sole = SOLE_CORNERS_IN_SOLE[:TOE_CORNERS]
     n_forces = FORCES_PER_TOE
     n_rows = CONSTRAINT_ROWS
-    force_rows_constant = True  # λ >= 0: unit rows
-
-    def __init__(self, side: str, friction: float, body_weight_n: float):
-        super().__init__(side, body_weight_n)
-        self.edges = pyramid_edges(friction)  # (4, 3)
-        self.force_rows = np.eye(FORCES_PER_TOE)
-        self.force_lower, self.force_upper = np.zeros(FORCES_PER_TOE), np.full(FORCES_PER_TOE, INFINITY)
-        self.normal_row = np.tile(self.edges[:, 2], TOE_CORNERS)
-        self._forces = np.tile(self.edges.T, TOE_CORNERS)  # (3, 8): the unit forces, corner by corner
-        self.corners_world = np.zeros((TOE_CORNERS, 3))
-        self._rotation = np.eye(3)
+    _rotation = np.eye(3)  # the sole's axes at the last update (world from foot), replaced at each
 
     def _update_forces(self, placement: pin.SE3) -> None:
-        r = placement.rotation
-        self._rotation = r
-        levers = SOLE_CORNERS_IN_SOLE[:TOE_CORNERS] @ r.T  # (2, 3) corner - sole centre, world axes
-        self.corners_world = placement.translation + levers
-        # B = Σ_c J_cᵀ β_e = J_linᵀ β_e + J_angᵀ (r_c × β_e), corner by corner, edge by edge.
-        moments = np.concatenate([np.cross(lever, self.edges).T for lever in levers], axis=1)  # (3, 8)
-        self.generator = self.jacobian[:3].T @ self._forces + self.jacobian[3:].T @ moments
-
-    def add_regularisation(self, hessian: np.ndarray, start: int) -> None:
-        """Set ``ε λ²`` on the diagonal of the QP's ``hessian`` (n, n) from variable ``start`` on."""
-        n = len(hessian)
-        hessian.ravel()[start * (n + 1):(start + self.n_forces) * (n + 1):n + 1] = self.regularisation
+        super()._update_forces(placement)
+        self._rotation = placement.rotation.copy()  # the sole's axes, for its rows
 
     def constraint_rows(self, velocity_gain: float) -> tuple[np.ndarray, np.ndarray]:
         """The toe line stays: its midpoint p = o + r does not move (``a_p = a_o + α × r + ω × (ω × r)``, world axes)
         and the sole does not turn about its forward axis or the vertical; each with its residual velocity damped at
         ``velocity_gain``. (5, nv) rows and (5,) right-hand sides."""
-        r_world = self._rotation @ _TOE_MID_IN_SOLE
+        rotation = self._rotation
+        r_world = rotation @ _TOE_MID_IN_SOLE
         j_lin, j_ang = self.jacobian[:3], self.jacobian[3:]
         omega = self.velocity[3:]
-        j_point = j_lin - _skew(r_world) @ j_ang  # v_p = v_o + ω × r = v_o - [r]× ω
+        j_point = j_lin - pin.skew(r_world) @ j_ang  # v_p = v_o + ω × r = v_o - [r]× ω
         drift_point = self.drift[:3] + np.cross(self.drift[3:], r_world) + np.cross(omega, np.cross(omega, r_world))
         vel_point = self.velocity[:3] + np.cross(omega, r_world)
-        axes = np.array([self._rotation[:, 0], [0.0, 0.0, 1.0]])  # the sole's forward axis and the vertical
+        axes = np.array([rotation[:, 0], [0.0, 0.0, 1.0]])  # the sole's forward axis and the vertical
         rows = np.vstack([j_point, axes @ j_ang])
         rhs = np.concatenate([-drift_point - velocity_gain * vel_point,
                               -(axes @ self.drift[3:]) - velocity_gain * (axes @ omega)])
         return rows, rhs
 
 
+def _heel_above_toes_m(corners_world: np.ndarray) -> float:
+    """How much higher a sole's rear corners are than its front ones (sole_corners_world's order) [m]."""
+    z = corners_world[:, 2]
+    return float(0.5 * (z[2] + z[3]) - 0.5 * (z[0] + z[1]))
+
+
 def heel_raised(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray) -> bool:
     """Whether a foot's heel is higher than its toes by more than HEEL_RAISED_M (its sole's rear corners against its
     front ones)."""
-    z = sole_corners_world(ankle_world, foot_quat_wxyz)[:, 2]
-    return bool(0.5 * (z[2] + z[3]) - 0.5 * (z[0] + z[1]) > HEEL_RAISED_M)
+    return _heel_above_toes_m(sole_corners_world(ankle_world, foot_quat_wxyz)) > HEEL_RAISED_M
 
 
 def toe_off_sides(support: list[str], stretch: dict[str, float], com_world: np.ndarray,
@@ -103,12 +87,12 @@ def toe_off_sides(support: list[str], stretch: dict[str, float], com_world: np.n
         return set()
     out = set()
     for s in support:
-        ankle, quat = ankles_world[s], feet_quat_wxyz[s]
-        corners = sole_corners_world(ankle, quat)
+        ankle = ankles_world[s]
+        corners = sole_corners_world(ankle, feet_quat_wxyz[s])
         ahead = 0.5 * (corners[0] + corners[1]) - 0.5 * (corners[2] + corners[3])  # the sole's forward axis, scaled
         ahead_xy = ahead[:2] / max(float(np.hypot(ahead[0], ahead[1])), 1e-9)
         if float((com_world[:2] - ankle[:2]) @ ahead_xy) < BEHIND_BODY_M:
             continue
-        if stretch[s] >= stretch_share or heel_raised(ankle, quat):
+        if stretch[s] >= stretch_share or _heel_above_toes_m(corners) > HEEL_RAISED_M:
             out.add(s)
     return out

@@ -55,7 +55,9 @@ from stylesync.model.character import (
     N_JOINT_DOFS,
     Q_WORLD_MODEL,
     ROOT_DOFS,
+    SHANK_LENGTH_M,
     SIDES,
+    THIGH_LENGTH_M,
 )
 from stylesync.model.character_model import HAND_FRAMES, CharacterModel
 from stylesync.model.state import CharacterState, JointFeedback, MassProperties, Torques
@@ -66,6 +68,7 @@ from stylesync.motion.stance_fsm import swing_side
 log = logging.getLogger("stylesync.control")
 _FOOT_LINK = {s: LINK_NAMES.index(f"{s}_ankle") for s in SIDES}
 _HIP_LINK = {s: LINK_NAMES.index(f"{s}_hip") for s in SIDES}
+_LEG_LENGTH_M = THIGH_LENGTH_M + SHANK_LENGTH_M  # hip to ankle, straight [m]
 # Each leg's hip, knee and ankle DOFs, in the joint-DOF layout of the posture task.
 _LEG_DOFS = {s: np.concatenate([JOINT_DOF_START[k] + np.arange(JOINT_DOF_COUNT[k]) for k in LEG_JOINTS[s]])
              for s in SIDES}
@@ -153,8 +156,6 @@ class WholeBodyController(ControllerBase):
         self.contacts = {s: contact(s, friction, mass.total_kg * gravity_mps2) for s in SIDES}
         # A rear sole on its toes (WholeBodyConfig.toe_off_leg_stretch)
         self.toe_contacts = {s: ToeContact(s, friction, mass.total_kg * gravity_mps2) for s in SIDES}
-        self._leg_length_m = model.rest_distance("left_hip", "left_knee") + model.rest_distance("left_knee",
-                                                                                               "left_ankle")
         self.on_toes: set[str] = set()  # the supporting feet on their toes this tick
         self.solver = DaqpSolver()
 
@@ -285,7 +286,7 @@ class WholeBodyController(ControllerBase):
         if len(support) != 2 or share is None:
             return set()
         link, quat = state.link_origin_world, state.link_quat_wxyz
-        stretch = {s: float(np.linalg.norm(link[_HIP_LINK[s]] - link[_FOOT_LINK[s]])) / self._leg_length_m
+        stretch = {s: float(np.linalg.norm(link[_HIP_LINK[s]] - link[_FOOT_LINK[s]])) / _LEG_LENGTH_M
                    for s in support}
         return toe_off_sides(support, stretch, com_world, {s: link[_FOOT_LINK[s]] for s in support},
                              {s: quat[_FOOT_LINK[s]] for s in support}, share)
