@@ -63,6 +63,32 @@ def test_a_silent_stream_is_held_then_ends_the_run_cleanly(caplog):
     assert short.sim_duration_s == pytest.approx(2.5, abs=0.05) and not short.fell
 
 
+def test_ctrl_c_while_a_tick_is_recorded_drops_that_tick_and_the_summary_is_written(monkeypatch):
+    from stylesync.metrics.summary import summarize
+    from stylesync.session import Session, TickLog
+
+    # Ctrl-C arrives at the 200th tick's record, after its first columns and before the others.
+    calls = {"n": 0}
+    record = TickLog.add
+
+    def add_cut_short(self, **values):
+        calls["n"] += 1
+        if calls["n"] == 200:
+            first = dict(list(values.items())[:5])
+            record(self, **first)
+            raise KeyboardInterrupt
+        record(self, **values)
+
+    monkeypatch.setattr(TickLog, "add", add_cut_short)
+    session = Session(SessionConfig(duration_s=10.0), _ScriptedStream(gaps=[]))
+    session.finish_on_interrupt = True
+    result = session.run()
+    assert result.end_reason == "interrupted"
+    assert {len(v) for v in result.log.columns.values()} == {199}
+    m = summarize(result)
+    assert m["ended_by"] == "interrupted" and m["sync_lag_s"] is not None and json.dumps(m)
+
+
 def _bone_bundle(msgs, timetag=None):
     from stylesync.sources.vmc import osc_bundle
 

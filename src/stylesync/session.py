@@ -82,6 +82,14 @@ class TickLog:
     def array(self, key: str) -> np.ndarray:
         return np.asarray(self.columns.get(key, []), dtype=float)
 
+    def drop_partial_tick(self) -> int:
+        """Cut every column to the shortest one's length: a tick whose record an interrupt (Ctrl-C) cut short
+        between two columns is dropped whole. Returns the number of ticks kept."""
+        n = min((len(v) for v in self.columns.values()), default=0)
+        for values in self.columns.values():
+            del values[n:]
+        return n
+
 
 @dataclass
 class SessionResult:
@@ -305,6 +313,7 @@ class Session:
             if not self.finish_on_interrupt:
                 raise
             run.end_reason = "interrupted"  # the run ends here and its outputs are written
+            run.log.drop_partial_tick()  # the interrupt may have come while the tick was being recorded
             log.warning("interrupted at t=%.2f s: the run ends there", step * dt)
         finally:
             operator.close()
