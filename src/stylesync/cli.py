@@ -23,7 +23,7 @@ from stylesync.config import (
     SessionConfig,
     follow_path,
     free_swing,
-    track_rise,
+    no_track_rise,
 )
 from stylesync.errors import ConfigError, SourceError, StylesyncError
 from stylesync.files import write_atomically
@@ -174,17 +174,17 @@ def _demo(args: argparse.Namespace) -> int:
                                                       "lipm_time_sync": not args.no_lipm,
                                                       "follow_path": args.follow_path,
                                                       "free_swing": args.free_swing,
-                                                      "track_rise": args.track_rise}, args)
+                                                      "track_rise": not args.no_track_rise}, args)
 
 
 def _motion_options(cfg: SessionConfig, args: argparse.Namespace) -> SessionConfig:
-    """``cfg`` with the opt-ins asked for on the command line (--follow-path, --free-swing, --track-rise)."""
+    """``cfg`` with the options asked for on the command line (--follow-path, --free-swing, --no-track-rise)."""
     if args.follow_path:
         cfg = follow_path(cfg)
     if args.free_swing:
         cfg = free_swing(cfg)
-    if args.track_rise:
-        cfg = track_rise(cfg)
+    if args.no_track_rise:
+        cfg = no_track_rise(cfg)
     return cfg
 
 
@@ -215,7 +215,7 @@ def _run(args: argparse.Namespace) -> int:
                                                               "lipm_time_sync": not args.no_lipm,
                                                               "follow_path": args.follow_path,
                                                               "free_swing": args.free_swing,
-                                                              "track_rise": args.track_rise,
+                                                              "track_rise": not args.no_track_rise,
                                                               **opened.extras}, args)
 
 
@@ -324,9 +324,9 @@ def _add_session_args(p: argparse.ArgumentParser, out_default: str, realtime_hel
                    help="a swing foot follows the operator's while both stand balanced on the other foot, lifted "
                         "only with the weight over that ankle (a kick strikes); by default every swing goes to a "
                         "landing placed for balance")
-    p.add_argument("--track-rise", action="store_true",
-                   help="on both feet the pelvis rises as fast as the operator's (a jump off both feet is followed "
-                        "up; by default the pelvis height's law damps every vertical speed; README, status)")
+    p.add_argument("--no-track-rise", action="store_true",
+                   help="the pelvis height's law damps every vertical speed, a jump's push included (by default it "
+                        "tracks half the operator's rise begun and kept on both feet; README, status)")
     p.add_argument("--record", type=typed.out_file, help="session file to write (default: OUT/session.jsonl)")
     p.add_argument("--progress", action="store_true", help="show a progress line (default: when on a terminal)")
     p.add_argument("--continue-after-fall", action="store_true",

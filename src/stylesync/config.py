@@ -351,6 +351,11 @@ class MotionConfig:
     # capture_bound_in_his_gait do not apply) and the character's own steps stop the body (no walk-on). None: any
     # double stance whose COM moves between his feet is a gait's [m/s].
     operator_way_time_s: float = 1.0
+    # His pelvis's upward speed handed on to the controller (ReferencePose.pelvis_vel_z_mps, tracked on both feet at
+    # WholeBodyConfig.pelvis_rate_share, 0 by default) only while he stands on both feet and began the rise on them:
+    # a jump's push, not a run's stride (his FSM passes through double stance in its flight) nor a vault onto one foot
+    # (motion/his_rise.py). False: his pelvis's rise whatever his stance.
+    rise_begun_on_both_feet: bool = True
     gait_min_way_speed_mps: float | None = None
     # Following the operator over the ground (motion/path_feedback.py): the swing's landing relative to the
     # character's capture point is moved so that a step removes this share of the capture point's error from his,
@@ -565,11 +570,12 @@ class WholeBodyConfig:
     # chain whose contact rows then ask for more than the limits allow, and the last iterate of the failed solve,
     # applied as torques, threw the limbs at 30-40 m/s (docs/decisions.md, "A QP with no feasible point")
     relax_limits_when_infeasible: bool = True
-    # The pelvis height's law also tracks the target's rise on both feet: force_z = m (kp (z_d - z) + kd (share ż_d -
-    # ż)), ż_d the operator's pelvis's upward speed scaled (Eq. 9; ReferencePose.pelvis_vel_z_mps). 0: the regulator
-    # as before, which damps every vertical speed: from a crouch before a jump the character rose over 0.7 s where he
-    # sprang up in 0.43 s (docs/decisions.md, "A jump's rise"; `--track-rise`: 0.5) [-]
-    pelvis_rate_share: float = 0.0
+    # The pelvis height's law also tracks this share of the target's rise on both feet: force_z = m (kp (z_d - z) +
+    # kd (share ż_d - ż)), ż_d the operator's pelvis's upward speed scaled (Eq. 9; ReferencePose.pelvis_vel_z_mps),
+    # handed on only for a jump's push (MotionConfig.rise_begun_on_both_feet). 0 (`--no-track-rise`): the regulator
+    # alone, which damps every vertical speed: from a crouch before a jump the character rose over 0.7 s where he
+    # sprang up in 0.43 s (docs/decisions.md, "A jump's rise", "A jump's push, begun on both feet") [-]
+    pelvis_rate_share: float = 0.5
     # A rear sole goes onto its toes (control/toe_contact.py): on two feet, the foot behind the body whose leg is
     # stretched to this share of its length (hip to ankle) or more stands on its toe line, its heel free to rise, as a
     # walker's heel rises before his rear foot lifts; held flat, a straight rear leg pinned the pelvis to its arc and
@@ -727,16 +733,16 @@ def free_swing(cfg: SessionConfig) -> SessionConfig:
     return cfg.replace(motion=dataclasses.replace(cfg.motion, **FREE_SWING_MOTION))
 
 
-# The opt-in that lets the pelvis rise with the operator's on both feet (docs/decisions.md, "A jump's rise"):
-# `--track-rise`.
-TRACK_RISE_WHOLE_BODY: dict[str, Any] = {
-    "pelvis_rate_share": 0.5,  # half his pelvis's rise is tracked; the regulator does the rest
+# The pelvis height's law without the operator's rise, the regulator alone (docs/decisions.md, "A jump's rise"):
+# `--no-track-rise`.
+NO_TRACK_RISE_WHOLE_BODY: dict[str, Any] = {
+    "pelvis_rate_share": 0.0,  # every vertical speed damped, his jump's push included
 }
 
 
-def track_rise(cfg: SessionConfig) -> SessionConfig:
-    """``cfg`` with TRACK_RISE_WHOLE_BODY."""
-    whole_body = dataclasses.replace(cfg.control.whole_body, **TRACK_RISE_WHOLE_BODY)
+def no_track_rise(cfg: SessionConfig) -> SessionConfig:
+    """``cfg`` with NO_TRACK_RISE_WHOLE_BODY."""
+    whole_body = dataclasses.replace(cfg.control.whole_body, **NO_TRACK_RISE_WHOLE_BODY)
     return cfg.replace(control=dataclasses.replace(cfg.control, whole_body=whole_body))
 
 

@@ -47,6 +47,7 @@ from stylesync.motion.balance_strategy import stance_hip_blend, swing_hip_feedba
 from stylesync.motion.bounds import BoundsMonitor, step_length_bound_m
 from stylesync.motion.capture_bound import bounded_com_target, landing_catch_region
 from stylesync.motion.double_stance_momentum import kept_com_velocity, moves_between_feet
+from stylesync.motion.his_rise import HisRise
 from stylesync.motion.leg_ik import solve_leg
 from stylesync.motion.operator_analysis import UPPER_JOINTS, OperatorAnalysis, analyse_operator, upper_local
 from stylesync.motion.operator_way import OperatorWay
@@ -240,6 +241,7 @@ class MotionOptimizer:
         self._com_d_rate = _SmoothedRate(self.dt_s)  # desired COM velocity [m/s]
         self._com_h_rate = _SmoothedRate(self.dt_s)  # operator COM velocity [m/s]
         self._pelvis_h_rate = _SmoothedRate(self.dt_s)  # operator pelvis velocity [m/s]
+        self._his_rise = HisRise() if cfg.rise_begun_on_both_feet else None  # his_rise.py
         self.way = OperatorWay(cfg.operator_way_time_s, self.dt_s)  # his way over the ground (operator_way.py)
         # only a gait's speed or a walk-on along his way reads it: otherwise it is not kept up each tick
         self._tracks_way = cfg.gait_min_way_speed_mps is not None or cfg.recovery_walk_on_his_way
@@ -517,6 +519,8 @@ class MotionOptimizer:
             pelvis_xy[:2], com_xy[:2] = self._ref_xy[0], self._ref_xy[1]
         tick.pelvis_d = np.array([pelvis_xy[0], pelvis_xy[1], ANKLE_HEIGHT_M + scale * (p_h[2] - ankle_h_z)])  # Eq. 9
         tick.pelvis_vel_z = scale * float(self._pelvis_h_rate(p_h)[2])
+        if self._his_rise is not None:
+            tick.pelvis_vel_z = self._his_rise.rise_mps(tick.pelvis_vel_z, tick.op_state is Stance.DS)
         # The operator's COM height reflects his own mass distribution, not the character's: the vertical is left
         # to the pelvis height (Eq. 9) through the leg IK, and the COM target keeps the character's own height.
         tick.com_d = np.array([com_xy[0], com_xy[1], com_c[2]])
