@@ -351,12 +351,12 @@ class MotionConfig:
     # capture_bound_in_his_gait do not apply) and the character's own steps stop the body (no walk-on). None: any
     # double stance whose COM moves between his feet is a gait's [m/s].
     operator_way_time_s: float = 1.0
-    # His pelvis's upward speed handed on to the controller (ReferencePose.pelvis_vel_z_mps, tracked on both feet at
-    # WholeBodyConfig.pelvis_rate_share, 0 by default) only while he stands on both feet and began the rise on them:
-    # a jump's push, not a run's stride (his FSM passes through double stance in its flight) nor a vault onto one foot
+    gait_min_way_speed_mps: float | None = None
+    # His pelvis's upward speed handed on to the controller (ReferencePose.pelvis_vel_z_mps, a share of it tracked on
+    # both feet, WholeBodyConfig.pelvis_rate_share) only while he stands on both feet and began the rise on them: a
+    # jump's push, not a run's stride (his FSM passes through double stance in its flight) nor a vault onto one foot
     # (motion/his_rise.py). False: his pelvis's rise whatever his stance.
     rise_begun_on_both_feet: bool = True
-    gait_min_way_speed_mps: float | None = None
     # Following the operator over the ground (motion/path_feedback.py): the swing's landing relative to the
     # character's capture point is moved so that a step removes this share of the capture point's error from his,
     # scaled onto the character's path from where both started (the divergent component of motion: 1 removes it
