@@ -95,9 +95,10 @@ needs_cmu_dev = pytest.mark.skipif(not (MOCAP / "cmu-dev").is_dir(),
 def test_a_chain_of_own_steps_in_the_rest_is_not_pushed_on(push_bound):
     """CMU-dev 08_08, seed 11 (traced): after the clip's end the operator stands; without the bound the character's
     own steps push its COM from 1.1 to 3 m/s (horizontally) and it falls 1.4 s into the rest. With the bound in the
-    steps taken while he stands (the default), it comes to rest."""
+    steps taken while he stands (the default), it comes to rest. Traced with the pelvis height's regulator alone
+    (WholeBodyConfig.pelvis_rate_share 0)."""
     speeds = []
-    control = ControlConfig(whole_body=WholeBodyConfig(own_step_push_bound=push_bound,
+    control = ControlConfig(whole_body=WholeBodyConfig(own_step_push_bound=push_bound, pelvis_rate_share=0.0,
                                                        recovery_foot_target_rate="differenced"))
 
     def watch(session):

@@ -281,12 +281,14 @@ def test_a_lift_off_waits_while_the_lifted_foot_is_the_only_one_down():
 # The controller the scenarios below were traced with: the supporting legs' posture and the pelvis at full weight
 # (before WholeBodyConfig.stance_leg_tracking_share and single_stance_pelvis_share). Each scenario is one clip and
 # seed on which a feature decides a fall; a change of the controller changes which runs fall, so the feature is
-# tested where its effect was traced, and the default controller where the test says "default".
+# tested where its effect was traced, and the default controller where the test says "default". All of them were
+# traced before the pelvis tracked a jump's push (WholeBodyConfig.pelvis_rate_share 0: the regulator alone).
 TRACED = ControlConfig(whole_body=WholeBodyConfig(stance_leg_tracking_share=1.0, single_stance_pelvis_share=1.0,
-                                                   recovery_foot_task_weight=0.0))
+                                                   recovery_foot_task_weight=0.0, pelvis_rate_share=0.0))
 # The default controller before WholeBodyConfig.single_stance_pelvis_share (and the recovery foot task), which
 # the scenarios of the stopping step and the overdue double stance were traced with.
-PELVIS_LEVEL = ControlConfig(whole_body=WholeBodyConfig(single_stance_pelvis_share=1.0, recovery_foot_task_weight=0.0))
+PELVIS_LEVEL = ControlConfig(whole_body=WholeBodyConfig(single_stance_pelvis_share=1.0, recovery_foot_task_weight=0.0,
+                                                        pelvis_rate_share=0.0))
 # ... and the motion stage's balance layer as it was then: recovery steps of 0.6 leg lengths, and a swing the
 # operator stops on not yet landed at once (with either, several of the traced falls come later or not at all).
 TRACED_MOTION = {"recovery_step_reach_share": 0.6, "recovery_on_stopping_step": False,
@@ -1206,7 +1208,8 @@ def test_a_recovery_foot_follows_its_swing_profiles_velocity_not_the_landings_re
     +-5 m/s), the task asked the leg for +-300 m/s² horizontally, the hip saturated, and the foot went up instead of
     down: it stayed 5-17 cm above the ground for 0.4 s past its due landing, and the run fell at 4.48 s (measured: the
     target velocity reversed at more than 2 m/s on 52 ticks). At the swing profile's own velocity, for the landing as
-    planned this tick, no tick reverses, and the run completes."""
+    planned this tick, no tick reverses, and the run completes. Traced with the pelvis height's regulator alone
+    (WholeBodyConfig.pelvis_rate_share 0)."""
 
     def run(rate: str):
         reversals = [0]
@@ -1224,7 +1227,7 @@ def test_a_recovery_foot_follows_its_swing_profiles_velocity_not_the_landings_re
                     last[side] = vel
             return tick
 
-        control = ControlConfig(whole_body=WholeBodyConfig(recovery_foot_target_rate=rate))
+        control = ControlConfig(whole_body=WholeBodyConfig(recovery_foot_target_rate=rate, pelvis_rate_share=0.0))
         result = suite_run("builtin:run", 14, MotionConfig(), control, watch=watch)
         return reversals[0], result
 
@@ -1343,7 +1346,8 @@ def test_a_recovery_step_whose_landing_is_due_is_pressed_onto_the_ground():
     (MotionConfig.fraction_needs_feet_in_his_order off), and with every recovery step's nominal time
     (MotionConfig.recovery_swing_min_s None: a step shortened to land before the capture point leaves the reach is due
     sooner, while its foot is still on its way, and that configuration's landings then wait up to 0.17 s), and before
-    a lift-off waited for the other foot to be down (MotionConfig.liftoff_needs_other_foot_down off)."""
+    a lift-off waited for the other foot to be down (MotionConfig.liftoff_needs_other_foot_down off), and before the
+    pelvis tracked a jump's push (WholeBodyConfig.pelvis_rate_share 0)."""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '08_08.bvh'}"
 
     def run(landing_weight: float):
@@ -1365,6 +1369,7 @@ def test_a_recovery_step_whose_landing_is_due_is_pressed_onto_the_ground():
                                                  fraction_needs_feet_in_his_order=False, recovery_swing_min_s=None,
                                                  liftoff_needs_other_foot_down=False),
                            ControlConfig(whole_body=WholeBodyConfig(recovery_foot_landing_weight=landing_weight,
+                                                                        pelvis_rate_share=0.0,
                                                                         recovery_foot_target_rate="differenced",
                                                                     joint_speed_limit_rad_s=None,
                                                                     own_step_push_bound="off")),

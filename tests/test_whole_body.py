@@ -284,10 +284,12 @@ def test_a_light_link_does_not_spin_up_within_a_control_tick():
     held over the control tick, spun the feet and hands to 26 m/s with the pelvis at 0.8 m: "the motion diverged"
     at 3.54 s (measured). With the joints' no-load speed the run completes its 12 s. Traced with Eq. 10's fraction
     by side after a step of the character's own (MotionConfig.fraction_needs_feet_in_his_order off) and every
-    recovery step's nominal time (MotionConfig.recovery_swing_min_s None)."""
+    recovery step's nominal time (MotionConfig.recovery_swing_min_s None), with the pelvis height's regulator alone
+    (WholeBodyConfig.pelvis_rate_share 0)."""
     def run(limit):
         control = ControlConfig(whole_body=WholeBodyConfig(joint_speed_limit_rad_s=limit, own_step_push_bound="off",
-                                                            recovery_foot_target_rate="differenced"))
+                                                            recovery_foot_target_rate="differenced",
+                                                            pelvis_rate_share=0.0))
         motion = MotionConfig(fraction_needs_feet_in_his_order=False, recovery_swing_min_s=None)
         return suite_run("builtin:dance_a", 2, motion, control)
 
