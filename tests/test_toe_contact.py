@@ -26,6 +26,7 @@ from stylesync.control.toe_contact import (
 from stylesync.control.whole_body import _TORQUE_LIMIT_FLAT
 from stylesync.model.character import ANKLE_HEIGHT_M, N_DOFS, ROOT_DOFS
 from stylesync.model.character_model import CharacterModel
+from stylesync.model.sole import sole_corners_world
 
 
 def _toe_mid_world(model: CharacterModel, frame: int) -> np.ndarray:
@@ -133,7 +134,7 @@ def test_which_feet_go_onto_their_toes():
     assert toe_off_sides(both, {"left": 0.99, "right": 0.99}, com_back, ankles, turned, 0.97) == {"right"}
     # A heel raised by 20° about the lateral axis (the toes down): on its toes whatever its leg
     _, raised = _flat_foot(0.0, 0.1, pitch=np.radians(20.0))
-    assert heel_raised(left, raised) and not heel_raised(left, ql)
+    assert heel_raised(sole_corners_world(left, raised)) and not heel_raised(sole_corners_world(left, ql))
     assert toe_off_sides(both, {"left": 0.5, "right": 0.5}, com, ankles, {"left": raised, "right": qr},
                          0.97) == {"left"}
     _, raised_front = _flat_foot(0.6, -0.1, pitch=np.radians(20.0))

@@ -65,16 +65,11 @@ class ToeContact(SoleContact):
         return rows, rhs
 
 
-def _heel_above_toes_m(corners_world: np.ndarray) -> float:
-    """How much higher a sole's rear corners are than its front ones (sole_corners_world's order) [m]."""
+def heel_raised(corners_world: np.ndarray) -> bool:
+    """Whether a sole's heel is higher than its toes by more than HEEL_RAISED_M: its rear corners against its front
+    ones, ``corners_world`` (4, 3) in sole_corners_world's order [m]."""
     z = corners_world[:, 2]
-    return float(0.5 * (z[2] + z[3]) - 0.5 * (z[0] + z[1]))
-
-
-def heel_raised(ankle_world: np.ndarray, foot_quat_wxyz: np.ndarray) -> bool:
-    """Whether a foot's heel is higher than its toes by more than HEEL_RAISED_M (its sole's rear corners against its
-    front ones)."""
-    return _heel_above_toes_m(sole_corners_world(ankle_world, foot_quat_wxyz)) > HEEL_RAISED_M
+    return bool(0.5 * (z[2] + z[3]) - 0.5 * (z[0] + z[1]) > HEEL_RAISED_M)
 
 
 def toe_off_sides(support: list[str], stretch: dict[str, float], com_world: np.ndarray,
@@ -93,6 +88,6 @@ def toe_off_sides(support: list[str], stretch: dict[str, float], com_world: np.n
         ahead_xy = ahead[:2] / max(float(np.hypot(ahead[0], ahead[1])), 1e-9)
         if float((com_world[:2] - ankle[:2]) @ ahead_xy) < BEHIND_BODY_M:
             continue
-        if stretch[s] >= stretch_share or _heel_above_toes_m(corners) > HEEL_RAISED_M:
+        if stretch[s] >= stretch_share or heel_raised(corners):
             out.add(s)
     return out
