@@ -28,6 +28,7 @@ def _exit_code(argv: list[str]) -> int:
     (["report", "/no/such/folder"], "folder"),
     (["inspect", "/no/such/file.bvh"], "file"),
     (["bench", "--seeds", "0"], "--seeds"),
+    (["bench", "--mirror"], "--mirror"),
     (["run", "--source", "builtin:walk", "--bvh-scale", "-0.01"], "--bvh-scale"),
     (["run", "--source", "vmc://127.0.0.1:99999", "--duration", "0.1"], "VMC port"),
 ])

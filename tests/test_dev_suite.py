@@ -35,6 +35,15 @@ def test_the_dev_suite_writes_one_row_per_category_and_controller(tmp_path, caps
     assert table(rows, ["stylesync"]).count("| kick |") == 1
 
 
+def test_the_dev_suite_runs_the_mirror_images_of_its_clips(tmp_path, capsys):
+    out = tmp_path / "mirrored"
+    assert cli_main(["bench", "--suite", "dev", "--only", "kick", "--seeds", "1", "--duration", "1.0",
+                     "--workers", "1", "--mirror", "--out", str(out)]) == 0
+    rows = json.loads((out / "dev_suite.json").read_text())
+    assert rows and all(r.get("mirror") is True and "error" not in r for r in rows)
+    assert (out / "dev_suite.md").read_text().startswith("Every clip mirrored left-right")
+
+
 def test_an_unknown_category_is_one_line(tmp_path, capsys):
     assert cli_main(["bench", "--suite", "dev", "--only", "swimming", "--out", str(tmp_path / "d")]) == 2
     err = capsys.readouterr().err.strip()

@@ -164,7 +164,7 @@ def _replay_viewer(args: argparse.Namespace, session) -> None:
 def _demo(args: argparse.Namespace) -> int:
     from stylesync.sources.builtin_operator import builtin_operator
 
-    operator = OperatorConfig(clip=args.clip, turn_rate_rad_s=args.turn_rate)
+    operator = OperatorConfig(clip=args.clip, turn_rate_rad_s=args.turn_rate, mirror=args.mirror)
     cfg = SessionConfig(duration_s=args.duration, seed=args.seed, gui=args.gui,
                         realtime=args.realtime or args.viewer != "none", operator=operator,
                         control=ControlConfig(lipm_time_sync=not args.no_lipm))
@@ -172,6 +172,7 @@ def _demo(args: argparse.Namespace) -> int:
     source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
     return _run_session(cfg, source, Path(args.out), {"clip": args.clip, "turn_rate_rad_s": args.turn_rate,
                                                       "lipm_time_sync": not args.no_lipm,
+                                                      "mirror": args.mirror,
                                                       "follow_path": args.follow_path,
                                                       "free_swing": args.free_swing,
                                                       "track_rise": not args.no_track_rise}, args)
@@ -209,10 +210,12 @@ def _run(args: argparse.Namespace) -> int:
     cfg = SessionConfig(duration_s=duration, seed=args.seed, gui=args.gui, stream_timeout_s=args.stream_timeout,
                         realtime=args.realtime or live or args.viewer != "none",
                         clocks=dataclasses.replace(clocks, mocap_hz=opened.mocap_hz),
-                        control=ControlConfig(lipm_time_sync=not args.no_lipm))
+                        control=ControlConfig(lipm_time_sync=not args.no_lipm),
+                        operator=OperatorConfig(mirror=args.mirror))
     cfg = _motion_options(cfg, args)
     return _run_session(cfg, opened.source, Path(args.out), {"source": args.source, "sensor": opened.sensor,
                                                               "lipm_time_sync": not args.no_lipm,
+                                                              "mirror": args.mirror,
                                                               "follow_path": args.follow_path,
                                                               "free_swing": args.free_swing,
                                                               "track_rise": not args.no_track_rise,
@@ -267,8 +270,11 @@ def _bench(args: argparse.Namespace) -> int:
             raise ConfigError(f"unknown categories {', '.join(unknown)}; expected some of {', '.join(ORDER)}")
         mocap = shared / "mocap"
         report = run_dev_suite(Path(args.out), args.seeds, args.duration, mocap if mocap.is_dir() else None, only,
-                               workers=args.workers, executor=args.executor, first_seed=args.seed)
+                               workers=args.workers, executor=args.executor, first_seed=args.seed,
+                               mirror=args.mirror)
     else:
+        if args.mirror:
+            raise ConfigError("--mirror is a dev-suite option: use it with --suite dev")
         report = run_bench(Path(args.out), args.duration, args.seed, shared if shared.is_dir() else None,
                            executor=args.executor or "inline", workers=args.workers)
     print(report["table"])
@@ -317,6 +323,9 @@ def _add_session_args(p: argparse.ArgumentParser, out_default: str, realtime_hel
     p.add_argument("--gui", action="store_true", help="open the PyBullet window")
     p.add_argument("--realtime", action="store_true", help=realtime_help)
     p.add_argument("--no-lipm", action="store_true", help="switch the LIPM time-sync compensation off (Eq. 21-23)")
+    p.add_argument("--mirror", action="store_true",
+                   help="the operator's mirror image drives the character (his right side its left), as a person "
+                        "facing it on a screen expects")
     p.add_argument("--follow-path", action="store_true",
                    help="keep to the operator's path over the ground (a recording starts at its speed); "
                         "falls more often (README, status)")
@@ -465,6 +474,9 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--seeds", type=typed.integer(1, 1000), default=2,
                        help="dev suite: sensor seeds SEED .. SEED+N-1")
     bench.add_argument("--only", help="dev suite: comma-separated categories (default: all)")
+    bench.add_argument("--mirror", action="store_true",
+                       help="dev suite: every clip's mirror image (left and right swapped), a second sample of what "
+                            "users bring")
     bench.add_argument("--workers", type=typed.integer(1, 256), default=2,
                        help="runs in parallel (with --executor processes or ray, and for the dev suite)")
     bench.add_argument("--executor", choices=("processes", "ray", "inline"),

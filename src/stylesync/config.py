@@ -663,6 +663,9 @@ class OperatorConfig:
     # that its root's horizontal speed is no more (None: the clip's as they are). A body started faster than its steps
     # can catch falls forward through them (docs/decisions.md) [m/s]
     start_speed_max_mps: float | None = None
+    # Every source's frames as their mirror image, his right side driving the character's left (sources/mirror.py):
+    # for a person facing the character on a screen, who expects it to move like his reflection.
+    mirror: bool = False
 
     def __post_init__(self) -> None:
         _positive("OperatorConfig.height_m", self.height_m)

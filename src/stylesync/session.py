@@ -46,6 +46,7 @@ from stylesync.sim.backend import PhysicsBackend
 from stylesync.sim.factory import make_backend
 from stylesync.sources.base import OperatorSource
 from stylesync.sources.frame import OperatorFrame
+from stylesync.sources.mirror import MirroredSource
 
 log = logging.getLogger("stylesync.session")
 FALL_ROOT_HEIGHT_M = 0.5  # a fall: pelvis below this height, or a non-foot link on the ground
@@ -141,7 +142,7 @@ class Session:
     def __init__(self, config: SessionConfig, source: OperatorSource, backend: PhysicsBackend | None = None,
                  on_tick: Callable[[CharacterState, object], None] | None = None):
         self.cfg = config
-        self.source = source
+        self.source = MirroredSource(source) if config.operator.mirror else source
         self._owns_backend = backend is None
         self.backend = backend or make_backend(config.world, config.clocks.physics_hz, gui=config.gui)
         self.mass = self.backend.mass_properties()

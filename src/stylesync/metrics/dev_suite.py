@@ -67,10 +67,12 @@ def clip_specs(mocap: Path | None) -> list[tuple[str, str, str]]:
     return [(spec, name, CATEGORIES.get(name, "other")) for spec, name in out]
 
 
-def suite_config(spec: str, opened: OpenedSource, seed: int, duration_s: float) -> tuple[SessionConfig, float]:
+def suite_config(spec: str, opened: OpenedSource, seed: int, duration_s: float,
+                 mirror: bool = False) -> tuple[SessionConfig, float]:
     """A suite run's configuration for the opened source ``spec`` (default settings, the source's frame rate, at
-    most ``duration_s``, the rest after a recorded file included) and the time its clip ends [s]."""
-    op = OperatorConfig()
+    most ``duration_s``, the rest after a recorded file included; ``mirror``: the operator's mirror image,
+    sources/mirror.py) and the time its clip ends [s]."""
+    op = OperatorConfig(mirror=mirror)
     length = min(duration_s, float(opened.duration_s or duration_s))
     in_motion = spec.startswith(("bvh:", "k4a-json:")) and op.start_in_motion
     clip_end = length - (min(op.rest_after_clip_s, length) if in_motion else 0.0)
@@ -79,9 +81,9 @@ def suite_config(spec: str, opened: OpenedSource, seed: int, duration_s: float) 
     return cfg, clip_end
 
 
-def run_clip(spec: str, seed: int, duration_s: float, controller: str) -> dict:
-    """One run of the suite: the clip through the Kinect sensor model with ``seed``; a clip that cannot be opened
-    gives ``{"error": ...}``."""
+def run_clip(spec: str, seed: int, duration_s: float, controller: str, mirror: bool = False) -> dict:
+    """One run of the suite: the clip through the Kinect sensor model with ``seed`` (``mirror``: its mirror image);
+    a clip that cannot be opened gives ``{"error": ...}``."""
     from stylesync.session import run_and_release
     from stylesync.sources.registry import open_source
 
@@ -91,7 +93,7 @@ def run_clip(spec: str, seed: int, duration_s: float, controller: str) -> dict:
         opened = open_source(spec, seed=seed, duration_s=duration_s)
     except StylesyncError as exc:
         return {"error": str(exc)[:200]}
-    cfg, clip_end = suite_config(spec, opened, seed, duration_s)
+    cfg, clip_end = suite_config(spec, opened, seed, duration_s, mirror)
     cfg = dataclasses.replace(cfg, control=control, motion=motion)
     result = run_and_release(cfg, opened.source)
     m = summarize(result)
@@ -102,9 +104,9 @@ def run_clip(spec: str, seed: int, duration_s: float, controller: str) -> dict:
 
 
 def _job(job: tuple) -> dict:
-    spec, name, cat, seed, controller, duration_s = job
+    spec, name, cat, seed, controller, duration_s, mirror = job
     return {"clip": name, "spec": spec, "category": cat, "seed": seed, "version": controller,
-            **run_clip(spec, seed, duration_s, controller)}
+            **({"mirror": True} if mirror else {}), **run_clip(spec, seed, duration_s, controller, mirror)}
 
 
 def _share(k: int, n: int) -> str:
@@ -163,23 +165,26 @@ def table(rows: list[dict], versions: list[str]) -> str:
 
 def run_dev_suite(out: Path, seeds: int, duration_s: float, mocap: Path | None, only: tuple[str, ...] = (),
                   controllers: tuple[str, ...] = SUITE_CONTROLLERS, workers: int = 2,
-                  executor: str | None = None, first_seed: int = 0) -> dict:
+                  executor: str | None = None, first_seed: int = 0, mirror: bool = False) -> dict:
     """Run the suite on the sensor seeds ``first_seed`` .. ``first_seed + seeds - 1`` on the executors of
-    parallel.py ("processes" by default, "ray", or "inline" when ``workers`` is 1); writes dev_suite.md and
-    dev_suite.json under ``out`` and returns {"rows", "table"}."""
+    parallel.py ("processes" by default, "ray", or "inline" when ``workers`` is 1), with ``mirror`` every clip's
+    mirror image (sources/mirror.py); writes dev_suite.md and dev_suite.json under ``out`` and returns {"rows",
+    "table"}."""
     from stylesync.parallel import execute_all
 
     out.mkdir(parents=True, exist_ok=True)
     clips = [c for c in clip_specs(mocap) if not only or c[2] in only]
-    jobs = [(spec, name, cat, seed, ctrl, duration_s) for spec, name, cat in clips
+    jobs = [(spec, name, cat, seed, ctrl, duration_s, mirror) for spec, name, cat in clips
             for seed in range(first_seed, first_seed + seeds)
             for ctrl in controllers]
     executor = executor or ("processes" if workers > 1 else "inline")
     rows = [row if isinstance(row, dict) else {"clip": name, "spec": spec, "category": cat, "seed": seed,
                                                "version": ctrl, "error": note}
-            for (row, note), (spec, name, cat, seed, ctrl, _) in zip(
+            for (row, note), (spec, name, cat, seed, ctrl, _, _) in zip(
                 execute_all(_job, [(j,) for j in jobs], executor, workers), jobs, strict=True)]
     md = table(rows, list(controllers))
+    if mirror:
+        md = "Every clip mirrored left-right (`--mirror`: his right side drives the character's left).\n\n" + md
     if len(controllers) > 1:
         md += "\n\n" + paired_table(rows, list(controllers), ORDER)
     (out / "dev_suite.json").write_text(json.dumps(rows, indent=1))
