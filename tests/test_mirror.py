@@ -78,8 +78,8 @@ def test_the_character_follows_the_mirror_image_of_the_operator():
     # The built-in walk and its mirror image, seed 0, 4 s: the operator side (sensor noise, interpolation, 1€
     # filter, floor filter) gives exactly the reflected ankles, and the character lifts the other foot first, on
     # the same control tick. Measured: over the first 2 s the character's ankles are within 9.5 mm of the
-    # reflected ones (its feet settle 4 mm towards +y in both runs alike, an asymmetry of the engine's contact, not
-    # of the pipeline).
+    # reflected ones (its feet settle 4 mm towards +y in both runs alike: not the pipeline's doing, and the model's
+    # left and right links are mirror images, so the engine's contact solving).
     logs = {}
     for mirror in (False, True):
         cfg = SessionConfig(duration_s=4.0, seed=0, operator=OperatorConfig(mirror=mirror))
