@@ -29,6 +29,8 @@ def _exit_code(argv: list[str]) -> int:
     (["inspect", "/no/such/file.bvh"], "file"),
     (["bench", "--seeds", "0"], "--seeds"),
     (["bench", "--mirror"], "--mirror"),
+    (["bench", "--sensor-noise", "2"], "--sensor-noise"),
+    (["bench", "--suite", "dev", "--sensor-noise", "-1"], "--sensor-noise"),
     (["run", "--source", "builtin:walk", "--bvh-scale", "-0.01"], "--bvh-scale"),
     (["run", "--source", "vmc://127.0.0.1:99999", "--duration", "0.1"], "VMC port"),
 ])

@@ -2,6 +2,9 @@
 
 import json
 
+import numpy as np
+import pytest
+
 from stylesync.cli import main as cli_main
 from stylesync.metrics.dev_suite import CATEGORIES, clip_specs, fall_endings, table
 
@@ -35,13 +38,34 @@ def test_the_dev_suite_writes_one_row_per_category_and_controller(tmp_path, caps
     assert table(rows, ["stylesync"]).count("| kick |") == 1
 
 
-def test_the_dev_suite_runs_the_mirror_images_of_its_clips(tmp_path, capsys):
+def test_the_dev_suite_runs_the_mirror_images_of_its_clips_through_a_noisier_sensor(tmp_path, capsys):
     out = tmp_path / "mirrored"
     assert cli_main(["bench", "--suite", "dev", "--only", "kick", "--seeds", "1", "--duration", "1.0",
-                     "--workers", "1", "--mirror", "--out", str(out)]) == 0
+                     "--workers", "1", "--mirror", "--sensor-noise", "4", "--out", str(out)]) == 0
     rows = json.loads((out / "dev_suite.json").read_text())
-    assert rows and all(r.get("mirror") is True and "error" not in r for r in rows)
-    assert (out / "dev_suite.md").read_text().startswith("Every clip mirrored left-right")
+    assert rows and all(r.get("mirror") is True and r.get("sensor_noise") == 4 and "error" not in r for r in rows)
+    md = (out / "dev_suite.md").read_text()
+    assert md.startswith("The sensor model's noise 4 times the default's") and "20 mm, 0.08 rad" in md
+    assert "Every clip mirrored left-right" in md
+
+
+def test_the_sensor_noise_reaches_the_frames():
+    from stylesync.config import OperatorConfig
+    from stylesync.metrics.dev_suite import operator_variant
+    from stylesync.sources.registry import open_source
+
+    assert operator_variant(OperatorConfig()) == {} and operator_variant(None) == {}
+    spread = {}
+    for factor in (1.0, 4.0):
+        op = OperatorConfig(position_noise_m=0.005 * factor, orientation_noise_rad=0.02 * factor)
+        frames = open_source("deepmimic:walk", operator=op, seed=0, duration_s=2.0).source.poll(2.0)
+        clean = open_source("deepmimic:walk", operator=OperatorConfig(position_noise_m=0.0, orientation_noise_rad=0.0,
+                                                                     timestamp_jitter_s=0.0),
+                            seed=0, duration_s=2.0).source.poll(2.0)
+        n = min(len(frames), len(clean))
+        errors = [f.pos("HEAD") - g.pos("HEAD") for f, g in zip(frames[:n], clean[:n], strict=True)]
+        spread[factor] = float(np.std(errors))
+    assert spread[4.0] == pytest.approx(4 * spread[1.0], rel=0.3)
 
 
 def test_an_unknown_category_is_one_line(tmp_path, capsys):

@@ -178,6 +178,13 @@ def _demo(args: argparse.Namespace) -> int:
                                                       "track_rise": not args.no_track_rise}, args)
 
 
+def _suite_operator(args: argparse.Namespace) -> OperatorConfig:
+    """The dev suite's operator: the default, or his mirror image (--mirror) and a noisier sensor (--sensor-noise)."""
+    default = OperatorConfig()
+    return OperatorConfig(mirror=args.mirror, position_noise_m=default.position_noise_m * args.sensor_noise,
+                          orientation_noise_rad=default.orientation_noise_rad * args.sensor_noise)
+
+
 def _motion_options(cfg: SessionConfig, args: argparse.Namespace) -> SessionConfig:
     """``cfg`` with the options asked for on the command line (--follow-path, --free-swing, --no-track-rise)."""
     if args.follow_path:
@@ -271,10 +278,11 @@ def _bench(args: argparse.Namespace) -> int:
         mocap = shared / "mocap"
         report = run_dev_suite(Path(args.out), args.seeds, args.duration, mocap if mocap.is_dir() else None, only,
                                workers=args.workers, executor=args.executor, first_seed=args.seed,
-                               mirror=args.mirror)
+                               operator=_suite_operator(args))
     else:
-        if args.mirror:
-            raise ConfigError("--mirror is a dev-suite option: use it with --suite dev")
+        for flag, given in (("--mirror", args.mirror), ("--sensor-noise", args.sensor_noise != 1.0)):
+            if given:
+                raise ConfigError(f"{flag} is a dev-suite option: use it with --suite dev")
         report = run_bench(Path(args.out), args.duration, args.seed, shared if shared.is_dir() else None,
                            executor=args.executor or "inline", workers=args.workers)
     print(report["table"])
@@ -477,6 +485,9 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--mirror", action="store_true",
                        help="dev suite: every clip's mirror image (left and right swapped), a second sample of what "
                             "users bring")
+    bench.add_argument("--sensor-noise", type=typed.noise_factor, default=1.0,
+                       help="dev suite: the sensor model's joint position and orientation noise times this (1: "
+                            "Kinect-like, 5 mm and 0.02 rad; a webcam's pose model is noisier)")
     bench.add_argument("--workers", type=typed.integer(1, 256), default=2,
                        help="runs in parallel (with --executor processes or ray, and for the dev suite)")
     bench.add_argument("--executor", choices=("processes", "ray", "inline"),

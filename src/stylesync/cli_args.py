@@ -133,3 +133,4 @@ mass_kg = number(0.0, 1000.0, lo_open=True, unit="kg")
 scale = number(0.0, 1e6, lo_open=True)
 speed = number(0.0, 100.0, lo_open=True)
 turn_rate_rad_s = number(-3.0, 3.0, unit="rad/s")
+noise_factor = number(0.0, 20.0)  # times the sensor model's default noise

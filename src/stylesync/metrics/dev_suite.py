@@ -68,11 +68,11 @@ def clip_specs(mocap: Path | None) -> list[tuple[str, str, str]]:
 
 
 def suite_config(spec: str, opened: OpenedSource, seed: int, duration_s: float,
-                 mirror: bool = False) -> tuple[SessionConfig, float]:
-    """A suite run's configuration for the opened source ``spec`` (default settings, the source's frame rate, at
-    most ``duration_s``, the rest after a recorded file included; ``mirror``: the operator's mirror image,
-    sources/mirror.py) and the time its clip ends [s]."""
-    op = OperatorConfig(mirror=mirror)
+                 operator: OperatorConfig | None = None) -> tuple[SessionConfig, float]:
+    """A suite run's configuration for the opened source ``spec`` (default settings, or ``operator``'s, e.g. his
+    mirror image; the source's frame rate, at most ``duration_s``, the rest after a recorded file included) and the
+    time its clip ends [s]."""
+    op = operator or OperatorConfig()
     length = min(duration_s, float(opened.duration_s or duration_s))
     in_motion = spec.startswith(("bvh:", "k4a-json:")) and op.start_in_motion
     clip_end = length - (min(op.rest_after_clip_s, length) if in_motion else 0.0)
@@ -81,19 +81,20 @@ def suite_config(spec: str, opened: OpenedSource, seed: int, duration_s: float,
     return cfg, clip_end
 
 
-def run_clip(spec: str, seed: int, duration_s: float, controller: str, mirror: bool = False) -> dict:
-    """One run of the suite: the clip through the Kinect sensor model with ``seed`` (``mirror``: its mirror image);
-    a clip that cannot be opened gives ``{"error": ...}``."""
+def run_clip(spec: str, seed: int, duration_s: float, controller: str,
+             operator: OperatorConfig | None = None) -> dict:
+    """One run of the suite: the clip through the Kinect sensor model with ``seed`` (its noise and the operator
+    options from ``operator``, by default the default's); a clip that cannot be opened gives ``{"error": ...}``."""
     from stylesync.session import run_and_release
     from stylesync.sources.registry import open_source
 
     logging.disable(logging.WARNING)
     control, motion = CONTROLLERS[controller]
     try:
-        opened = open_source(spec, seed=seed, duration_s=duration_s)
+        opened = open_source(spec, operator=operator, seed=seed, duration_s=duration_s)
     except StylesyncError as exc:
         return {"error": str(exc)[:200]}
-    cfg, clip_end = suite_config(spec, opened, seed, duration_s, mirror)
+    cfg, clip_end = suite_config(spec, opened, seed, duration_s, operator)
     cfg = dataclasses.replace(cfg, control=control, motion=motion)
     result = run_and_release(cfg, opened.source)
     m = summarize(result)
@@ -104,9 +105,24 @@ def run_clip(spec: str, seed: int, duration_s: float, controller: str, mirror: b
 
 
 def _job(job: tuple) -> dict:
-    spec, name, cat, seed, controller, duration_s, mirror = job
+    spec, name, cat, seed, controller, duration_s, operator = job
     return {"clip": name, "spec": spec, "category": cat, "seed": seed, "version": controller,
-            **({"mirror": True} if mirror else {}), **run_clip(spec, seed, duration_s, controller, mirror)}
+            **operator_variant(operator), **run_clip(spec, seed, duration_s, controller, operator)}
+
+
+def operator_variant(operator: OperatorConfig | None) -> dict:
+    """How ``operator`` differs from the suite's default operator, for the rows: ``mirror`` (his mirror image) and
+    ``sensor_noise`` (the sensor model's position noise over the default's); {} for the default."""
+    if operator is None:
+        return {}
+    default = OperatorConfig()
+    out: dict = {}
+    if operator.mirror:
+        out["mirror"] = True
+    if (operator.position_noise_m, operator.orientation_noise_rad) != (default.position_noise_m,
+                                                                       default.orientation_noise_rad):
+        out["sensor_noise"] = round(operator.position_noise_m / default.position_noise_m, 6)
+    return out
 
 
 def _share(k: int, n: int) -> str:
@@ -165,16 +181,16 @@ def table(rows: list[dict], versions: list[str]) -> str:
 
 def run_dev_suite(out: Path, seeds: int, duration_s: float, mocap: Path | None, only: tuple[str, ...] = (),
                   controllers: tuple[str, ...] = SUITE_CONTROLLERS, workers: int = 2,
-                  executor: str | None = None, first_seed: int = 0, mirror: bool = False) -> dict:
+                  executor: str | None = None, first_seed: int = 0, operator: OperatorConfig | None = None) -> dict:
     """Run the suite on the sensor seeds ``first_seed`` .. ``first_seed + seeds - 1`` on the executors of
-    parallel.py ("processes" by default, "ray", or "inline" when ``workers`` is 1), with ``mirror`` every clip's
-    mirror image (sources/mirror.py); writes dev_suite.md and dev_suite.json under ``out`` and returns {"rows",
-    "table"}."""
+    parallel.py ("processes" by default, "ray", or "inline" when ``workers`` is 1), with ``operator``'s options if
+    given (every clip's mirror image, a noisier sensor: :func:`operator_variant`); writes dev_suite.md and
+    dev_suite.json under ``out`` and returns {"rows", "table"}."""
     from stylesync.parallel import execute_all
 
     out.mkdir(parents=True, exist_ok=True)
     clips = [c for c in clip_specs(mocap) if not only or c[2] in only]
-    jobs = [(spec, name, cat, seed, ctrl, duration_s, mirror) for spec, name, cat in clips
+    jobs = [(spec, name, cat, seed, ctrl, duration_s, operator) for spec, name, cat in clips
             for seed in range(first_seed, first_seed + seeds)
             for ctrl in controllers]
     executor = executor or ("processes" if workers > 1 else "inline")
@@ -183,8 +199,12 @@ def run_dev_suite(out: Path, seeds: int, duration_s: float, mocap: Path | None, 
             for (row, note), (spec, name, cat, seed, ctrl, _, _) in zip(
                 execute_all(_job, [(j,) for j in jobs], executor, workers), jobs, strict=True)]
     md = table(rows, list(controllers))
-    if mirror:
+    variant = operator_variant(operator)
+    if variant.get("mirror"):
         md = "Every clip mirrored left-right (`--mirror`: his right side drives the character's left).\n\n" + md
+    if "sensor_noise" in variant:
+        md = (f"The sensor model's noise {variant['sensor_noise']:g} times the default's (`--sensor-noise`: "
+              f"{operator.position_noise_m * 1000:g} mm, {operator.orientation_noise_rad:g} rad).\n\n" + md)
     if len(controllers) > 1:
         md += "\n\n" + paired_table(rows, list(controllers), ORDER)
     (out / "dev_suite.json").write_text(json.dumps(rows, indent=1))
