@@ -202,7 +202,7 @@ def run_dev_suite(out: Path, seeds: int, duration_s: float, mocap: Path | None, 
     variant = operator_variant(operator)
     if variant.get("mirror"):
         md = "Every clip mirrored left-right (`--mirror`: his right side drives the character's left).\n\n" + md
-    if "sensor_noise" in variant:
+    if "sensor_noise" in variant and operator is not None:
         md = (f"The sensor model's noise {variant['sensor_noise']:g} times the default's (`--sensor-noise`: "
               f"{operator.position_noise_m * 1000:g} mm, {operator.orientation_noise_rad:g} rad).\n\n" + md)
     if len(controllers) > 1:
