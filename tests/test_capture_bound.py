@@ -18,7 +18,7 @@ from stylesync.model.sole import (
     sole_corners_world,
     sole_points_xy,
 )
-from stylesync.motion.capture_bound import bounded_com_target, landing_catch_region
+from stylesync.motion.capture_bound import bounded_com_target, gait_capture_margin_m, landing_catch_region
 from stylesync.motion.recovery_step import capture_point
 
 IDENTITY = np.array([1.0, 0.0, 0.0, 0.0])
@@ -78,6 +78,33 @@ def test_the_bounded_target_is_continuous_as_its_capture_point_crosses_the_edge(
     assert np.max(np.abs(np.diff(forces))) < 0.1  # per 0.1 mm of ξ_d [N/kg]
     far = np.array([*(np.array([front + 0.2, 0.0]) - vel[:2] / OMEGA), 0.8])
     assert bounded_com_target(far, vel, OMEGA, _soles(FEET, 0.8))[1][0] == 0.0
+
+
+def test_a_gait_margin_lets_the_capture_point_run_that_far_ahead_and_no_further():
+    """His gait's double stance (MotionConfig.gait_capture_step_s): the bound is the polygon grown by the margin."""
+    com, vel = np.array([0.2, 0.03, 0.8]), np.array([0.8, 0.1, 0.0])
+    outside = _outside(_xi(com, vel), FEET, 0.8)
+    assert outside > 0.3
+    out_com, out_vel = bounded_com_target(com, vel, OMEGA, _soles(FEET, 0.8), margin_m=0.15)
+    xi = _xi(out_com, out_vel)
+    assert _outside(xi, FEET, 0.8) == pytest.approx(0.15, abs=1e-9)
+    unbounded, _ = bounded_com_target(com, vel, OMEGA, _soles(FEET, 0.8))  # the margin's point is on the same line
+    edge = _xi(unbounded, np.zeros(3))
+    direction = (_xi(com, vel) - edge) / np.linalg.norm(_xi(com, vel) - edge)
+    assert xi - edge == pytest.approx(0.15 * direction, abs=1e-9)
+    # within the margin the target is left as it is
+    near = np.array([*(edge + 0.1 * direction - vel[:2] / OMEGA), 0.8])
+    kept_com, kept_vel = bounded_com_target(near, vel, OMEGA, _soles(FEET, 0.8), margin_m=0.15)
+    assert kept_com is near and kept_vel is vel
+
+
+def test_the_gait_margin_is_what_a_step_then_catches_within_reach():
+    """ξ(T) = p + (ξ - p) e^(ω T): a capture point the margin out now is the reach out when the step lands."""
+    margin = gait_capture_margin_m(0.6, OMEGA, 0.3)
+    assert margin * np.exp(OMEGA * 0.3) == pytest.approx(0.6)
+    assert gait_capture_margin_m(0.6, OMEGA, 0.4) < margin  # a later step catches less
+    with pytest.raises(ConfigError):
+        MotionConfig(gait_capture_step_s=0.0)
 
 
 def test_on_one_foot_the_bound_is_that_sole():

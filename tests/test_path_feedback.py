@@ -182,3 +182,38 @@ def test_targets_on_his_path_keep_the_stealthy_walk_within_the_uhc_distance():
     assert out[False]["uhc_fall_time_s"] is not None and out[False]["uhc_fall_time_s"] < 5.0
     assert out[True]["uhc_fall_time_s"] is None
     assert out[True]["mpjpe_global_mm"] < 0.5 * out[False]["mpjpe_global_mm"]
+
+
+_CMU_DEV = Path(__file__).resolve().parents[2] / "shared" / "mocap" / "cmu-dev"
+
+
+@pytest.mark.skipif(not (_CMU_DEV / "12_01.bvh").is_file(), reason="../shared/mocap/cmu-dev is not present")
+@pytest.mark.parametrize(("clip", "seed", "fall_s"), [("12_01", 6, 4.30), ("08_08", 1, 2.42), ("10_04", 0, 4.85)])
+def test_a_gait_double_stance_bounded_by_what_a_step_catches_keeps_fast_walks_up(clip, seed, fall_s):
+    """Measured (development-suite runs, ``--follow-path``): with the capture point unbounded in his gait's double
+    stance (gait_capture_step_s None) these walks fell at ``fall_s``, their own steps beginning with the capture point
+    0.24-0.29 m out (docs/decisions.md, "Where `--follow-path`'s chains of own steps begin"); bounded to what a step
+    0.3 s later catches (about 0.21 m out), none falls in the first 5.5 s."""
+    import logging
+
+    from conftest import suite_run
+
+    from stylesync.config import ControlConfig, follow_path
+
+    def configure(bounded):
+        def with_bound(cfg):
+            cfg = follow_path(cfg).replace(duration_s=5.5)
+            if not bounded:
+                cfg = cfg.replace(motion=dataclasses.replace(cfg.motion, gait_capture_step_s=None))
+            return cfg
+        return with_bound
+
+    logging.disable(logging.WARNING)
+    try:
+        out = {bounded: suite_run(f"bvh:{_CMU_DEV / clip}.bvh", seed, MotionConfig(), ControlConfig(),
+                                  configure=configure(bounded))
+               for bounded in (False, True)}
+    finally:
+        logging.disable(logging.NOTSET)
+    assert out[False].fell and out[False].fall_time_s == pytest.approx(fall_s, abs=0.01)
+    assert not out[True].fell

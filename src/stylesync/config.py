@@ -337,6 +337,10 @@ class MotionConfig:
     # (capture_bound_sole_share); False: not while the operator walks from one foot onto the other
     # (double_stance_momentum.moves_between_feet), whose capture point runs ahead of his front foot.
     capture_bound_in_his_gait: bool = True
+    # ... and where it is False, opt-in: in his gait's double stance the COM target's capture point runs ahead of the
+    # soles by at most what a step this long from now catches within a recovery step's reach
+    # (capture_bound.gait_capture_margin_m: reach e^(-ω T)); None: unbounded there [s].
+    gait_capture_step_s: float | None = None
     # While the operator walks (his capture point outside his soles), a recovery step lands with the capture point
     # this far ahead of its ankle instead of on its sole's trailing edge: a step that walks on with him rather than
     # one that stops the body (recovery_step.capture_landing). None: every recovery step stops it [m].
@@ -409,6 +413,8 @@ class MotionConfig:
             raise ConfigError(f"MotionConfig.capture_bound_sole_share must be within [0, 1], got "
                               f"{self.capture_bound_sole_share}")
         _positive("MotionConfig.recovery_swing_s", self.recovery_swing_s)
+        if self.gait_capture_step_s is not None:
+            _positive("MotionConfig.gait_capture_step_s", self.gait_capture_step_s)
         if self.recovery_swing_min_s is not None:
             _positive("MotionConfig.recovery_swing_min_s", self.recovery_swing_min_s)
         if self.recovery_landing_gap_m is not None:
@@ -711,6 +717,7 @@ class SessionConfig:
 FOLLOW_PATH_MOTION: dict[str, Any] = {
     "double_stance_keeps_momentum_m": 0.1,  # a gait's double stance does not brake it
     "capture_bound_in_his_gait": False,  # nor does the capture bound while he walks
+    "gait_capture_step_s": 0.3,  # but its capture point runs ahead no further than a step then catches
     "reference_follows_operator_s": 0.5,  # the targets go on at his speed
     "path_feedback_share": 0.5,  # each landing takes up half the path's error
     "recovery_walk_on_m": 0.1,  # its own steps walk on while he walks

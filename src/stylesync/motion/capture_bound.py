@@ -39,24 +39,37 @@ BAND_M = 0.05
 
 
 def bounded_com_target(com_d_world: np.ndarray, com_vel_d_world: np.ndarray, omega_1ps: float,
-                       soles_xy: list[list[Point]]) -> tuple[np.ndarray, np.ndarray]:
+                       soles_xy: list[list[Point]], margin_m: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """The COM target (position (3,) [m], velocity (3,) [m/s]) with its capture point ξ_d = c_d + ċ_d / ω
     (``omega_1ps`` [1/s]) within the support polygon of the soles ``soles_xy`` (each its corners' world horizontal
     positions, model/sole.sole_points_xy, shrunk as wanted): unchanged where it is within (or without soles);
     otherwise with its capture point on the polygon's point nearest to ξ_d and its velocity cut over BAND_M
-    (horizontally; the height and vertical velocity are kept)."""
+    (horizontally; the height and vertical velocity are kept). With ``margin_m`` > 0 the capture point may lie up to
+    that far outside the polygon [m]: the bound is the polygon grown by it (a gait's capture point runs ahead of
+    its front foot, :func:`gait_capture_margin_m`)."""
     if not soles_xy:
         return com_d_world, com_vel_d_world
     polygon = convex_hull_points([p for sole in soles_xy for p in sole])
     vx, vy = float(com_vel_d_world[0]), float(com_vel_d_world[1])
     xi_d = (float(com_d_world[0]) + vx / omega_1ps, float(com_d_world[1]) + vy / omega_1ps)
     distance, (nx, ny) = outside_distance_points(xi_d, polygon)
-    if distance <= 0.0:
+    if distance <= margin_m:
         return com_d_world, com_vel_d_world
+    if margin_m > 0.0:  # the nearest point of the grown polygon, on the line from the polygon's nearest to ξ_d
+        nx += margin_m * (xi_d[0] - nx) / distance
+        ny += margin_m * (xi_d[1] - ny) / distance
+        distance -= margin_m
     keep = max(0.0, 1.0 - distance / BAND_M)
     vel = np.array([vx * keep, vy * keep, float(com_vel_d_world[2])])
     com = np.array([nx - vel[0] / omega_1ps, ny - vel[1] / omega_1ps, float(com_d_world[2])])
     return com, vel
+
+
+def gait_capture_margin_m(reach_m: float, omega_1ps: float, step_s: float) -> float:
+    """How far outside the soles a double stance's capture point may run and a step of ``step_s`` [s] still catch
+    it within ``reach_m`` of where it is [m]: ξ(T) = p + (ξ - p) e^(ω T) (Eq. 21's pendulum, the centre of pressure p
+    at the soles' edge), so the distance d now reaches d e^(ω T) by the landing: d = reach e^(-ω T)."""
+    return reach_m * float(np.exp(-omega_1ps * step_s))
 
 
 def landing_catch_region(stance_xy: list[Point], landing_offset_xy: tuple[float, float],

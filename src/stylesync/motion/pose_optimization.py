@@ -45,7 +45,7 @@ from stylesync.model.sole import sole_corner_points, sole_outside_m, sole_points
 from stylesync.model.state import CharacterState, MassProperties
 from stylesync.motion.balance_strategy import stance_hip_blend, swing_hip_feedback
 from stylesync.motion.bounds import BoundsMonitor, step_length_bound_m
-from stylesync.motion.capture_bound import bounded_com_target, landing_catch_region
+from stylesync.motion.capture_bound import bounded_com_target, gait_capture_margin_m, landing_catch_region
 from stylesync.motion.double_stance_momentum import kept_com_velocity, moves_between_feet
 from stylesync.motion.his_rise import HisRise
 from stylesync.motion.leg_ik import solve_leg
@@ -695,12 +695,13 @@ class MotionOptimizer:
         return self._operator_stands(tick, sides)
 
     def _bounded_com_target(self, tick: _Tick, state: CharacterState, com_d: np.ndarray,
-                            com_vel_d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The COM target with its capture point within the soles the character stands on (capture_bound.py)."""
+                            com_vel_d: np.ndarray, margin_m: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+        """The COM target with its capture point within the soles the character stands on, or at most ``margin_m``
+        outside them (capture_bound.py)."""
         soles = [sole_points_xy(tick.a_c[s], state.link_quat_wxyz[_LINK[f"{s}_ankle"]], self._sole_bound)
                  for s in soles_on_ground(state) if tick.weights[s] > 0.0]
         _, omega = capture_point(tick.com_c, tick.com_vel_c, self.g)
-        return bounded_com_target(com_d, com_vel_d, omega, soles)
+        return bounded_com_target(com_d, com_vel_d, omega, soles, margin_m)
 
     def _landing_bounded_com_target(self, tick: _Tick, state: CharacterState, com_d: np.ndarray,
                                     com_vel_d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -1070,6 +1071,12 @@ class MotionOptimizer:
             com_vel_d = np.array([tick.com_vel_c[0], tick.com_vel_c[1], 0.0])
         elif self.cfg.capture_bound_sole_share > 0.0 and self._capture_bounded(tick):
             com_d, com_vel_d = self._bounded_com_target(tick, state, com_d, com_vel_d)
+        elif self.cfg.gait_capture_step_s is not None and tick.ch_state is Stance.DS:
+            # His gait's double stance (capture_bound_in_his_gait False): the capture point runs ahead of the
+            # soles, but no further than a step then catches (capture_bound.gait_capture_margin_m).
+            _, omega = capture_point(tick.com_c, tick.com_vel_c, self.g)
+            margin = gait_capture_margin_m(self.recovery.max_step_m, omega, self.cfg.gait_capture_step_s)
+            com_d, com_vel_d = self._bounded_com_target(tick, state, com_d, com_vel_d, margin)
         elif self.cfg.landing_capture_bound != "off" and tick.swing is not None and tick.swing_landing_xy is not None:
             com_d, com_vel_d = self._landing_bounded_com_target(tick, state, com_d, com_vel_d)
         self.reading = MotionReading(tick.op_state, tick.analysis.features, self.char_fsm.hold_reference, tick.scale,
