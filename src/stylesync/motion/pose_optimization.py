@@ -1071,9 +1071,11 @@ class MotionOptimizer:
             com_vel_d = np.array([tick.com_vel_c[0], tick.com_vel_c[1], 0.0])
         elif self.cfg.capture_bound_sole_share > 0.0 and self._capture_bounded(tick):
             com_d, com_vel_d = self._bounded_com_target(tick, state, com_d, com_vel_d)
-        elif self.cfg.gait_capture_step_s is not None and tick.ch_state is Stance.DS:
-            # His gait's double stance (capture_bound_in_his_gait False): the capture point runs ahead of the
-            # soles, but no further than a step then catches (capture_bound.gait_capture_margin_m).
+        elif (self.cfg.gait_capture_step_s is not None and self.cfg.capture_bound_sole_share > 0.0
+              and tick.ch_state is Stance.DS):
+            # His gait's double stance, where the bound above is lifted (capture_bound_in_his_gait False): the
+            # capture point runs ahead of the (shrunk) soles, but no further than a step then catches
+            # (capture_bound.gait_capture_margin_m).
             _, omega = capture_point(tick.com_c, tick.com_vel_c, self.g)
             margin = gait_capture_margin_m(self.recovery.max_step_m, omega, self.cfg.gait_capture_step_s)
             com_d, com_vel_d = self._bounded_com_target(tick, state, com_d, com_vel_d, margin)
