@@ -58,8 +58,11 @@ def test_clips_are_found_in_folders_globs_and_lists_and_keyed_by_content(clips, 
     assert cli_main(["batch", str(tmp_path / "nothing"), "--out", str(tmp_path / "o")]) == 2
 
 
-def test_a_ray_batch_gives_what_each_clip_gives_alone(clips, tmp_path):
+def test_a_ray_batch_gives_what_each_clip_gives_alone(clips, tmp_path, monkeypatch):
+    """... in a Ray instance of its own: a cluster address left in the environment (or a stale
+    /tmp/ray/ray_current_cluster of a cluster gone) is not joined."""
     pytest.importorskip("ray")
+    monkeypatch.setenv("RAY_ADDRESS", "127.0.0.1:6390")  # no cluster there
     jobs = jobs_for(find_clips(str(clips)), SETTINGS)
     out = tmp_path / "out"
     counts = runner.run_batch(jobs, SETTINGS, out, executor="ray", workers=2)

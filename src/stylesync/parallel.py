@@ -59,8 +59,8 @@ def _ray(fn: Callable, items: list[tuple], workers: int, address: str | None, ma
                         "configure_logging": False}
         if address:
             ray.init(address=address, **kwargs)
-        else:
-            ray.init(num_cpus=workers, **kwargs)
+        else:  # a Ray instance of its own: not a cluster a stale /tmp/ray/ray_current_cluster names
+            ray.init(address="local", num_cpus=workers, **kwargs)
     task = ray.remote(num_cpus=1, max_retries=0)(fn)
     # An argument object that many items share (settings) goes to the object store once.
     uses: dict[int, int] = {}
