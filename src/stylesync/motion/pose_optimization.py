@@ -695,12 +695,15 @@ class MotionOptimizer:
         return self._operator_stands(tick, sides)
 
     def _bounded_com_target(self, tick: _Tick, state: CharacterState, com_d: np.ndarray,
-                            com_vel_d: np.ndarray, margin_m: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
-        """The COM target with its capture point within the soles the character stands on, or at most ``margin_m``
-        outside them (capture_bound.py)."""
+                            com_vel_d: np.ndarray, catch_step_s: float | None = None
+                            ) -> tuple[np.ndarray, np.ndarray]:
+        """The COM target with its capture point within the soles the character stands on, or, with
+        ``catch_step_s``, at most as far outside them as a step that lands that long from now catches
+        (capture_bound.py)."""
         soles = [sole_points_xy(tick.a_c[s], state.link_quat_wxyz[_LINK[f"{s}_ankle"]], self._sole_bound)
                  for s in soles_on_ground(state) if tick.weights[s] > 0.0]
         _, omega = capture_point(tick.com_c, tick.com_vel_c, self.g)
+        margin_m = 0.0 if catch_step_s is None else gait_capture_margin_m(self.recovery.max_step_m, omega, catch_step_s)
         return bounded_com_target(com_d, com_vel_d, omega, soles, margin_m)
 
     def _landing_bounded_com_target(self, tick: _Tick, state: CharacterState, com_d: np.ndarray,
@@ -1076,9 +1079,7 @@ class MotionOptimizer:
             # His gait's double stance, where the bound above is lifted (capture_bound_in_his_gait False): the
             # capture point runs ahead of the (shrunk) soles, but no further than a step then catches
             # (capture_bound.gait_capture_margin_m).
-            _, omega = capture_point(tick.com_c, tick.com_vel_c, self.g)
-            margin = gait_capture_margin_m(self.recovery.max_step_m, omega, self.cfg.gait_capture_step_s)
-            com_d, com_vel_d = self._bounded_com_target(tick, state, com_d, com_vel_d, margin)
+            com_d, com_vel_d = self._bounded_com_target(tick, state, com_d, com_vel_d, self.cfg.gait_capture_step_s)
         elif self.cfg.landing_capture_bound != "off" and tick.swing is not None and tick.swing_landing_xy is not None:
             com_d, com_vel_d = self._landing_bounded_com_target(tick, state, com_d, com_vel_d)
         self.reading = MotionReading(tick.op_state, tick.analysis.features, self.char_fsm.hold_reference, tick.scale,
