@@ -303,6 +303,13 @@ class MotionConfig:
     # ahead of it in a walk's rest), the foot was out of reach, and the pelvis target dropped to the foot's own
     # height (docs/decisions.md, "A pelvis target out of a landing foot's reach"; 0: no floor) [-]
     landing_pelvis_floor_share: float = 0.6
+    # The pelvis target (Eq. 9) no higher than this share of the leg's length reaches above each planted stance foot
+    # (hip to ankle, from the target's hip). His pelvis, scaled, can sit above what the character's straight legs
+    # reach (CMU 02_01: 0.94 m against 0.88 m): the stance leg is then held straight, and the lowering above for a
+    # foot that must land came as one step of the target (11 cm at a late contact), which the stance knee took by
+    # folding and the walk by braking (docs/decisions.md, "The pelvis target within the stance legs' reach")
+    # (None: not bounded) [-]
+    pelvis_stance_reach_share: float | None = None
     # An operator's swing is aimed within the leg's horizontal reach of the swing hip as it is, with the pelvis
     # lowered to that floor (sqrt(1 - floor²) of the reach): a runner's foot, placed as his is relative to his
     # capture point and his stance foot, was aimed up to 2.3 m from the slower character's hip (CMU-dev 09_06); in
@@ -426,6 +433,9 @@ class MotionConfig:
             raise ConfigError(f"MotionConfig.recovery_touchdown_share must be within (0, 1], "
                               f"got {self.recovery_touchdown_share}")
         _non_negative("MotionConfig.recovery_step_height_m", self.recovery_step_height_m)
+        if self.pelvis_stance_reach_share is not None and not 0.0 < self.pelvis_stance_reach_share <= 1.0:
+            raise ConfigError(f"MotionConfig.pelvis_stance_reach_share must be within (0, 1] or None, got "
+                              f"{self.pelvis_stance_reach_share}")
         if not 0.0 <= self.landing_pelvis_floor_share <= 1.0:
             raise ConfigError(f"MotionConfig.landing_pelvis_floor_share must be within [0, 1], got "
                               f"{self.landing_pelvis_floor_share}")

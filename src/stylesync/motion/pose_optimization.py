@@ -231,6 +231,9 @@ class MotionOptimizer:
         self.dt_s = 1.0 / control_hz
         # A landing foot lowers the pelvis target to at least this height above the foot's target [m]
         self._landing_pelvis_floor_m = cfg.landing_pelvis_floor_share * _LANDING_REACH_M
+        # The hip-to-ankle distance the pelvis target keeps within above a planted stance foot [m]
+        share = cfg.pelvis_stance_reach_share
+        self._stance_reach_m = None if share is None else share * CHAR_LEG_LENGTH_M
         # How far from its hip, horizontally, a swing foot can land with the pelvis at that floor [m]
         self._swing_reach_m = math.sqrt(max(_LANDING_REACH_M ** 2 - self._landing_pelvis_floor_m ** 2, 0.0))
         self.op_fsm = OperatorStanceFsm(cfg.stance_height_threshold_m, cfg.stance_hysteresis_m)
@@ -616,21 +619,33 @@ class MotionOptimizer:
         # from the body) would otherwise put the pelvis target on the ground.
         landing_step = (self.cfg.recovery_landing_reach and self.char_fsm.recovery_step
                         and self.recovery.landing_due(state.time_s))
+        if self._stance_reach_m is not None:
+            # ... and never higher than the planted stance legs reach (MotionConfig.pelvis_stance_reach_share)
+            for side, sign in (("left", 1.0), ("right", -1.0)):
+                if tick.weights[side] > 0 and tick.contact[side]:
+                    tick.pelvis_d[2] = min(tick.pelvis_d[2], self._pelvis_within_m(tick, side, sign,
+                                                                                  self._stance_reach_m))
         for side, sign in (("left", 1.0), ("right", -1.0)):
             must_land = tick.weights[side] > 0 or (side == sw and (self.char_fsm.hold_reference or landing_step))
             if must_land and not tick.contact[side]:
-                hip_xy = (tick.pelvis_d + tick.R_root_d @ np.array([0.0, sign * HIP_HALF_WIDTH_M, 0.0]))[:2]
-                if side == sw and landing_step:
-                    # The character's own step: from where its hip is (the operator's pelvis target may be
-                    # anywhere behind a body that carries momentum he does not have).
-                    hip_xy = state.link_origin_world[_LINK[f"{side}_hip"]][:2]
-                d2 = float(np.sum((tick.targets[side][:2] - hip_xy) ** 2))
-                above_foot = max(float(np.sqrt(max(_LANDING_REACH_M * _LANDING_REACH_M - d2, 0.0))),
-                                 self._landing_pelvis_floor_m)
-                lowered = tick.targets[side][2] + above_foot
+                # The character's own step: from where its hip is (the operator's pelvis target may be anywhere
+                # behind a body that carries momentum he does not have).
+                hip_xy = state.link_origin_world[_LINK[f"{side}_hip"]][:2] if side == sw and landing_step else None
+                lowered = self._pelvis_within_m(tick, side, sign, _LANDING_REACH_M, hip_xy)
                 if lowered < tick.pelvis_d[2]:
                     tick.pelvis_d[2] = lowered
                     tick.pelvis_vel_z = 0.0
+
+    def _pelvis_within_m(self, tick: _Tick, side: str, sign: float, reach_m: float,
+                         hip_xy: np.ndarray | None = None) -> float:
+        """The highest pelvis target [m] from which the leg on ``side`` (``sign`` +1 left, -1 right) reaches its
+        ankle target at ``reach_m`` hip to ankle, from ``hip_xy`` (default: the pelvis target's hip), no lower than
+        landing_pelvis_floor_share of the landing reach above the target."""
+        if hip_xy is None:
+            hip_xy = (tick.pelvis_d + tick.R_root_d @ np.array([0.0, sign * HIP_HALF_WIDTH_M, 0.0]))[:2]
+        d2 = float(np.sum((tick.targets[side][:2] - hip_xy) ** 2))
+        above_foot = max(float(np.sqrt(max(reach_m * reach_m - d2, 0.0))), self._landing_pelvis_floor_m)
+        return float(tick.targets[side][2]) + above_foot
 
     def _his_gait(self, tick: _Tick, his_ankles_world: dict[str, np.ndarray]) -> bool:
         """Whether the operator's double stance on ``his_ankles_world`` is a gait's: his COM moves from one foot
