@@ -10,6 +10,7 @@ import pytest
 from conftest import suite_run
 
 from stylesync.config import ConfigError, ControlConfig, MotionConfig, follow_path
+from stylesync.model.character import ANKLE_HEIGHT_M
 from stylesync.motion.pose_optimization import CHAR_LEG_LENGTH_M
 
 WALK = Path(__file__).resolve().parents[2] / "shared" / "mocap" / "cmu" / "02_01.bvh"
@@ -50,5 +51,5 @@ def test_a_pelvis_target_within_the_stance_legs_reach_lets_a_followed_walk_keep_
     high, speed, fell = _followed_walk(None)
     assert high > CHAR_LEG_LENGTH_M + 0.09 and speed < 0.85 and not fell
     high, speed, fell = _followed_walk(1.0)
-    assert high <= CHAR_LEG_LENGTH_M + 0.05 + 1e-9  # the leg's length above the ankle's height
+    assert high <= CHAR_LEG_LENGTH_M + ANKLE_HEIGHT_M + 1e-9  # the leg's length above the ankle's height
     assert speed > 0.95 and not fell

@@ -620,7 +620,7 @@ class MotionOptimizer:
         landing_step = (self.cfg.recovery_landing_reach and self.char_fsm.recovery_step
                         and self.recovery.landing_due(state.time_s))
         if self._stance_reach_m is not None:
-            # ... and never higher than the planted stance legs reach (MotionConfig.pelvis_stance_reach_share)
+            # Opt-in: no higher than the planted stance legs reach (MotionConfig.pelvis_stance_reach_share)
             for side, sign in (("left", 1.0), ("right", -1.0)):
                 if tick.weights[side] > 0 and tick.contact[side]:
                     tick.pelvis_d[2] = min(tick.pelvis_d[2], self._pelvis_within_m(tick, side, sign,
