@@ -286,6 +286,11 @@ class MotionConfig:
     # and the character's capture point runs out of reach before it ends (with the overrun, off at 0;
     # docs/decisions.md, "A double stance that waits out of reach")
     recovery_ds_on_reach_limit: bool = True
+    # ... and at once as well where no recovery step now captures it either: a capture point already beyond one
+    # step's reach only runs further out while the character waits on both feet, and a step as far as it reaches
+    # leaves the least for the next (False: only where a step now captures it; docs/decisions.md, "A double stance
+    # beyond a step's reach")
+    recovery_ds_beyond_reach: bool = True
     # ... at once where the capture point has left that polygon behind: the outward direction from the polygon's
     # nearest point to the capture point has a share below minus this of the heading's forward axis (a step of an
     # operator walking forwards can never catch it; docs/decisions.md, "A capture point behind both feet"; None: off)

@@ -838,13 +838,13 @@ class MotionOptimizer:
         """Whether a step begun at the operator's next lift-off (:meth:`_wait_for_his_lift_off_s`) would land with
         the capture point out of a recovery step's reach whichever foot stands, while a recovery step begun now
         captures it (recovery_step.out_of_reach_after_wait, RecoveryStepper.capture_residual_m; with one sole on
-        the ground, the first test alone). Waiting cannot be better then; where no step now captures it either, the
-        pendulum's prediction is no reason to step before him (the controller may still bring it back)."""
+        the ground, or with ``recovery_ds_beyond_reach``, the first test alone). Waiting cannot be better then; where
+        no step now captures it either, the step that lands furthest towards it leaves the least for the next."""
         if not out_of_reach_after_wait(tick.com_c, tick.com_vel_c, self.g, tick.a_c, quats, on_ground,
                                        self._wait_for_his_lift_off_s(tick, state), self.cfg.recovery_swing_s,
                                        self.recovery.max_step_m):
             return False
-        if len(on_ground) < 2:
+        if len(on_ground) < 2 or self.cfg.recovery_ds_beyond_reach:
             return True
         return min(self.recovery.capture_residual_m(tick.com_c, tick.com_vel_c, tick.a_c[s], quats[s], tick.R_root_d,
                                                     OTHER_SIDE[s]) for s in on_ground) <= 0.0
