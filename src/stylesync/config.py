@@ -149,6 +149,11 @@ class MotionConfig:
     # above, while the character's capture point is further than this outside its other sole towards the lifting
     # foot. Standing on that sole alone, the body could only fall back onto the foot it lifts [m] (None: off).
     liftoff_capture_behind_m: float | None = 0.05
+    # ... and while that holds, the foot stays down however long (False: at most liftoff_weight_shift_s, as the
+    # sideways weight shift): no weight shift brings back a capture point the body is moving past, and the double
+    # stance's own rules step the foot the balance chooses meanwhile (docs/decisions.md, "A lift-off onto the wrong
+    # foot")
+    liftoff_behind_waits: bool = True
     # A lift-off from double stance waits, however long, while the foot the operator lifts is the only one of the
     # character's on the ground (stance_fsm.CharacterStanceFsm): lifted, it would leave the body on a foot in the air
     # (docs/decisions.md, "A lift-off onto a foot in the air").

@@ -276,6 +276,8 @@ class MotionOptimizer:
         self._op_swing_s = OPERATOR_SWING_S  # the operator's swing time, averaged over his swings [s]
         self._op_state: Stance | None = None
         self._op_state_t0_s = 0.0
+        # Per foot, whether this tick's lift-off test holds it down for the capture point beyond its other sole
+        self._lift_blocked_behind = {"left": False, "right": False}
         self._op_last_ds_s = 0.0
         self.recovery = RecoveryStepper(cfg, CHAR_LEG_LENGTH_M, gravity_mps2)
         self._operator_stands_since_s: float | None = None
@@ -346,6 +348,7 @@ class MotionOptimizer:
             foot_q = state.link_quat_wxyz[_LINK[f"{stance}_ankle"]]
             may = not (behind_limit_m is not None and pressing[side] and beyond_sole_towards_m(
                 xi, ankle, foot_q, state.link_origin_world[_LINK[f"{side}_ankle"]]) > behind_limit_m)
+            self._lift_blocked_behind[side] = not may
             if after_stand:
                 ankle_h = sample.pos[f"ANKLE_{_SIDE_UP[stance]}"]
                 yaw_h = rot.twist_angle(sample.quat[f"ANKLE_{_SIDE_UP[stance]}"], _UP)
@@ -408,8 +411,13 @@ class MotionOptimizer:
         contact = self._feet_down(state)
         # Only a lift-off from double stance can wait for the weight to shift.
         lifting = op_state is not Stance.DS and self.char_fsm.state is Stance.DS
+        self._lift_blocked_behind = {"left": False, "right": False}
         can_lift = self._can_lift(sample, state, mass) if lifting else None
-        ch_state = self.char_fsm.update(op_state, contact, state.time_s, can_lift, self.cfg.liftoff_weight_shift_s)
+        lift_wait_s = self.cfg.liftoff_weight_shift_s
+        sw_op = swing_side(op_state)
+        if self.cfg.liftoff_behind_waits and sw_op is not None and self._lift_blocked_behind[sw_op]:
+            lift_wait_s = math.inf
+        ch_state = self.char_fsm.update(op_state, contact, state.time_s, can_lift, lift_wait_s)
         if self.char_fsm.recovery_step:
             self._feet_by_own_step = True
         elif ch_state is not Stance.DS:
