@@ -224,12 +224,13 @@ def test_a_long_single_stance_keeps_the_capture_point_where_the_landing_catches_
     across the heading (MotionConfig.landing_capture_bound "sideways") the target's capture point stays where the
     landing catches it, and the walk holds through its 12 s. (Traced with the reach rule predicting for now once
     his usual swing time is past, ``recovery_overdue_swing_horizon`` off: with it on, the default walk of seed 0
-    stands too; and before a recovery step's timing adapted to its reach, ``recovery_swing_min_s`` None: with it, the
-    walk stands too.)"""
+    stands too; and before a recovery step's timing adapted to its reach, ``recovery_swing_min_s`` None, and before a
+    lift-off onto a sole the capture point has passed waited however long, ``liftoff_behind_waits`` off: with either,
+    the walk stands too.)"""
     from conftest import suite_run
 
     spec = f"deepmimic:{ZOMBIE}"
-    then = {"recovery_overdue_swing_horizon": False, "recovery_swing_min_s": None}
+    then = {"recovery_overdue_swing_horizon": False, "recovery_swing_min_s": None, "liftoff_behind_waits": False}
     off = suite_run(spec, 0, MotionConfig(**then), TRACED_DIFFERENCED)
     sideways = suite_run(spec, 0, MotionConfig(landing_capture_bound="sideways", **then), TRACED_DIFFERENCED)
     assert off.fell and off.fall_time_s < 6.0

@@ -50,7 +50,9 @@ def test_the_zombie_walk_goes_his_way_when_its_own_steps_walk_on_only_along_it()
     """The zombie walk (seed 0, as the development suite runs it) with the path settings: its own steps walked on
     along the capture point's divergence, sideways too, and the character walked 3.6 m to the side of his path, its
     progress along it negative (-0.15). Walking on only along his way, and keeping a gait only while he goes somewhere,
-    it goes 0.37 of his way (measured), with no fall either way."""
+    it goes 0.37 of his way (measured), with no fall either way. (Traced while a lift-off onto a sole the capture
+    point has passed waited only the weight shift's time, ``liftoff_behind_waits`` off: with it, and these path
+    settings alone, the walk goes 0.15 of his way; with all of ``--follow-path``'s it goes 0.92 either way.)"""
     import logging
 
     from conftest import TRACED_DIFFERENCED, suite_run
@@ -61,9 +63,11 @@ def test_the_zombie_walk_goes_his_way_when_its_own_steps_walk_on_only_along_it()
     logging.disable(logging.WARNING)
     try:
         spec = f"deepmimic:{ZOMBIE}"
-        own = summarize(suite_run(spec, 0, MotionConfig(**PATH_OPT_INS), TRACED_DIFFERENCED))
+        own = summarize(suite_run(spec, 0, MotionConfig(**PATH_OPT_INS, liftoff_behind_waits=False),
+                                  TRACED_DIFFERENCED))
         his = summarize(suite_run(spec, 0, MotionConfig(**PATH_OPT_INS, recovery_walk_on_his_way=True,
-                                                        gait_min_way_speed_mps=0.3), TRACED_DIFFERENCED))
+                                                        gait_min_way_speed_mps=0.3, liftoff_behind_waits=False),
+                                  TRACED_DIFFERENCED))
     finally:
         logging.disable(logging.NOTSET)
     assert not own["fell"] and not his["fell"]

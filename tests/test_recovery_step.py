@@ -50,9 +50,12 @@ def traced_motion(**kwargs) -> MotionConfig:
     its distance to the capture point (``recovery_landing_foot_waits`` off), and Eq. 10's fraction by side after a
     step of the character's own (``fraction_needs_feet_in_his_order`` off): their motion configurations start from
     it. They were traced before a recovery step's timing adapted to its reach (``recovery_swing_min_s`` None), and
-    before a lift-off waited for the other foot to be down (``liftoff_needs_other_foot_down`` off)."""
+    before a lift-off waited for the other foot to be down (``liftoff_needs_other_foot_down`` off), and while a
+    lift-off onto a sole the capture point has passed waited only the weight shift's time (``liftoff_behind_waits``
+    off)."""
     return MotionConfig(**{"swing_landing": "his_foot_now", "recovery_overdue_swing_horizon": False,
                            "recovery_swing_min_s": None, "liftoff_needs_other_foot_down": False,
+                           "liftoff_behind_waits": False,
                            "recovery_cross_nearest": False, "recovery_cross_stance_frame": False,
                            "recovery_landing_foot_waits": False, "fraction_needs_feet_in_his_order": False,
                            **kwargs})
@@ -1348,7 +1351,8 @@ def test_a_recovery_step_whose_landing_is_due_is_pressed_onto_the_ground():
     (MotionConfig.recovery_swing_min_s None: a step shortened to land before the capture point leaves the reach is due
     sooner, while its foot is still on its way, and that configuration's landings then wait up to 0.17 s), and before
     a lift-off waited for the other foot to be down (MotionConfig.liftoff_needs_other_foot_down off), and before the
-    pelvis tracked a jump's push (WholeBodyConfig.pelvis_rate_share 0)."""
+    pelvis tracked a jump's push (WholeBodyConfig.pelvis_rate_share 0), and while a lift-off onto a sole the capture
+    point has passed waited only the weight shift's time (MotionConfig.liftoff_behind_waits off)."""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '08_08.bvh'}"
 
     def run(landing_weight: float):
@@ -1368,7 +1372,7 @@ def test_a_recovery_step_whose_landing_is_due_is_pressed_onto_the_ground():
 
         result = suite_run(spec, 1, MotionConfig(recovery_cross_nearest=False, recovery_cross_stance_frame=False,
                                                  fraction_needs_feet_in_his_order=False, recovery_swing_min_s=None,
-                                                 liftoff_needs_other_foot_down=False),
+                                                 liftoff_needs_other_foot_down=False, liftoff_behind_waits=False),
                            ControlConfig(whole_body=WholeBodyConfig(recovery_foot_landing_weight=landing_weight,
                                                                         pelvis_rate_share=0.0,
                                                                         recovery_foot_target_rate="differenced",
