@@ -276,8 +276,6 @@ class MotionOptimizer:
         self._op_swing_s = OPERATOR_SWING_S  # the operator's swing time, averaged over his swings [s]
         self._op_state: Stance | None = None
         self._op_state_t0_s = 0.0
-        # Per foot, whether this tick's lift-off test holds it down for the capture point beyond its other sole
-        self._lift_blocked_behind = {"left": False, "right": False}
         self._op_last_ds_s = 0.0
         self.recovery = RecoveryStepper(cfg, CHAR_LEG_LENGTH_M, gravity_mps2)
         self._operator_stands_since_s: float | None = None
@@ -310,8 +308,9 @@ class MotionOptimizer:
 
     # ---- 1. stance tracking (Sec. 5.1) ---------------------------------------------------------------------
     def _can_lift(self, sample: OperatorSample, state: CharacterState, mass: MassProperties
-                  ) -> dict[str, bool] | None:
-        """Weight shift before a lift-off: per foot, whether the character may lift it now. None: no such test now.
+                  ) -> tuple[dict[str, bool] | None, set[str]]:
+        """Weight shift before a lift-off: per foot, whether the character may lift it now (None: no such test now),
+        and the feet held down by the first test below (``liftoff_behind_waits``: those wait however long).
 
         * Any lift-off (``liftoff_capture_behind_m``): a foot that bears weight may not while the character's
           capture point is further than that outside its other sole towards it
@@ -328,12 +327,12 @@ class MotionOptimizer:
           ``liftoff_shift_outward_m``."""
         cfg = self.cfg
         if cfg.liftoff_weight_shift_s <= 0.0:
-            return None
+            return None, set()
         stood_s = (state.time_s - self._op_state_t0_s) if self._op_state is Stance.DS else self._op_last_ds_s
         after_stand = stood_s >= cfg.liftoff_after_stand_s
         behind_limit_m = cfg.liftoff_capture_behind_m
         if behind_limit_m is None and not after_stand:
-            return None
+            return None, set()
         xi, _ = capture_point(mass.com(state), mass.com_velocity(state), self.g)
         pressing = state.feet_pressing()
         if after_stand:
@@ -341,14 +340,15 @@ class MotionOptimizer:
             h_h = max(sample.com_world[2] - min(sample.pos["ANKLE_LEFT"][2], sample.pos["ANKLE_RIGHT"][2]), 0.1)
             xi_h = sample.com_world + self._com_h_rate.rate * np.sqrt(h_h / self.g)
             edge = FOOT_WIDTH_M / 2 + cfg.liftoff_margin_m
-        can = {}
+        can, behind = {}, set()
         for side in ("left", "right"):
             stance = OTHER_SIDE[side]
             ankle = state.link_origin_world[_LINK[f"{stance}_ankle"]]
             foot_q = state.link_quat_wxyz[_LINK[f"{stance}_ankle"]]
             may = not (behind_limit_m is not None and pressing[side] and beyond_sole_towards_m(
                 xi, ankle, foot_q, state.link_origin_world[_LINK[f"{side}_ankle"]]) > behind_limit_m)
-            self._lift_blocked_behind[side] = not may
+            if not may:
+                behind.add(side)
             if after_stand:
                 ankle_h = sample.pos[f"ANKLE_{_SIDE_UP[stance]}"]
                 yaw_h = rot.twist_angle(sample.quat[f"ANKLE_{_SIDE_UP[stance]}"], _UP)
@@ -363,7 +363,7 @@ class MotionOptimizer:
                     if cfg.liftoff_shift_outward_m is not None:  # nor beyond the stance ankle, outwards
                         may = may and inward >= -cfg.liftoff_shift_outward_m
             can[side] = may
-        return can
+        return can, behind
 
     def _feet_down(self, state: CharacterState) -> dict[str, bool]:
         """Per side, whether the foot is on the ground: it presses it (``CharacterState.feet_pressing``), or it is a
@@ -411,12 +411,10 @@ class MotionOptimizer:
         contact = self._feet_down(state)
         # Only a lift-off from double stance can wait for the weight to shift.
         lifting = op_state is not Stance.DS and self.char_fsm.state is Stance.DS
-        self._lift_blocked_behind = {"left": False, "right": False}
-        can_lift = self._can_lift(sample, state, mass) if lifting else None
+        can_lift, behind = self._can_lift(sample, state, mass) if lifting else (None, set())
         lift_wait_s = self.cfg.liftoff_weight_shift_s
-        sw_op = swing_side(op_state)
-        if self.cfg.liftoff_behind_waits and sw_op is not None and self._lift_blocked_behind[sw_op]:
-            lift_wait_s = math.inf
+        if self.cfg.liftoff_behind_waits and swing_side(op_state) in behind:
+            lift_wait_s = math.inf  # no weight shift brings back a capture point the body moves past
         ch_state = self.char_fsm.update(op_state, contact, state.time_s, can_lift, lift_wait_s)
         if self.char_fsm.recovery_step:
             self._feet_by_own_step = True
