@@ -842,10 +842,10 @@ class MotionOptimizer:
     def _his_lift_off_too_late(self, tick: _Tick, state: CharacterState, on_ground: list[str],
                                quats: dict[str, np.ndarray]) -> bool:
         """Whether a step begun at the operator's next lift-off (:meth:`_wait_for_his_lift_off_s`) would land with
-        the capture point out of a recovery step's reach whichever foot stands, while a recovery step begun now
-        captures it (recovery_step.out_of_reach_after_wait, RecoveryStepper.capture_residual_m; with one sole on
-        the ground, or with ``recovery_ds_beyond_reach``, the first test alone). Waiting cannot be better then; where
-        no step now captures it either, the step that lands furthest towards it leaves the least for the next."""
+        the capture point out of a recovery step's reach whichever foot stands (recovery_step.out_of_reach_after_wait):
+        waiting cannot be better then. Without ``recovery_ds_beyond_reach``, and with both soles on the ground, only
+        where a recovery step begun now captures it (RecoveryStepper.capture_residual_m); with it, also where none
+        does: the step that lands furthest towards it leaves the least for the next."""
         if not out_of_reach_after_wait(tick.com_c, tick.com_vel_c, self.g, tick.a_c, quats, on_ground,
                                        self._wait_for_his_lift_off_s(tick, state), self.cfg.recovery_swing_s,
                                        self.recovery.max_step_m):
