@@ -354,6 +354,10 @@ class MotionConfig:
     # (capture_bound_sole_share); False: not while the operator walks from one foot onto the other
     # (double_stance_momentum.moves_between_feet), whose capture point runs ahead of his front foot.
     capture_bound_in_his_gait: bool = True
+    # ... and while he is on one foot of his gait (he goes somewhere, his capture point outside the sole he stands on)
+    # and the character on both (its step landed before his). False: there too the bound is his gait's
+    # (gait_capture_step_s), not the soles', which braked the character to a stop before each of his landings.
+    capture_bound_before_his_landing: bool = True
     # ... and where it is False, opt-in: in his gait's double stance the COM target's capture point runs ahead of the
     # soles by at most what a step this long from now catches within a recovery step's reach
     # (capture_bound.gait_capture_margin_m: reach e^(-ω T)); None: unbounded there [s].
@@ -737,6 +741,7 @@ class SessionConfig:
 FOLLOW_PATH_MOTION: dict[str, Any] = {
     "double_stance_keeps_momentum_m": 0.1,  # a gait's double stance does not brake it
     "capture_bound_in_his_gait": False,  # nor does the capture bound while he walks
+    "capture_bound_before_his_landing": False,  # nor while its step has landed before his
     "gait_capture_step_s": 0.3,  # but its capture point runs ahead no further than a step then catches
     "reference_follows_operator_s": 0.5,  # the targets go on at his speed
     "path_feedback_share": 0.5,  # each landing takes up half the path's error

@@ -46,7 +46,7 @@ from stylesync.model.state import CharacterState, MassProperties
 from stylesync.motion.balance_strategy import stance_hip_blend, swing_hip_feedback
 from stylesync.motion.bounds import BoundsMonitor, step_length_bound_m
 from stylesync.motion.capture_bound import bounded_com_target, gait_capture_margin_m, landing_catch_region
-from stylesync.motion.double_stance_momentum import kept_com_velocity, moves_between_feet
+from stylesync.motion.double_stance_momentum import GAIT_AXIS_DEG, kept_com_velocity, moves_between_feet
 from stylesync.motion.his_rise import HisRise
 from stylesync.motion.leg_ik import solve_leg
 from stylesync.motion.operator_analysis import UPPER_JOINTS, OperatorAnalysis, analyse_operator, upper_local
@@ -91,6 +91,7 @@ _SCALE_SMOOTHING = 0.02  # per tick, exponential average of the operator's leg l
 _BALL_JOINTS = [k for k, j in enumerate(JOINTS) if j.kind is JointKind.BALL]
 _HINGE_JOINTS = [k for k, j in enumerate(JOINTS) if j.kind is not JointKind.BALL]
 _VELOCITY_SMOOTHING = 0.2  # per tick, exponential average of the desired COM velocity
+_GAIT_AXIS_COS = math.cos(math.radians(GAIT_AXIS_DEG))
 _SIDE_UP = {"left": "LEFT", "right": "RIGHT"}
 _LINK = {n: i for i, n in enumerate(LINK_NAMES)}
 _ROOT_LINK = _LINK["root"]
@@ -660,6 +661,16 @@ class MotionOptimizer:
         return (moves_between_feet(tick.com_vel_h, his_ankles_world["left"], his_ankles_world["right"])
                 and self.way.goes(self.cfg.gait_min_way_speed_mps, tick.scale * tick.com_vel_h))
 
+    def _goes_his_way(self, tick: _Tick) -> bool:
+        """Whether the operator goes somewhere (operator_way.py, MotionConfig.gait_min_way_speed_mps) and his COM
+        moves now within GAIT_AXIS_DEG of that way (a walk's, not a turn on the spot's or a dance's swing)."""
+        v_now = tick.scale * tick.com_vel_h
+        if not self.way.goes(self.cfg.gait_min_way_speed_mps, v_now):
+            return False
+        way = self.way.direction_world()
+        speed = float(np.hypot(v_now[0], v_now[1]))
+        return way is not None and float(way[0] * v_now[0] + way[1] * v_now[1]) >= _GAIT_AXIS_COS * speed
+
     def _walk_on(self, tick: _Tick) -> WalkOn | None:
         """How the character's own step lands while the operator walks (recovery_step.WalkOn): None while he stands
         or does not go anywhere (MotionConfig.gait_min_way_speed_mps; the step stops the body), or with
@@ -710,8 +721,13 @@ class MotionOptimizer:
         if tick.ch_state is Stance.DS:
             # Opt-out: not while he walks from one foot onto the other (his gait's capture point runs ahead of his
             # front foot, and the character's, bounded within its soles, was braked at every double stance).
-            return (self.cfg.capture_bound_in_his_gait or tick.op_state is not Stance.DS
-                    or not self._his_gait(tick, tick.sample.support_ankle_world))
+            if tick.op_state is Stance.DS:
+                return self.cfg.capture_bound_in_his_gait or not self._his_gait(tick, tick.sample.support_ankle_world)
+            # He is on one foot, the character on both: its step landed before his.
+            if self.cfg.capture_bound_before_his_landing:
+                return True
+            he_stands_on = tuple(s for s in _SIDE_UP if swing_side(tick.op_state) != s)
+            return self._operator_stands(tick, he_stands_on) or not self._goes_his_way(tick)
         sides = tuple(s for s in _SIDE_UP if tick.op_state is Stance.DS or swing_side(tick.op_state) != s)
         return self._operator_stands(tick, sides)
 
