@@ -354,14 +354,16 @@ class MotionConfig:
     # (capture_bound_sole_share); False: not while the operator walks from one foot onto the other
     # (double_stance_momentum.moves_between_feet), whose capture point runs ahead of his front foot.
     capture_bound_in_his_gait: bool = True
-    # ... and while he is on one foot of his gait (he goes somewhere, his capture point outside the sole he stands on)
-    # and the character on both (its step landed before his). False: there too the bound is his gait's
-    # (gait_capture_step_s), not the soles', which braked the character to a stop before each of his landings.
-    capture_bound_before_his_landing: bool = True
     # ... and where it is False, opt-in: in his gait's double stance the COM target's capture point runs ahead of the
     # soles by at most what a step this long from now catches within a recovery step's reach
     # (capture_bound.gait_capture_margin_m: reach e^(-ω T)); None: unbounded there [s].
     gait_capture_step_s: float | None = None
+    # While the operator is on one foot of his gait (he goes somewhere, his COM moving his way, his capture point
+    # outside the sole he stands on) and the character on both (its step landed before his), the COM target's capture
+    # point is kept within its soles; False: there too the bound is his gait's double stance's (gait_capture_step_s;
+    # none where that is None), not the soles', which braked the character to a stop before each of his landings
+    # (docs/decisions.md, "A step landed before his").
+    capture_bound_before_his_landing: bool = True
     # While the operator walks (his capture point outside his soles), a recovery step lands with the capture point
     # this far ahead of its ankle instead of on its sole's trailing edge: a step that walks on with him rather than
     # one that stops the body (recovery_step.capture_landing). None: every recovery step stops it [m].

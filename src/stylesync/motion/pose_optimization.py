@@ -715,9 +715,10 @@ class MotionOptimizer:
 
     def _capture_bounded(self, tick: _Tick) -> bool:
         """Whether the COM target's capture point is bounded to the character's soles this tick (capture_bound.py):
-        in the character's double stance, and in its single stance while the operator's capture point is within the
-        soles he stands on (he balances on one leg, as in a kick, or he has stopped while the character's foot is
-        still in the air)."""
+        in the character's double stance (but, with the opt-outs, not in his gait's double stance, nor while he is on
+        one foot of his gait and the character on both), and in its single stance while the operator's capture point
+        is within the soles he stands on (he balances on one leg, as in a kick, or he has stopped while the
+        character's foot is still in the air)."""
         if tick.ch_state is Stance.DS:
             # Opt-out: not while he walks from one foot onto the other (his gait's capture point runs ahead of his
             # front foot, and the character's, bounded within its soles, was braked at every double stance).
