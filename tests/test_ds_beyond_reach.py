@@ -43,7 +43,10 @@ def _followed_walk(beyond_reach: bool) -> tuple[float, bool, float | None]:
 
     def configure(cfg):
         cfg = follow_path(cfg)
-        return dataclasses.replace(cfg, motion=dataclasses.replace(cfg.motion, recovery_ds_beyond_reach=beyond_reach))
+        # traced before the bound before his landing (docs/decisions.md, "A step landed before his"), off here
+        motion = dataclasses.replace(cfg.motion, recovery_ds_beyond_reach=beyond_reach,
+                                     capture_bound_before_his_landing=True)
+        return dataclasses.replace(cfg, motion=motion)
 
     result = suite_run(f"bvh:{WALK}", 0, MotionConfig(), ControlConfig(), watch=watch, configure=configure)
     return longest, result.fell, result.fall_time_s
