@@ -74,3 +74,18 @@ def test_the_zombie_walk_goes_his_way_when_its_own_steps_walk_on_only_along_it()
     assert own["path_progress"] < 0.0
     assert his["path_progress"] > 0.25
     assert his["path_sideways_m"] < own["path_sideways_m"]
+
+
+def test_his_way_along_it_and_not_across():
+    """He goes his way while his present velocity is within the given angle of the average; not across it, not
+    while the average is at rest, and not while he goes too slowly (OperatorWay.goes_along)."""
+    import math
+
+    way = OperatorWay(1.0, 0.01)
+    way.prime(np.array([1.0, 0.0]))
+    cos45 = math.cos(math.radians(45.0))
+    assert way.goes_along(0.3, np.array([0.8, 0.3]), cos45)  # 20° off the way
+    assert not way.goes_along(0.3, np.array([0.3, 0.8]), cos45)  # 69° off: a dance's swing
+    assert not way.goes_along(0.3, np.array([0.1, 0.0]), cos45)  # too slow now
+    way.prime(np.zeros(2))
+    assert not way.goes_along(None, np.array([0.8, 0.3]), cos45)  # no way to go along

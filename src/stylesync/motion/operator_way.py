@@ -39,6 +39,19 @@ class OperatorWay:
             return False
         return float(np.hypot(*self.velocity_world)) >= min_speed_mps
 
+    def goes_along(self, min_speed_mps: float | None, velocity_now_world: np.ndarray, min_cos: float) -> bool:
+        """Whether he goes somewhere (:meth:`goes`, with ``velocity_now_world``) and his present scaled COM velocity
+        ((2,) or (3,) [m/s]) is within the angle whose cosine is ``min_cos`` of the average: a walk's, not the swing
+        of a dance or a turn on the spot. False while the average is (nearly) zero."""
+        if not self.goes(min_speed_mps, velocity_now_world):
+            return False
+        avg = self.velocity_world
+        avg_speed = float(np.hypot(avg[0], avg[1]))
+        if avg_speed < 1e-6:
+            return False
+        vx, vy = float(velocity_now_world[0]), float(velocity_now_world[1])
+        return (avg[0] * vx + avg[1] * vy) / avg_speed >= min_cos * float(np.hypot(vx, vy))
+
     def direction_world(self) -> np.ndarray | None:
         """(3,) the unit horizontal direction of the average, or None when it is (nearly) zero."""
         speed = float(np.hypot(*self.velocity_world))

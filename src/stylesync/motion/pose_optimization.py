@@ -661,16 +661,6 @@ class MotionOptimizer:
         return (moves_between_feet(tick.com_vel_h, his_ankles_world["left"], his_ankles_world["right"])
                 and self.way.goes(self.cfg.gait_min_way_speed_mps, tick.scale * tick.com_vel_h))
 
-    def _goes_his_way(self, tick: _Tick) -> bool:
-        """Whether the operator goes somewhere (operator_way.py, MotionConfig.gait_min_way_speed_mps) and his COM
-        moves now within GAIT_AXIS_DEG of that way (a walk's, not a turn on the spot's or a dance's swing)."""
-        v_now = tick.scale * tick.com_vel_h
-        if not self.way.goes(self.cfg.gait_min_way_speed_mps, v_now):
-            return False
-        way = self.way.direction_world()
-        speed = float(np.hypot(v_now[0], v_now[1]))
-        return way is not None and float(way[0] * v_now[0] + way[1] * v_now[1]) >= _GAIT_AXIS_COS * speed
-
     def _walk_on(self, tick: _Tick) -> WalkOn | None:
         """How the character's own step lands while the operator walks (recovery_step.WalkOn): None while he stands
         or does not go anywhere (MotionConfig.gait_min_way_speed_mps; the step stops the body), or with
@@ -719,16 +709,15 @@ class MotionOptimizer:
         one foot of his gait and the character on both), and in its single stance while the operator's capture point
         is within the soles he stands on (he balances on one leg, as in a kick, or he has stopped while the
         character's foot is still in the air)."""
-        if tick.ch_state is Stance.DS:
+        if tick.ch_state is Stance.DS and tick.op_state is Stance.DS:
             # Opt-out: not while he walks from one foot onto the other (his gait's capture point runs ahead of his
             # front foot, and the character's, bounded within its soles, was braked at every double stance).
-            if tick.op_state is Stance.DS:
-                return self.cfg.capture_bound_in_his_gait or not self._his_gait(tick, tick.sample.support_ankle_world)
-            # He is on one foot, the character on both: its step landed before his.
-            if self.cfg.capture_bound_before_his_landing:
-                return True
-            he_stands_on = tuple(s for s in _SIDE_UP if swing_side(tick.op_state) != s)
-            return self._operator_stands(tick, he_stands_on) or not self._goes_his_way(tick)
+            return self.cfg.capture_bound_in_his_gait or not self._his_gait(tick, tick.sample.support_ankle_world)
+        if tick.ch_state is Stance.DS and self.cfg.capture_bound_before_his_landing:
+            return True  # he is on one foot, the character on both: its step landed before his
+        if tick.ch_state is Stance.DS and not self.way.goes_along(
+                self.cfg.gait_min_way_speed_mps, tick.scale * tick.com_vel_h, _GAIT_AXIS_COS):
+            return True  # ... and, with the opt-out, still while he does not walk his way; while he does, as below
         sides = tuple(s for s in _SIDE_UP if tick.op_state is Stance.DS or swing_side(tick.op_state) != s)
         return self._operator_stands(tick, sides)
 
