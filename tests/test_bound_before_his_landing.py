@@ -30,7 +30,9 @@ def _followed_walk(bounded: bool) -> tuple[float, int, float, bool]:
 
     def configure(cfg):
         cfg = follow_path(cfg)
-        motion = dataclasses.replace(cfg.motion, capture_bound_before_his_landing=bounded)
+        # Traced before the rule for a foot lying on the ground (landing_reach_ground_gap_m): pinned off
+        motion = dataclasses.replace(cfg.motion, capture_bound_before_his_landing=bounded,
+                                     landing_reach_ground_gap_m=None)
         return dataclasses.replace(cfg, motion=motion)
 
     result = suite_run("builtin:walk", 0, MotionConfig(), ControlConfig(), watch=watch, configure=configure)

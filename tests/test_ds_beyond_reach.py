@@ -45,7 +45,8 @@ def _followed_walk(beyond_reach: bool) -> tuple[float, bool, float | None]:
         cfg = follow_path(cfg)
         # traced before the bound before his landing (docs/decisions.md, "A step landed before his"), off here
         motion = dataclasses.replace(cfg.motion, recovery_ds_beyond_reach=beyond_reach,
-                                     capture_bound_before_his_landing=True)
+                                     capture_bound_before_his_landing=True,
+                                     landing_reach_ground_gap_m=None)
         return dataclasses.replace(cfg, motion=motion)
 
     result = suite_run(f"bvh:{WALK}", 0, MotionConfig(), ControlConfig(), watch=watch, configure=configure)

@@ -167,7 +167,8 @@ def test_targets_on_his_path_keep_the_stealthy_walk_within_the_uhc_distance():
 
     def without_pull(cfg):
         cfg = follow_path(cfg)
-        return cfg.replace(motion=dataclasses.replace(cfg.motion, path_target_share=0.0),
+        return cfg.replace(motion=dataclasses.replace(cfg.motion, path_target_share=0.0,
+                                                      landing_reach_ground_gap_m=None),
                            control=dataclasses.replace(cfg.control, whole_body=dataclasses.replace(
                                cfg.control.whole_body, own_step_push_bound="he_stands")))
 
@@ -206,7 +207,8 @@ def test_a_gait_double_stance_bounded_by_what_a_step_catches_keeps_fast_walks_up
         def with_bound(cfg):
             cfg = follow_path(cfg).replace(duration_s=5.5)
             cfg = cfg.replace(motion=dataclasses.replace(cfg.motion, recovery_ds_beyond_reach=False,
-                                                         capture_bound_before_his_landing=True))
+                                                         capture_bound_before_his_landing=True,
+                                                         landing_reach_ground_gap_m=None))
             if not bounded:
                 cfg = cfg.replace(motion=dataclasses.replace(cfg.motion, gait_capture_step_s=None))
             return cfg

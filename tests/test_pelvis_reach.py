@@ -34,7 +34,8 @@ def _followed_walk(share: float | None) -> tuple[float, float, bool]:
 
     def configure(cfg):
         cfg = follow_path(cfg)
-        return dataclasses.replace(cfg, motion=dataclasses.replace(cfg.motion, pelvis_stance_reach_share=share))
+        return dataclasses.replace(cfg, motion=dataclasses.replace(cfg.motion, pelvis_stance_reach_share=share,
+                                                                             landing_reach_ground_gap_m=None))
 
     result = suite_run(f"bvh:{WALK}", 0, MotionConfig(), ControlConfig(), on_tick, configure=configure)
     a = np.array(rec)

@@ -313,6 +313,11 @@ class MotionConfig:
     # ahead of it in a walk's rest), the foot was out of reach, and the pelvis target dropped to the foot's own
     # height (docs/decisions.md, "A pelvis target out of a landing foot's reach"; 0: no floor) [-]
     landing_pelvis_floor_share: float = 0.6
+    # ... but a foot whose sole's lowest corner is within this of the ground is on it, pressing or not, and needs no
+    # lowering: a supporting foot resting unloaded (0-4 N, below CONTACT_FORCE_N) read as one that must land, and the
+    # pelvis target dropped to its floor (0.3 m) and back on alternate control ticks while the stance knee folded
+    # (docs/decisions.md, "A foot on the ground that must land"; None: by its pressing alone) [m]
+    landing_reach_ground_gap_m: float | None = None
     # The pelvis target (Eq. 9) no higher than this share of the leg's length reaches above each planted stance foot
     # (hip to ankle, from the target's hip). His pelvis, scaled, can sit above what the character's straight legs
     # reach (CMU 02_01: 0.94 m against 0.88 m): the stance leg is then held straight, and the lowering above for a
@@ -452,6 +457,8 @@ class MotionConfig:
         if self.pelvis_stance_reach_share is not None and not 0.0 < self.pelvis_stance_reach_share <= 1.0:
             raise ConfigError(f"MotionConfig.pelvis_stance_reach_share must be within (0, 1] or None, got "
                               f"{self.pelvis_stance_reach_share}")
+        if self.landing_reach_ground_gap_m is not None:
+            _positive("MotionConfig.landing_reach_ground_gap_m", self.landing_reach_ground_gap_m)
         if not 0.0 <= self.landing_pelvis_floor_share <= 1.0:
             raise ConfigError(f"MotionConfig.landing_pelvis_floor_share must be within [0, 1], got "
                               f"{self.landing_pelvis_floor_share}")
@@ -751,6 +758,7 @@ FOLLOW_PATH_MOTION: dict[str, Any] = {
     "recovery_walk_on_his_way": True,  # along his way over the ground, a divergence across it caught
     "gait_min_way_speed_mps": 0.3,  # a gait only while he goes somewhere (not a sway on the spot, not a stop)
     "path_target_share": 1.0,  # the targets pulled to his path, at most path_target_max_m (0.3 m) ahead
+    "landing_reach_ground_gap_m": 0.003,  # a foot lying on the ground, pressing or not, is not lowered for
 }
 # ... and in the whole-body controller (docs/decisions.md, "Targets on his path")
 FOLLOW_PATH_WHOLE_BODY: dict[str, Any] = {

@@ -634,7 +634,7 @@ class MotionOptimizer:
                                                                                   self._stance_reach_m))
         for side, sign in (("left", 1.0), ("right", -1.0)):
             must_land = tick.weights[side] > 0 or (side == sw and (self.char_fsm.hold_reference or landing_step))
-            if must_land and not tick.contact[side]:
+            if must_land and not tick.contact[side] and not self._sole_on_ground(state, side):
                 # The character's own step: from where its hip is (the operator's pelvis target may be anywhere
                 # behind a body that carries momentum he does not have).
                 hip_xy = state.link_origin_world[_LINK[f"{side}_hip"]][:2] if side == sw and landing_step else None
@@ -642,6 +642,13 @@ class MotionOptimizer:
                 if lowered < tick.pelvis_d[2]:
                     tick.pelvis_d[2] = lowered
                     tick.pelvis_vel_z = 0.0
+
+    def _sole_on_ground(self, state: CharacterState, side: str) -> bool:
+        """Whether the foot on ``side`` lies on the ground unpressed: its sole's lowest corner within
+        MotionConfig.landing_reach_ground_gap_m of it (False with that None)."""
+        gap = self.cfg.landing_reach_ground_gap_m
+        ankle = _LINK[f"{side}_ankle"]
+        return gap is not None and sole_within_m(state.link_origin_world[ankle], state.link_quat_wxyz[ankle], gap)
 
     def _pelvis_within_m(self, tick: _Tick, side: str, sign: float, reach_m: float,
                          hip_xy: np.ndarray | None = None) -> float:
