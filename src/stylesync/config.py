@@ -318,6 +318,10 @@ class MotionConfig:
     # pelvis target dropped to its floor (0.3 m) and back on alternate control ticks while the stance knee folded
     # (docs/decisions.md, "A foot on the ground that must land"; None: by its pressing alone) [m]
     landing_reach_ground_gap_m: float | None = None
+    # The pelvis target lowered for a foot that must land comes down at most at this speed from the last control
+    # tick's: the lowering to a foot out of reach came as one step of 0.3-0.4 m within a tick at landings of the
+    # humanoid3d spinning kick (docs/decisions.md, "A foot on the ground that must land"; None: at once) [m/s]
+    landing_pelvis_descent_mps: float | None = None
     # The pelvis target (Eq. 9) no higher than this share of the leg's length reaches above each planted stance foot
     # (hip to ankle, from the target's hip). His pelvis, scaled, can sit above what the character's straight legs
     # reach (CMU 02_01: 0.94 m against 0.88 m): the stance leg is then held straight, and the lowering above for a
@@ -410,6 +414,12 @@ class MotionConfig:
     # ground, and the stance leg folded (docs/decisions.md, "An operator in the air"; None: from the foot wherever
     # it is) [-]
     airborne_ankle_height_leg: float | None = 0.2
+    # ... and so is it where Eq. 10 is anchored on both his feet (his double stance, or the character's while a late
+    # contact holds the reference): from the mean of his two ankles' ground heights, not of the ankles wherever they
+    # are. From the ankles, his kick in the air while the character stood on both feet dropped the pelvis target by
+    # 0.67 m for a control tick (the humanoid3d spinning kick; docs/decisions.md, "An operator in the air, anchored on
+    # both feet"; False: from the ankles)
+    ds_anchor_ground_height: bool = False
 
     def __post_init__(self) -> None:
         lo, hi = self.step_outside_capture_point_m
@@ -457,6 +467,8 @@ class MotionConfig:
         if self.pelvis_stance_reach_share is not None and not 0.0 < self.pelvis_stance_reach_share <= 1.0:
             raise ConfigError(f"MotionConfig.pelvis_stance_reach_share must be within (0, 1] or None, got "
                               f"{self.pelvis_stance_reach_share}")
+        if self.landing_pelvis_descent_mps is not None:
+            _positive("MotionConfig.landing_pelvis_descent_mps", self.landing_pelvis_descent_mps)
         if self.landing_reach_ground_gap_m is not None:
             _positive("MotionConfig.landing_reach_ground_gap_m", self.landing_reach_ground_gap_m)
         if not 0.0 <= self.landing_pelvis_floor_share <= 1.0:

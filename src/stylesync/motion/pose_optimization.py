@@ -274,6 +274,7 @@ class MotionOptimizer:
         self._his_landed_side: str | None = None
         self._aim_at_his_landing = cfg.swing_landing == "his_last_landing"  # MotionConfig.swing_landing
         self._planted_yaw: dict[str, float] = {}  # each planted foot's yaw when it last pressed the ground [rad]
+        self._last_pelvis_z: float | None = None  # the last tick's pelvis target (landing_pelvis_descent_mps) [m]
         self._op_swing_s = OPERATOR_SWING_S  # the operator's swing time, averaged over his swings [s]
         self._op_state: Stance | None = None
         self._op_state_t0_s = 0.0
@@ -472,7 +473,8 @@ class MotionOptimizer:
                                                 scale, R_root_d, order)
             com_xy = _heading_frame_fraction(com_h, a_hs["left"], a_hs["right"], a_c["left"], a_c["right"],
                                              scale, R_root_d, order)
-            ankle_h_z = 0.5 * (a_h["left"][2] + a_h["right"][2])
+            ankle_h_z = (0.5 * (ground_z["left"] + ground_z["right"]) if self.cfg.ds_anchor_ground_height
+                         else 0.5 * (a_h["left"][2] + a_h["right"][2]))
         else:
             st = "left" if anchor is Stance.LS else "right"
             pelvis_xy = a_c[st] + scale * (p_h - a_hs[st])
@@ -632,6 +634,7 @@ class MotionOptimizer:
                 if tick.weights[side] > 0 and tick.contact[side]:
                     tick.pelvis_d[2] = min(tick.pelvis_d[2], self._pelvis_within_m(tick, side, sign,
                                                                                   self._stance_reach_m))
+        unlowered_z = float(tick.pelvis_d[2])
         for side, sign in (("left", 1.0), ("right", -1.0)):
             must_land = tick.weights[side] > 0 or (side == sw and (self.char_fsm.hold_reference or landing_step))
             if must_land and not tick.contact[side] and not self._sole_on_ground(state, side):
@@ -642,13 +645,21 @@ class MotionOptimizer:
                 if lowered < tick.pelvis_d[2]:
                     tick.pelvis_d[2] = lowered
                     tick.pelvis_vel_z = 0.0
+        rate = self.cfg.landing_pelvis_descent_mps
+        if rate is not None:  # the lowering no faster than rate from the last tick's target
+            if self._last_pelvis_z is not None and tick.pelvis_d[2] < unlowered_z:
+                floor_z = self._last_pelvis_z - rate * self.dt_s
+                tick.pelvis_d[2] = min(unlowered_z, max(float(tick.pelvis_d[2]), floor_z))
+            self._last_pelvis_z = float(tick.pelvis_d[2])
 
     def _sole_on_ground(self, state: CharacterState, side: str) -> bool:
-        """Whether the foot on ``side`` lies on the ground unpressed: its sole's lowest corner within
+        """Whether the foot on ``side`` lies on the ground, pressing or not: its sole's lowest corner within
         MotionConfig.landing_reach_ground_gap_m of it (False with that None)."""
         gap = self.cfg.landing_reach_ground_gap_m
+        if gap is None:
+            return False
         ankle = _LINK[f"{side}_ankle"]
-        return gap is not None and sole_within_m(state.link_origin_world[ankle], state.link_quat_wxyz[ankle], gap)
+        return sole_within_m(state.link_origin_world[ankle], state.link_quat_wxyz[ankle], gap)
 
     def _pelvis_within_m(self, tick: _Tick, side: str, sign: float, reach_m: float,
                          hip_xy: np.ndarray | None = None) -> float:
