@@ -320,7 +320,8 @@ class MotionConfig:
     landing_reach_ground_gap_m: float | None = None
     # The pelvis target lowered for a foot that must land comes down at most at this speed from the last control
     # tick's: the lowering to a foot out of reach came as one step of 0.3-0.4 m within a tick at landings of the
-    # humanoid3d spinning kick (docs/decisions.md, "A foot on the ground that must land"; None: at once) [m/s]
+    # humanoid3d spinning kick (docs/decisions.md, "The pelvis target's steps within a control tick"; None: at
+    # once) [m/s]
     landing_pelvis_descent_mps: float | None = None
     # The pelvis target (Eq. 9) no higher than this share of the leg's length reaches above each planted stance foot
     # (hip to ankle, from the target's hip). His pelvis, scaled, can sit above what the character's straight legs
@@ -417,8 +418,8 @@ class MotionConfig:
     # ... and so is it where Eq. 10 is anchored on both his feet (his double stance, or the character's while a late
     # contact holds the reference): from the mean of his two ankles' ground heights, not of the ankles wherever they
     # are. From the ankles, his kick in the air while the character stood on both feet dropped the pelvis target by
-    # 0.67 m for a control tick (the humanoid3d spinning kick; docs/decisions.md, "An operator in the air, anchored on
-    # both feet"; False: from the ankles)
+    # 0.67 m for a control tick (the humanoid3d spinning kick; docs/decisions.md, "The pelvis target's steps within a
+    # control tick"; False: from the ankles)
     ds_anchor_ground_height: bool = False
 
     def __post_init__(self) -> None:
@@ -770,7 +771,7 @@ FOLLOW_PATH_MOTION: dict[str, Any] = {
     "recovery_walk_on_his_way": True,  # along his way over the ground, a divergence across it caught
     "gait_min_way_speed_mps": 0.3,  # a gait only while he goes somewhere (not a sway on the spot, not a stop)
     "path_target_share": 1.0,  # the targets pulled to his path, at most path_target_max_m (0.3 m) ahead
-    "landing_reach_ground_gap_m": 0.003,  # a foot lying on the ground, pressing or not, is not lowered for
+    "landing_reach_ground_gap_m": 0.003,  # a foot lying on the ground, pressing or not, lowers no pelvis target
 }
 # ... and in the whole-body controller (docs/decisions.md, "Targets on his path")
 FOLLOW_PATH_WHOLE_BODY: dict[str, Any] = {
