@@ -622,10 +622,11 @@ class MotionOptimizer:
         self._swing = sw
         # A foot that has to reach the ground and does not touch it yet (a stance foot, or the swing foot held
         # for a late contact; not one lying on it unpressed, landing_reach_ground_gap_m) must be within the leg's
-        # reach of its hip: the pelvis is lowered as far as that needs (no faster than landing_pelvis_descent_mps). With the pelvis at the operator's height (Eq. 9) the legs are nearly straight, and a foot ahead
-        # of the body could otherwise never land. It is lowered no further than landing_pelvis_floor_share of the
-        # reach above the foot: a foot out of reach from the hip even then (the operator's pelvis target may be far
-        # from the body) would otherwise put the pelvis target on the ground.
+        # reach of its hip: the pelvis is lowered as far as that needs (no faster than landing_pelvis_descent_mps).
+        # With the pelvis at the operator's height (Eq. 9) the legs are nearly straight, and a foot ahead of the body
+        # could otherwise never land. It is lowered no further than landing_pelvis_floor_share of the reach above the
+        # foot: a foot out of reach from the hip even then (the operator's pelvis target may be far from the body)
+        # would otherwise put the pelvis target on the ground.
         landing_step = (self.cfg.recovery_landing_reach and self.char_fsm.recovery_step
                         and self.recovery.landing_due(state.time_s))
         if self._stance_reach_m is not None:
