@@ -224,6 +224,12 @@ class _Tick:
     stands: dict[tuple[str, ...], bool] = field(default_factory=dict)
 
 
+def _sole_within_m(state: CharacterState, side: str, gap_m: float) -> bool:
+    """Whether the lowest corner of the sole on ``side`` is within ``gap_m`` of the ground (model/sole.py)."""
+    ankle = _LINK[f"{side}_ankle"]
+    return sole_within_m(state.link_origin_world[ankle], state.link_quat_wxyz[ankle], gap_m)
+
+
 class MotionOptimizer:
     def __init__(self, cfg: MotionConfig, control_hz: float, bounds: BoundsMonitor | None = None,
                  gravity_mps2: float = 9.8):
@@ -375,9 +381,7 @@ class MotionOptimizer:
         gap, step = self.cfg.recovery_landing_gap_m, self.recovery.step
         if gap is None or step is None or not self.char_fsm.recovery_step or contact[step.side]:
             return contact
-        ankle = _LINK[f"{step.side}_ankle"]
-        if self.recovery.landing_due(state.time_s) and sole_within_m(state.link_origin_world[ankle],
-                                                                     state.link_quat_wxyz[ankle], gap):
+        if self.recovery.landing_due(state.time_s) and _sole_within_m(state, step.side, gap):
             contact[step.side] = True
         return contact
 
@@ -636,9 +640,11 @@ class MotionOptimizer:
                     tick.pelvis_d[2] = min(tick.pelvis_d[2], self._pelvis_within_m(tick, side, sign,
                                                                                   self._stance_reach_m))
         unlowered_z = float(tick.pelvis_d[2])
+        ground_gap = self.cfg.landing_reach_ground_gap_m  # a foot this near the ground lies on it, pressed or not
         for side, sign in (("left", 1.0), ("right", -1.0)):
             must_land = tick.weights[side] > 0 or (side == sw and (self.char_fsm.hold_reference or landing_step))
-            if must_land and not tick.contact[side] and not self._sole_on_ground(state, side):
+            if must_land and not tick.contact[side] and not (ground_gap is not None
+                                                              and _sole_within_m(state, side, ground_gap)):
                 # The character's own step: from where its hip is (the operator's pelvis target may be anywhere
                 # behind a body that carries momentum he does not have).
                 hip_xy = state.link_origin_world[_LINK[f"{side}_hip"]][:2] if side == sw and landing_step else None
@@ -652,15 +658,6 @@ class MotionOptimizer:
                 floor_z = self._last_pelvis_z - rate * self.dt_s
                 tick.pelvis_d[2] = min(unlowered_z, max(float(tick.pelvis_d[2]), floor_z))
             self._last_pelvis_z = float(tick.pelvis_d[2])
-
-    def _sole_on_ground(self, state: CharacterState, side: str) -> bool:
-        """Whether the foot on ``side`` lies on the ground, pressing or not: its sole's lowest corner within
-        MotionConfig.landing_reach_ground_gap_m of it (False with that None)."""
-        gap = self.cfg.landing_reach_ground_gap_m
-        if gap is None:
-            return False
-        ankle = _LINK[f"{side}_ankle"]
-        return sole_within_m(state.link_origin_world[ankle], state.link_quat_wxyz[ankle], gap)
 
     def _pelvis_within_m(self, tick: _Tick, side: str, sign: float, reach_m: float,
                          hip_xy: np.ndarray | None = None) -> float:
@@ -728,15 +725,16 @@ class MotionOptimizer:
         one foot of his gait and the character on both), and in its single stance while the operator's capture point
         is within the soles he stands on (he balances on one leg, as in a kick, or he has stopped while the
         character's foot is still in the air)."""
-        if tick.ch_state is Stance.DS and tick.op_state is Stance.DS:
-            # Opt-out: not while he walks from one foot onto the other (his gait's capture point runs ahead of his
-            # front foot, and the character's, bounded within its soles, was braked at every double stance).
-            return self.cfg.capture_bound_in_his_gait or not self._his_gait(tick, tick.sample.support_ankle_world)
-        if tick.ch_state is Stance.DS and self.cfg.capture_bound_before_his_landing:
-            return True  # he is on one foot, the character on both: its step landed before his
-        if tick.ch_state is Stance.DS and not self.way.goes_along(
-                self.cfg.gait_min_way_speed_mps, tick.scale * tick.com_vel_h, _GAIT_AXIS_COS):
-            return True  # ... and, with the opt-out, still while he does not walk his way; while he does, as below
+        if tick.ch_state is Stance.DS:
+            if tick.op_state is Stance.DS:
+                # Opt-out: not while he walks from one foot onto the other (his gait's capture point runs ahead of
+                # his front foot, and the character's, bounded within its soles, was braked at every double stance).
+                return self.cfg.capture_bound_in_his_gait or not self._his_gait(tick, tick.sample.support_ankle_world)
+            # He is on one foot, the character on both (its step landed before his): bounded; with the opt-out, still
+            # while he does not walk his way, and while he does as in his single stance below.
+            if self.cfg.capture_bound_before_his_landing or not self.way.goes_along(
+                    self.cfg.gait_min_way_speed_mps, tick.scale * tick.com_vel_h, _GAIT_AXIS_COS):
+                return True
         sides = tuple(s for s in _SIDE_UP if tick.op_state is Stance.DS or swing_side(tick.op_state) != s)
         return self._operator_stands(tick, sides)
 
