@@ -551,6 +551,11 @@ class WholeBodyConfig:
     # [1/s², 1/s].
     momentum_com_kp: float = 12.0
     momentum_com_kd: float = 7.0
+    # While a step of the character's own is due to land and the pelvis is above its target, the pelvis height's law
+    # with these gains instead: the soft ones left the hip 0.1 m above a target lowered for the landing and the foot
+    # above the ground while the body ran past it (docs/decisions.md, "An own step's foot held above its landing").
+    # None: the gains above [1/s², 1/s]
+    landing_pelvis_gains: tuple[float, float] | None = None
     momentum_root_kp: float = 200.0  # root virtual torque of Eq. 16 about the COM [N·m/rad]
     momentum_root_kd: float = 40.0  # [N·m·s/rad]
     momentum_moment_weight_per_m: float = 2.0  # the moment rows' weight is this squared, the force rows' 1 [1/m]
@@ -652,6 +657,15 @@ class WholeBodyConfig:
             _positive("WholeBodyConfig.joint_speed_limit_rad_s", self.joint_speed_limit_rad_s)
         if self.toe_off_leg_stretch is not None:
             _positive("WholeBodyConfig.toe_off_leg_stretch", self.toe_off_leg_stretch)
+        if self.landing_pelvis_gains is not None:
+            try:
+                kp, kd = (float(v) for v in self.landing_pelvis_gains)
+            except (TypeError, ValueError):
+                raise ConfigError("WholeBodyConfig.landing_pelvis_gains must be two numbers (kp [1/s²], kd [1/s]) or "
+                                  f"None, got {self.landing_pelvis_gains!r}") from None
+            _non_negative("WholeBodyConfig.landing_pelvis_gains kp", kp)
+            _non_negative("WholeBodyConfig.landing_pelvis_gains kd", kd)
+            object.__setattr__(self, "landing_pelvis_gains", (kp, kd))
         if self.recovery_foot_target_rate not in RECOVERY_FOOT_TARGET_RATES:
             raise ConfigError(f"WholeBodyConfig.recovery_foot_target_rate must be one of "
                               f"{', '.join(RECOVERY_FOOT_TARGET_RATES)}, got '{self.recovery_foot_target_rate}'")

@@ -181,8 +181,13 @@ class WholeBodyController(ControllerBase):
         # The target's rise on both feet, shared (WholeBodyConfig.pelvis_rate_share); its descent is left to the
         # regulator, and so is the rise over one foot (a gait's vault over its stance leg)
         pelvis_vz_d = wb.pelvis_rate_share * max(ref.pelvis_vel_z_mps, 0.0) if len(support) == 2 else 0.0
-        force[2] = m * (wb.momentum_com_kp * (pelvis_z_d - state.root_pos_world[2])
-                        + wb.momentum_com_kd * (pelvis_vz_d - state.root_lin_vel_world[2]))
+        kp_z, kd_z = wb.momentum_com_kp, wb.momentum_com_kd
+        if (wb.landing_pelvis_gains is not None and ref.recovery_ankle_world is not None
+                and state.root_pos_world[2] > pelvis_z_d
+                and any(recovery_landing_due(t) for t in ref.recovery_ankle_world.values())):
+            kp_z, kd_z = wb.landing_pelvis_gains  # an own step's landing: the pelvis brought down in its time
+        force[2] = m * (kp_z * (pelvis_z_d - state.root_pos_world[2])
+                        + kd_z * (pelvis_vz_d - state.root_lin_vel_world[2]))
         f_lipm = np.zeros(3)
         if cfg.lipm_time_sync and ref.lipm is not None:  # Eq. 21-23, bounded by Eq. 26
             f_lipm = bounded_lipm_sync_force(ref.lipm, m, self.g, cfg.lipm_force_limit_n, cfg.enforce_bounds,
