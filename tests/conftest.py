@@ -66,13 +66,6 @@ def random_pose(seed: int, ball_sigma_rad: float = 0.3, hinge_rad: float = 0.6) 
     return q
 
 
-def without_landing_gains(cfg):
-    """``cfg`` without the own steps' landing gains (WholeBodyConfig.landing_pelvis_gains), which ``--follow-path``
-    sets: for runs traced before them."""
-    whole_body = dataclasses.replace(cfg.control.whole_body, landing_pelvis_gains=None)
-    return dataclasses.replace(cfg, control=dataclasses.replace(cfg.control, whole_body=whole_body))
-
-
 def suite_run(spec: str, seed: int, motion: MotionConfig, control: ControlConfig, on_tick=None, watch=None,
               configure=None):
     """One development-suite run of ``spec`` (its configuration and source as the suite opens them) with ``motion``

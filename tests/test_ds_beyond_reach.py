@@ -7,7 +7,7 @@ import dataclasses
 from pathlib import Path
 
 import pytest
-from conftest import suite_run, without_landing_gains
+from conftest import suite_run
 
 from stylesync.config import ControlConfig, MotionConfig, follow_path
 from stylesync.model.character import LINK_NAMES
@@ -42,7 +42,7 @@ def _followed_walk(beyond_reach: bool) -> tuple[float, bool, float | None]:
         return on_tick
 
     def configure(cfg):
-        cfg = without_landing_gains(follow_path(cfg))
+        cfg = follow_path(cfg)
         # traced before the bound before his landing (docs/decisions.md, "A step landed before his"), off here
         motion = dataclasses.replace(cfg.motion, recovery_ds_beyond_reach=beyond_reach,
                                      capture_bound_before_his_landing=True,

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 
-from conftest import suite_run, without_landing_gains
+from conftest import suite_run
 
 from stylesync.config import ControlConfig, MotionConfig, follow_path
 from stylesync.model.character import LINK_NAMES
@@ -34,7 +34,7 @@ def _drops_for_resting_feet(gap_m: float | None) -> int:
         last[:] = [z]
 
     def configure(cfg):
-        cfg = without_landing_gains(follow_path(cfg))  # traced before them
+        cfg = follow_path(cfg)
         motion = dataclasses.replace(cfg.motion, landing_reach_ground_gap_m=gap_m)
         return dataclasses.replace(cfg, motion=motion, duration_s=6.75)
 

@@ -199,13 +199,13 @@ def test_a_gait_double_stance_bounded_by_what_a_step_catches_keeps_fast_walks_up
     well.)"""
     import logging
 
-    from conftest import suite_run, without_landing_gains
+    from conftest import suite_run
 
     from stylesync.config import ControlConfig, follow_path
 
     def configure(bounded):
         def with_bound(cfg):
-            cfg = without_landing_gains(follow_path(cfg)).replace(duration_s=5.5)
+            cfg = follow_path(cfg).replace(duration_s=5.5)
             cfg = cfg.replace(motion=dataclasses.replace(cfg.motion, recovery_ds_beyond_reach=False,
                                                          capture_bound_before_his_landing=True,
                                                          landing_reach_ground_gap_m=None))

@@ -790,7 +790,6 @@ FOLLOW_PATH_MOTION: dict[str, Any] = {
 # ... and in the whole-body controller (docs/decisions.md, "Targets on his path")
 FOLLOW_PATH_WHOLE_BODY: dict[str, Any] = {
     "own_step_push_bound": "always",  # the push of the character's own steps bounded while he walks too
-    "landing_pelvis_gains": (100.0, 20.0),  # and their pelvis brought down in a landing's time when due
 }
 
 
