@@ -9,7 +9,7 @@ from conftest import suite_run
 
 from stylesync.config import ControlConfig, MotionConfig, follow_path
 from stylesync.model.character import LINK_NAMES
-from stylesync.model.sole import sole_corners_world
+from stylesync.model.sole import sole_within_m
 
 _ANKLE = {s: LINK_NAMES.index(f"{s}_ankle") for s in ("left", "right")}
 DROP_M = 0.1  # a fall of the pelvis target within one control tick [m]
@@ -27,8 +27,8 @@ def _drops_for_resting_feet(gap_m: float | None) -> int:
         z = float(ref.pelvis_world[2])
         pressing = state.feet_pressing()
         resting = [s for s in _ANKLE if ref.stance_weight[s] > 0 and not pressing[s]
-                   and sole_corners_world(state.link_origin_world[_ANKLE[s]],
-                                          state.link_quat_wxyz[_ANKLE[s]])[:, 2].min() < ON_GROUND_M]
+                   and sole_within_m(state.link_origin_world[_ANKLE[s]], state.link_quat_wxyz[_ANKLE[s]],
+                                     ON_GROUND_M)]
         if last and last[0] - z > DROP_M and resting:
             drops[0] += 1
         last[:] = [z]
