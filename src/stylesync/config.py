@@ -130,6 +130,11 @@ class MotionConfig:
     # the feet-anchored targets of Eq. 10 with this time constant [s]. The character then keeps up with the operator
     # over the ground (about twice the distance on the walk set) but falls more often (docs/decisions.md).
     reference_follows_operator_s: float = 0.0
+    # ... and the targets so advanced at most this far from the anchored ones (None: no bound). Advanced at a
+    # runner's speed the character cannot step at, they ran 1.7 m ahead of it, and when he stopped they came back at
+    # 2-3 m/s while the COM task still pulled the body on towards them: it reached his stop too fast to stop
+    # (docs/decisions.md, "Targets that ran ahead of the character") [m]
+    reference_lead_max_m: float | None = None
     # Weight shift before a lift-off from standing (pose_optimization._can_lift): the operator lifts a foot after a
     # double stance of at least liftoff_after_stand_s [s] with his capture point over his other sole (within
     # liftoff_margin_m [m] of its inner edge, sideways); while the character's is further than that inwards of its
@@ -483,6 +488,8 @@ class MotionConfig:
             raise ConfigError("MotionConfig.recovery_step_behind_cos must be within [-1, 1] or None, "
                               f"got {self.recovery_step_behind_cos}")
         _non_negative("MotionConfig.reference_follows_operator_s", self.reference_follows_operator_s)
+        if self.reference_lead_max_m is not None:
+            _non_negative("MotionConfig.reference_lead_max_m", self.reference_lead_max_m)
         _non_negative("MotionConfig.path_feedback_share", self.path_feedback_share)
         _non_negative("MotionConfig.path_feedback_max_m", self.path_feedback_max_m)
         if not 0.0 <= self.path_target_share <= 1.0:
@@ -780,6 +787,7 @@ FOLLOW_PATH_MOTION: dict[str, Any] = {
     "capture_bound_before_his_landing": False,  # nor while its step has landed before his
     "gait_capture_step_s": 0.3,  # but its capture point runs ahead no further than a step then catches
     "reference_follows_operator_s": 0.5,  # the targets go on at his speed
+    "reference_lead_max_m": 0.3,  # but no further than this from the anchored ones
     "path_feedback_share": 0.5,  # each landing takes up half the path's error
     "recovery_walk_on_m": 0.1,  # its own steps walk on while he walks
     "recovery_walk_on_his_way": True,  # along his way over the ground, a divergence across it caught

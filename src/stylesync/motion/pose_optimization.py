@@ -532,6 +532,11 @@ class MotionOptimizer:
             else:
                 pred = self._ref_xy + v_ff * self.dt_s
                 self._ref_xy = pred + (self.dt_s / tau) * (raw - pred)
+                lead_max = self.cfg.reference_lead_max_m
+                if lead_max is not None:  # no further from the anchored targets than this
+                    lead = self._ref_xy - raw
+                    norms = np.linalg.norm(lead, axis=1, keepdims=True)
+                    self._ref_xy = raw + lead * np.minimum(1.0, lead_max / np.maximum(norms, 1e-12))
             pelvis_xy[:2], com_xy[:2] = self._ref_xy[0], self._ref_xy[1]
         tick.pelvis_d = np.array([pelvis_xy[0], pelvis_xy[1], ANKLE_HEIGHT_M + scale * (p_h[2] - ankle_h_z)])  # Eq. 9
         tick.pelvis_vel_z = scale * float(self._pelvis_h_rate(p_h)[2])
