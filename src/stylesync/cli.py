@@ -336,7 +336,7 @@ def _add_session_args(p: argparse.ArgumentParser, out_default: str, realtime_hel
                         "facing it on a screen expects")
     p.add_argument("--follow-path", action="store_true",
                    help="keep to the operator's path over the ground (a recording starts at its speed); "
-                        "falls more often (README, status)")
+                        "its own steps between his make the transition delays longer (README, status)")
     p.add_argument("--free-swing", action="store_true",
                    help="a swing foot follows the operator's while both stand balanced on the other foot, lifted "
                         "only with the weight over that ankle (a kick strikes); by default every swing goes to a "
