@@ -387,6 +387,11 @@ class MotionConfig:
     # capture point diverges that way; across it the step catches the body on its ankle (recovery_step.WalkOn).
     # False: along the capture point's own divergence, which carries a sideways drift on from step to step.
     recovery_walk_on_his_way: bool = False
+    # ... and only as far as his way goes forwards: the walk-on times the share of his way along his heading's
+    # forward axis (none where he goes sideways or backwards, and the step stops the body). Walked on sideways, a
+    # dance's own steps, which cannot cross or lengthen as a forward stride does, ran the body away from its feet
+    # at 1-2 m/s (docs/decisions.md, "Own steps that walk on sideways"; False: along his way whichever way it goes)
+    recovery_walk_on_forward: bool = False
     # The operator's way over the ground: his scaled COM velocity averaged with this time constant, longer than a
     # step (motion/operator_way.py) [s]. While its speed is below gait_min_way_speed_mps he goes nowhere (a sway on
     # the spot, a dance): his double stance is no gait's (double_stance_keeps_momentum_m and

@@ -693,10 +693,16 @@ class MotionOptimizer:
             return None
         if not self.cfg.recovery_walk_on_his_way:
             return WalkOn(distance_m)
+        heading = np.array([tick.R_root_d[0, 0], tick.R_root_d[1, 0], 0.0])
+        heading /= max(float(np.linalg.norm(heading)), 1e-9)
         way = self.way.direction_world()
         if way is None:
-            heading = np.array([tick.R_root_d[0, 0], tick.R_root_d[1, 0], 0.0])
-            way = heading / max(float(np.linalg.norm(heading)), 1e-9)
+            way = heading
+        if self.cfg.recovery_walk_on_forward:
+            forward = float(way @ heading)
+            if forward <= 0.0:
+                return None
+            distance_m *= forward
         return WalkOn(distance_m, way)
 
     def _record_his_landing(self, tick: _Tick) -> None:

@@ -1,0 +1,45 @@
+"""The character's own steps walk on only as far as the operator's way goes forwards (MotionConfig.
+recovery_walk_on_forward; docs/decisions.md, "Own steps that walk on sideways")."""
+
+from __future__ import annotations
+
+import dataclasses
+
+from conftest import suite_run
+
+from stylesync.config import ControlConfig, MotionConfig, follow_path
+
+
+def _dance(forward: bool) -> tuple[bool, float | None, int]:
+    """The humanoid3d dance_a, sensor seed 2, with ``--follow-path`` and ``recovery_walk_on_forward`` as given, to
+    6.5 s: whether it fell, when, and the control ticks of steps of its own taken while his way went more than 90°
+    from his heading."""
+    backwards = [0]
+
+    def watch(session):
+        motion = session.motion
+
+        def on_tick(state, ref) -> None:
+            way = motion.way.direction_world()
+            w, x, y, z = ref.root_quat_wxyz
+            heading = (1.0 - 2.0 * (y * y + z * z), 2.0 * (w * z + x * y))
+            if motion.recovery.step is not None and way is not None and way[0] * heading[0] + way[1] * heading[1] < 0:
+                backwards[0] += 1
+        return on_tick
+
+    def configure(cfg):
+        cfg = follow_path(cfg)
+        motion = dataclasses.replace(cfg.motion, recovery_walk_on_forward=forward)
+        return dataclasses.replace(cfg, duration_s=6.5, motion=motion)
+
+    result = suite_run("builtin:dance_a", 2, MotionConfig(), ControlConfig(), watch=watch, configure=configure)
+    return result.fell, result.fall_time_s, backwards[0]
+
+
+def test_own_steps_do_not_walk_on_where_he_goes_sideways_or_backwards():
+    fell, fall_s, backwards = _dance(False)
+    # His way 120-145° from his heading (he travels back and to the side, turning), the character's own steps landed
+    # 0.1 m behind the capture point along it, its COM reached 2.2 m/s that way, and it fell at 6.35 s
+    assert fell and backwards > 0, (fell, fall_s, backwards)
+    fell, fall_s, _ = _dance(True)
+    assert not fell, fall_s
