@@ -88,3 +88,19 @@ def test_falls_are_counted_by_how_they_ended():
     header, rule, row = table(rows, ["v"]).splitlines()
     assert header.count("|") == rule.count("|") == row.count("|")
     assert "| 2/1/1 |" in row
+
+
+def test_the_dev_suite_runs_the_follow_path_settings_beside_the_default(tmp_path, capsys):
+    from stylesync.metrics.dev_suite import FOLLOW_PATH_VERSION, run_clip
+
+    out = tmp_path / "fp"
+    assert cli_main(["bench", "--suite", "dev", "--only", "kick", "--seeds", "1", "--duration", "1.0",
+                     "--workers", "1", "--follow-path", "--out", str(out)]) == 0
+    rows = json.loads((out / "dev_suite.json").read_text())
+    assert {r["version"] for r in rows} == {"stylesync", FOLLOW_PATH_VERSION, "plain-pd"}
+    assert "| kick | follow-path |" in (out / "dev_suite.md").read_text()
+    # The settings reach the run: 3 s of the built-in walk (his first steps from 1.3 s) go further along his path
+    default, follow = (run_clip("builtin:walk", 0, 3.0, v) for v in ("stylesync", FOLLOW_PATH_VERSION))
+    assert follow["path_progress"] > default["path_progress"] + 0.3, (default, follow)
+    # a bench option only with the dev suite
+    assert cli_main(["bench", "--follow-path", "--out", str(tmp_path / "b")]) == 2

@@ -269,18 +269,21 @@ def _bench(args: argparse.Namespace) -> int:
 
     shared = Path(args.shared) if args.shared else SHARED_DIR
     if args.suite == "dev":
-        from stylesync.metrics.dev_suite import ORDER, run_dev_suite
+        from stylesync.metrics.dev_suite import FOLLOW_PATH_VERSION, ORDER, SUITE_CONTROLLERS, run_dev_suite
 
         only = tuple(c.strip() for c in args.only.split(",") if c.strip()) if args.only else ()
         unknown = [c for c in only if c not in ORDER]
         if unknown:
             raise ConfigError(f"unknown categories {', '.join(unknown)}; expected some of {', '.join(ORDER)}")
         mocap = shared / "mocap"
+        controllers = SUITE_CONTROLLERS[:1] + ((FOLLOW_PATH_VERSION,) if args.follow_path else ()) \
+            + SUITE_CONTROLLERS[1:]
         report = run_dev_suite(Path(args.out), args.seeds, args.duration, mocap if mocap.is_dir() else None, only,
-                               workers=args.workers, executor=args.executor, first_seed=args.seed,
-                               operator=_suite_operator(args))
+                               controllers=controllers, workers=args.workers, executor=args.executor,
+                               first_seed=args.seed, operator=_suite_operator(args))
     else:
-        for flag, given in (("--mirror", args.mirror), ("--sensor-noise", args.sensor_noise != 1.0)):
+        for flag, given in (("--mirror", args.mirror), ("--sensor-noise", args.sensor_noise != 1.0),
+                            ("--follow-path", args.follow_path)):
             if given:
                 raise ConfigError(f"{flag} is a dev-suite option: use it with --suite dev")
         report = run_bench(Path(args.out), args.duration, args.seed, shared if shared.is_dir() else None,
@@ -488,6 +491,9 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--sensor-noise", type=typed.noise_factor, default=1.0,
                        help="dev suite: the sensor model's joint position and orientation noise times this (1: "
                             "Kinect-like, 5 mm and 0.02 rad; a webcam's pose model is noisier)")
+    bench.add_argument("--follow-path", action="store_true",
+                       help="dev suite: also the controller with --follow-path's settings, in the same run (the "
+                            "'follow-path' rows, paired with stylesync's)")
     bench.add_argument("--workers", type=typed.integer(1, 256), default=2,
                        help="runs in parallel (with --executor processes or ray, and for the dev suite)")
     bench.add_argument("--executor", choices=("processes", "ray", "inline"),

@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from stylesync.config import OperatorConfig, SessionConfig
+from stylesync.config import OperatorConfig, SessionConfig, follow_path
 from stylesync.errors import StylesyncError
 from stylesync.metrics.bench import CONTROLLERS
 from stylesync.metrics.paired_outcomes import paired_table
@@ -49,6 +49,9 @@ CATEGORIES = {
 }
 ORDER = ("walk", "styled walk", "uneven", "run", "jump", "kick", "arms", "acrobatics", "other")
 SUITE_CONTROLLERS = ("stylesync", "plain-pd")
+# The stylesync controller with `--follow-path`'s settings (config.follow_path): `stylesync bench --suite dev
+# --follow-path` runs it beside the others, in the same run
+FOLLOW_PATH_VERSION = "follow-path"
 
 
 def clip_specs(mocap: Path | None) -> list[tuple[str, str, str]]:
@@ -89,13 +92,15 @@ def run_clip(spec: str, seed: int, duration_s: float, controller: str,
     from stylesync.sources.registry import open_source
 
     logging.disable(logging.WARNING)
-    control, motion = CONTROLLERS[controller]
+    control, motion = CONTROLLERS["stylesync" if controller == FOLLOW_PATH_VERSION else controller]
     try:
         opened = open_source(spec, operator=operator, seed=seed, duration_s=duration_s)
     except StylesyncError as exc:
         return {"error": str(exc)[:200]}
     cfg, clip_end = suite_config(spec, opened, seed, duration_s, operator)
     cfg = dataclasses.replace(cfg, control=control, motion=motion)
+    if controller == FOLLOW_PATH_VERSION:
+        cfg = follow_path(cfg)
     result = run_and_release(cfg, opened.source)
     m = summarize(result)
     keys = ("fell", "fall_time_s", "sim_duration_s", "operator_steps", "character_steps",
