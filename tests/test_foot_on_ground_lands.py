@@ -35,7 +35,8 @@ def _drops_for_resting_feet(gap_m: float | None) -> int:
 
     def configure(cfg):
         cfg = follow_path(cfg)
-        motion = dataclasses.replace(cfg.motion, landing_reach_ground_gap_m=gap_m)
+        # (traced before the bound on the targets' lead, off here)
+        motion = dataclasses.replace(cfg.motion, landing_reach_ground_gap_m=gap_m, reference_lead_max_m=None)
         return dataclasses.replace(cfg, motion=motion, duration_s=6.75)
 
     suite_run("builtin:dance_a", 15, MotionConfig(), ControlConfig(), on_tick=on_tick, configure=configure)
