@@ -5,8 +5,10 @@ from __future__ import annotations
 
 import dataclasses
 
+import numpy as np
 from conftest import suite_run
 
+from stylesync import rotations as rot
 from stylesync.config import ControlConfig, MotionConfig, follow_path
 
 
@@ -21,9 +23,8 @@ def _dance(forward: bool) -> tuple[bool, float | None, int]:
 
         def on_tick(state, ref) -> None:
             way = motion.way.direction_world()
-            w, x, y, z = ref.root_quat_wxyz
-            heading = (1.0 - 2.0 * (y * y + z * z), 2.0 * (w * z + x * y))
-            if motion.recovery.step is not None and way is not None and way[0] * heading[0] + way[1] * heading[1] < 0:
+            yaw = rot.yaw_from_quat(ref.root_quat_wxyz)
+            if motion.recovery.step is not None and way is not None and way[0] * np.cos(yaw) + way[1] * np.sin(yaw) < 0:
                 backwards[0] += 1
         return on_tick
 

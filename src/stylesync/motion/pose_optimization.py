@@ -104,6 +104,12 @@ OPERATOR_VELOCITY_SETTLE_S = 0.2  # the operator's filtered COM velocity is take
 HEEL_AHEAD_OF_ANKLE_M = FOOT_CENTER_AHEAD_OF_ANKLE_M - FOOT_LENGTH_M / 2  # < 0: the heel is behind the ankle [m]
 
 
+def _heading_world(tick: _Tick) -> np.ndarray:
+    """(3,) the forward axis of his heading (the reference root's), horizontal, unit, world frame."""
+    heading = np.array([tick.R_root_d[0, 0], tick.R_root_d[1, 0], 0.0])
+    return heading / max(float(np.linalg.norm(heading)), 1e-9)
+
+
 def _heading_frame_fraction(p_h, al_h, ar_h, al_c, ar_c, scale: float, R: np.ndarray,
                             rear_to_front: bool = False) -> np.ndarray:
     """Eq. 10 (fraction reading) in the heading frame (world rotation ``R``), horizontal components only.
@@ -693,13 +699,11 @@ class MotionOptimizer:
             return None
         if not self.cfg.recovery_walk_on_his_way:
             return WalkOn(distance_m)
-        heading = np.array([tick.R_root_d[0, 0], tick.R_root_d[1, 0], 0.0])
-        heading /= max(float(np.linalg.norm(heading)), 1e-9)
         way = self.way.direction_world()
         if way is None:
-            way = heading
+            way = _heading_world(tick)
         if self.cfg.recovery_walk_on_forward:
-            forward = float(way @ heading)
+            forward = float(way @ _heading_world(tick))
             if forward <= 0.0:
                 return None
             distance_m *= forward
