@@ -196,6 +196,71 @@ def test_a_bvh_whose_rest_pose_lays_every_bone_along_x_loads_as_the_same_motion(
     assert np.all(head > hips + 0.3)  # standing: the head above the pelvis
 
 
+# A rig mirrored from its left side (joint frames with x along each left bone and against each right one), in the
+# naming and channel layout of Bandai Namco's motion dataset: a floor root, 6 channels on every joint, centimetres,
+# y up. (joint, parent, offset [cm]); bones along +x on the left and the spine, -x on the right.
+_MIRRORED_RIG = (
+    ("joint_Root", None, (0, 0, 0)), ("Hips", "joint_Root", (0, 90, 0)), ("Spine", "Hips", (15, 0, 0)),
+    ("Chest", "Spine", (9, 0, 0)), ("Neck", "Chest", (16, 0, 0)), ("Head", "Neck", (7, 0, 0)),
+    ("Shoulder_L", "Chest", (13, 0, 5)), ("UpperArm_L", "Shoulder_L", (5, 0, 0)),
+    ("LowerArm_L", "UpperArm_L", (24, 0, 0)), ("Hand_L", "LowerArm_L", (22, 0, 0)),
+    ("Shoulder_R", "Chest", (13, 0, -5)), ("UpperArm_R", "Shoulder_R", (-5, 0, 0)),
+    ("LowerArm_R", "UpperArm_R", (-24, 0, 0)), ("Hand_R", "LowerArm_R", (-22, 0, 0)),
+    ("UpperLeg_L", "Hips", (-2, -7, 0)), ("LowerLeg_L", "UpperLeg_L", (39, 0, 0)), ("Foot_L", "LowerLeg_L", (41, 0, 0)),
+    ("Toes_L", "Foot_L", (12, 0, 0)), ("UpperLeg_R", "Hips", (-2, 7, 0)), ("LowerLeg_R", "UpperLeg_R", (-39, 0, 0)),
+    ("Foot_R", "LowerLeg_R", (-41, 0, 0)), ("Toes_R", "Foot_R", (-12, 0, 0)),
+)
+
+
+def _mirrored_rig_bvh(n_frames: int = 40) -> str:
+    """A standing figure on :data:`_MIRRORED_RIG` that sways its pelvis sideways: the pelvis's frame turned +90° about
+    z (its x, the spine, up; the right leg's -x down), the left thigh's a further 180° (its +x down), and the toes
+    turned forward; every joint's position channels hold its offset."""
+    kids: dict[str | None, list[str]] = {}
+    for name, parent, _ in _MIRRORED_RIG:
+        kids.setdefault(parent, []).append(name)
+    offsets = {name: off for name, _, off in _MIRRORED_RIG}
+    chans = "CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation"
+
+    def block(name: str, depth: int) -> list[str]:
+        pad, head = "  " * depth, ("ROOT " if depth == 0 else "JOINT ") + name
+        out = [pad + head, pad + "{", f"{pad}  OFFSET {' '.join(str(v) for v in offsets[name])}", f"{pad}  {chans}"]
+        for kid in kids.get(name, []):
+            out += block(kid, depth + 1)
+        if name not in kids:
+            out += [f"{pad}  End Site", pad + "  {", pad + "    OFFSET 0 0 0", pad + "  }"]
+        return out + [pad + "}"]
+
+    turn = {"Hips": (90, 0, 0), "UpperLeg_L": (180, 0, 0), "Foot_L": (90, 0, 0), "Foot_R": (-90, 0, 0)}
+    rows = []
+    for k in range(n_frames):
+        row = []
+        for name, _, off in _MIRRORED_RIG:
+            pos = (5.0 * np.sin(0.2 * k), 90.0, 0.0) if name == "Hips" else off
+            row += [*pos, *turn.get(name, (0, 0, 0))]
+        rows.append(" ".join(f"{v:.4f}" for v in row))
+    return "\n".join(["HIERARCHY", *block("joint_Root", 0), "MOTION", f"Frames: {n_frames}",
+                      "Frame Time: 0.0333333", *rows]) + "\n"
+
+
+def test_a_mirrored_rig_with_a_floor_root_loads_standing(tmp_path):
+    """Its rest pose has the left leg along +x (with the spine) and the right along -x: the ankles' midpoint lies
+    just behind the pelvis, opposite the head, as a standing person's would, although neither leg points away from
+    the head. Each leg is now held against the spine: the rest pose does not stand, and the up axis and stature come
+    from the frames. Before, the rest pose was taken as standing and the file refused ("joints ANKLE_LEFT and
+    FOOT_LEFT coincide; cannot orient the segment")."""
+    path = tmp_path / "mirrored.bvh"
+    path.write_text(_mirrored_rig_bvh())
+    rec = BvhRecording(path)
+    assert (rec.up_axis, rec.scale_m) == ("+y", 0.01)
+    assert rec.orientations_from_positions
+    assert rec.mapping["ANKLE_LEFT"] == "Foot_L" and rec.mapping["FOOT_RIGHT"] == "Toes_R"
+    pos = rec.performer.pos_world
+    pelvis, head = pos[:, JOINT_INDEX["PELVIS"]], pos[:, JOINT_INDEX["HEAD"]]
+    ankles = pos[:, [JOINT_INDEX["ANKLE_LEFT"], JOINT_INDEX["ANKLE_RIGHT"]]]
+    assert np.all(head[:, 2] > pelvis[:, 2] + 0.4) and np.all(ankles[..., 2] < pelvis[:, None, 2] - 0.7)
+
+
 def test_unknown_skeleton_and_custom_joint_map(tmp_path):
     p = _write_tiny(tmp_path, names={"LeftUpLeg": "Oberschenkel_L"})
     # A name not understood: the skeleton is matched by structure instead (skeleton_structure.py).

@@ -57,13 +57,18 @@ UPRIGHT_REST_MIN_DEG = 120.0  # legs and spine at least this far apart: a rest p
 log = logging.getLogger("stylesync.sources")
 
 
-def rest_stands_upright(pelvis: np.ndarray, ankles: np.ndarray, head: np.ndarray) -> bool:
-    """Whether a skeleton's rest pose is a person standing: the legs (pelvis to the ankles' midpoint) point away from
-    the head (pelvis to head), at more than UPRIGHT_REST_MIN_DEG between them. Rigs whose joint frames have x along
-    the bone lay every bone along x at rest, legs and spine alike."""
-    legs, spine = np.asarray(ankles) - pelvis, np.asarray(head) - pelvis
-    norms = float(np.linalg.norm(legs) * np.linalg.norm(spine))
-    return norms > 0 and float(legs @ spine) / norms < np.cos(np.radians(UPRIGHT_REST_MIN_DEG))
+def rest_stands_upright(pelvis: np.ndarray, ankles: list[np.ndarray], head: np.ndarray) -> bool:
+    """Whether a skeleton's rest pose is a person standing: each leg (pelvis to its ankle) points away from the head
+    (pelvis to head), at more than UPRIGHT_REST_MIN_DEG between them. Rigs whose joint frames have x along the bone
+    lay every bone along x at rest, legs and spine alike, or one leg along +x and the other along -x (Bandai Namco's
+    motion dataset): there the ankles' midpoint can lie below the pelvis although neither leg does."""
+    spine = np.asarray(head) - pelvis
+    for ankle in ankles:
+        leg = np.asarray(ankle) - pelvis
+        norms = float(np.linalg.norm(leg) * np.linalg.norm(spine))
+        if norms <= 0 or float(leg @ spine) / norms >= np.cos(np.radians(UPRIGHT_REST_MIN_DEG)):
+            return False
+    return True
 
 
 def load_joint_map(path: str | Path) -> dict[str, str]:
@@ -305,7 +310,8 @@ class BvhRecording:
         # The file's up axis and stature: from the rest pose when it stands upright, otherwise from the frames.
         ankles = 0.5 * (rest[idx["ANKLE_LEFT"]] + rest[idx["ANKLE_RIGHT"]])
         up_vec = rest[idx["HEAD"]] - ankles
-        posed = not rest_stands_upright(rest[idx["PELVIS"]], ankles, rest[idx["HEAD"]])
+        posed = not rest_stands_upright(rest[idx["PELVIS"]], [rest[idx["ANKLE_LEFT"]], rest[idx["ANKLE_RIGHT"]]],
+                                         rest[idx["HEAD"]])
         up_t = world_pos[idx["HEAD"]] - 0.5 * (world_pos[idx["ANKLE_LEFT"]] + world_pos[idx["ANKLE_RIGHT"]])
         if posed:
             # Rigs whose bones lie along one axis at rest (joint frames with x along the bone): the pose at rest is
