@@ -214,8 +214,8 @@ _MIRRORED_RIG = (
 
 def _mirrored_rig_bvh(n_frames: int = 40) -> str:
     """A standing figure on :data:`_MIRRORED_RIG` that sways its pelvis sideways: the pelvis's frame turned +90° about
-    z (its x, the spine, up; the right leg's -x down), the left thigh's a further 180° (its +x down), and the toes
-    turned forward; every joint's position channels hold its offset."""
+    z (its x, the spine, up; the right leg's -x down), the left thigh's a further 180° (its +x down), and the feet a
+    quarter turn, so that the toes lie level (pointing outwards); every joint's position channels hold its offset."""
     kids: dict[str | None, list[str]] = {}
     for name, parent, _ in _MIRRORED_RIG:
         kids.setdefault(parent, []).append(name)
