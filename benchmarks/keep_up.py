@@ -43,7 +43,8 @@ def _speeds_mps(result, lead_in_s: float) -> tuple[float, float]:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--clip", default="walk")
-    ap.add_argument("--speeds", default="0.8,1.0,1.2,1.4,1.6", help="playback speeds, times the clip's, comma-separated")
+    ap.add_argument("--speeds", default="0.8,1.0,1.2,1.4,1.6",
+                    help="playback speeds, times the clip's, comma-separated")
     ap.add_argument("--seeds", default="0,1,2,3", help="sensor seeds, comma-separated")
     ap.add_argument("--duration", type=float, default=12.0, help="simulated seconds of each run")
     args = ap.parse_args()
