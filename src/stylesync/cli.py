@@ -276,8 +276,9 @@ def _bench(args: argparse.Namespace) -> int:
         if unknown:
             raise ConfigError(f"unknown categories {', '.join(unknown)}; expected some of {', '.join(ORDER)}")
         mocap = shared / "mocap"
-        controllers = SUITE_CONTROLLERS[:1] + ((FOLLOW_PATH_VERSION,) if args.follow_path else ()) \
-            + SUITE_CONTROLLERS[1:]
+        # the follow-path version beside stylesync's (the first), before the baselines
+        follow = (FOLLOW_PATH_VERSION,) if args.follow_path else ()
+        controllers = (*SUITE_CONTROLLERS[:1], *follow, *SUITE_CONTROLLERS[1:])
         report = run_dev_suite(Path(args.out), args.seeds, args.duration, mocap if mocap.is_dir() else None, only,
                                controllers=controllers, workers=args.workers, executor=args.executor,
                                first_seed=args.seed, operator=_suite_operator(args))
