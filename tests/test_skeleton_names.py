@@ -10,6 +10,7 @@ import pytest
 from stylesync.cli import main as cli_main
 from stylesync.errors import SourceError
 from stylesync.sources.bvh import BvhRecording, match_joints
+from stylesync.sources.frame import JOINT_INDEX
 from stylesync.sources.skeleton_names import ParsedName, match_by_name, parse_name
 
 MOCAP = Path(__file__).resolve().parents[2] / "shared" / "mocap"
@@ -43,6 +44,11 @@ needs_cmu_dev = pytest.mark.skipif(not (MOCAP / "cmu-dev").is_dir(),
     ("left_foot", "left", "foot", False),
     ("LUArm", "left", "uarm", False),
     ("RFArm", "right", "farm", False),
+    ("foot.LEnd", "left", "footend", False),  # the loader's end-site suffix after a side suffix (Blender)
+    ("forearm.REnd", "right", "forearmend", False),
+    ("LeftFootEnd", "left", "footend", False),
+    ("spine.001", None, "spine1", False),  # numbered bones: Blender's .001, Unreal's spine_03
+    ("spine_03", None, "spine3", False),
 ])
 def test_parse_name(name, side, word, helper):
     assert parse_name(name) == ParsedName(side, word, helper)
@@ -71,45 +77,51 @@ def test_first_ranked_synonym_wins_and_helpers_are_skipped():
 # SMPL/AMASS exports (an ankle joint and a foot joint below it), Xsens MVN, OptiTrack Motive among them.
 _SEGMENTS = {  # MotionBuilder name (side "Left"/"Right" or none) -> convention -> name pattern ({L}/{Left}: side)
     "Hips": {"unity": "Hips", "poser": "hip", "blender": "pelvis", "biped": "Bip01 Pelvis", "vrm": "J_Bip_C_Hips",
-             "smpl": "Pelvis", "smplx": "pelvis", "xsens": "Hips", "motive": "Hip", "asf": "root"},
+             "smpl": "Pelvis", "smplx": "pelvis", "xsens": "Hips", "motive": "Hip", "asf": "root", "unreal": "pelvis"},
     "UpLeg": {"unity": "UpperLeg_{L}", "poser": "{l}ThighBend", "blender": "thigh.{L}", "biped": "Bip01 {L} Thigh",
               "vrm": "J_Bip_{L}_UpperLeg",
-              "smpl": "{L}_Hip", "smplx": "{left}_hip", "xsens": "{Left}Hip", "motive": "{L}Thigh", "asf": "{l}femur"},
+              "smpl": "{L}_Hip", "smplx": "{left}_hip", "xsens": "{Left}Hip", "motive": "{L}Thigh", "asf": "{l}femur",
+              "unreal": "thigh_{l}"},
     "Leg": {"unity": "LowerLeg_{L}", "poser": "{l}Shin", "blender": "DEF-shin.{L}", "biped": "Bip01 {L} Calf",
             "vrm": "J_Bip_{L}_LowerLeg",
-            "smpl": "{L}_Knee", "smplx": "{left}_knee", "xsens": "{Left}Knee", "motive": "{L}Shin", "asf": "{l}tibia"},
+            "smpl": "{L}_Knee", "smplx": "{left}_knee", "xsens": "{Left}Knee", "motive": "{L}Shin", "asf": "{l}tibia",
+            "unreal": "calf_{l}"},
     "Foot": {"unity": "Foot_{L}", "poser": "{l}Foot", "blender": "foot.{L}", "biped": "Bip01 {L} Foot",
              "vrm": "J_Bip_{L}_Foot",
              "smpl": "{L}_Ankle", "smplx": "{left}_ankle", "xsens": "{Left}Ankle", "motive": "{L}Foot",
-             "asf": "{l}foot"},
+             "asf": "{l}foot", "unreal": "foot_{l}"},
     "ToeBase": {"unity": "Toes_{L}", "poser": "{l}Toe", "blender": "toe.{L}", "biped": "Bip01 {L} Toe0",
                 "vrm": "J_Bip_{L}_ToeBase",
-                "smpl": "{L}_Foot", "smplx": "{left}_foot", "xsens": "{Left}Toe", "motive": "{L}Toe", "asf": "{l}toes"},
+                "smpl": "{L}_Foot", "smplx": "{left}_foot", "xsens": "{Left}Toe", "motive": "{L}Toe", "asf": "{l}toes",
+                "unreal": "ball_{l}"},
     "Arm": {"unity": "UpperArm_{L}", "poser": "{l}ShldrBend", "blender": "upper_arm.{L}",
             "biped": "Bip01 {L} UpperArm", "vrm": "J_Bip_{L}_UpperArm",
             "smpl": "{L}_Shoulder", "smplx": "{left}_shoulder", "xsens": "{Left}Shoulder", "motive": "{L}UArm",
-            "asf": "{l}humerus"},
+            "asf": "{l}humerus", "unreal": "upperarm_{l}"},
     "ForeArm": {"unity": "LowerArm_{L}", "poser": "{l}ForearmBend", "blender": "forearm.{L}",
                 "biped": "Bip01 {L} Forearm", "vrm": "J_Bip_{L}_LowerArm",
                 "smpl": "{L}_Elbow", "smplx": "{left}_elbow", "xsens": "{Left}Elbow", "motive": "{L}FArm",
-                "asf": "{l}radius"},
+                "asf": "{l}radius", "unreal": "lowerarm_{l}"},
     "Hand": {"unity": "Hand_{L}", "poser": "{l}Hand", "blender": "hand.{L}", "biped": "Bip01 {L} Hand",
              "vrm": "J_Bip_{L}_Hand",
              "smpl": "{L}_Wrist", "smplx": "{left}_wrist", "xsens": "{Left}Wrist", "motive": "{L}Hand",
-             "asf": "{l}wrist"},
+             "asf": "{l}wrist", "unreal": "hand_{l}"},
     "Shoulder": {"unity": "Shoulder_{L}", "poser": "{l}Collar", "blender": "shoulder.{L}",
                  "biped": "Bip01 {L} Clavicle", "vrm": "J_Bip_{L}_Shoulder",
                  "smpl": "{L}_Collar", "smplx": "{left}_collar", "xsens": "{Left}Collar", "motive": "{L}Shoulder",
-                 "asf": "{l}clavicle"},
+                 "asf": "{l}clavicle", "unreal": "clavicle_{l}"},
     "Spine": {"unity": "Spine", "poser": "abdomen", "blender": "spine", "biped": "Bip01 Spine", "vrm": "J_Bip_C_Spine",
-              "smpl": "Spine1", "smplx": "spine1", "xsens": "Chest", "motive": "Ab", "asf": "upperback"},
+              "smpl": "Spine1", "smplx": "spine1", "xsens": "Chest", "motive": "Ab", "asf": "upperback",
+              "unreal": "spine_01"},
     "Spine1": {"unity": "Chest", "poser": "chest", "blender": "chest", "biped": "Bip01 Spine1",
                "vrm": "J_Bip_C_Chest",
-               "smpl": "Spine2", "smplx": "spine2", "xsens": "Chest2", "motive": "Chest", "asf": "thorax"},
+               "smpl": "Spine2", "smplx": "spine2", "xsens": "Chest2", "motive": "Chest", "asf": "thorax",
+               "unreal": "spine_02"},
     "Neck": {"unity": "Neck", "poser": "neck", "blender": "neck", "biped": "Bip01 Neck", "vrm": "J_Bip_C_Neck",
-             "smpl": "Neck", "smplx": "neck", "xsens": "Neck", "motive": "Neck", "asf": "lowerneck"},
+             "smpl": "Neck", "smplx": "neck", "xsens": "Neck", "motive": "Neck", "asf": "lowerneck",
+             "unreal": "neck_01"},
     "Head": {"unity": "Head", "poser": "head", "blender": "head", "biped": "Bip01 Head", "vrm": "J_Bip_C_Head",
-             "smpl": "Head", "smplx": "head", "xsens": "Head", "motive": "Head", "asf": "head"},
+             "smpl": "Head", "smplx": "head", "xsens": "Head", "motive": "Head", "asf": "head", "unreal": "head"},
 }
 
 
@@ -128,7 +140,7 @@ def _renamed(text: str, convention: str) -> str:
 
 @needs_cmu
 @pytest.mark.parametrize("convention", ["unity", "poser", "blender", "biped", "vrm", "smpl", "smplx", "xsens",
-                                        "motive", "asf"])
+                                        "motive", "asf", "unreal"])
 def test_renamed_cmu_clip_gives_the_same_operator(tmp_path, convention):
     original = (MOCAP / "cmu" / "02_01.bvh").read_text()
     path = tmp_path / f"02_01_{convention}.bvh"
@@ -172,6 +184,77 @@ def test_structure_finds_the_named_joints_of_every_shared_skeleton(tmp_path):
             if "lowerneck" in names and canon in ("NECK", "SPINE_CHEST"):
                 continue
             assert got == name, (f.name, canon)
+
+
+# A rig as Blender's BVH export writes a simple metarig without hands (our own numbers, metres, y up): each arm ends
+# at its forearm's end site, the clavicles (shoulder.L/R) start on the spine where the neck does, and the head is
+# ``face``; numbered spine bones (spine.001).
+_NO_HANDS_RIG = (
+    ("pelvis", None, (0, 0.9, 0), ()), ("spine", "pelvis", (0, 0, 0), ()),
+    ("spine.001", "spine", (0, 0.23, 0.01), ()), ("neck", "spine.001", (0, 0.23, -0.03), ()),
+    ("face", "neck", (0, 0.18, 0), (0, -0.01, 0.03)),
+    ("shoulder.L", "spine.001", (0, 0.23, -0.03), ()), ("upper_arm.L", "shoulder.L", (0.16, 0, 0), ()),
+    ("forearm.L", "upper_arm.L", (0.255, 0, 0), (0.222, 0, 0)),
+    ("shoulder.R", "spine.001", (0, 0.23, -0.03), ()), ("upper_arm.R", "shoulder.R", (-0.16, 0, 0), ()),
+    ("forearm.R", "upper_arm.R", (-0.255, 0, 0), (-0.222, 0, 0)),
+    ("thigh.L", "pelvis", (0.095, 0, 0), ()), ("shin.L", "thigh.L", (0.017, -0.33, 0), ()),
+    ("foot.L", "shin.L", (0.017, -0.32, 0), (0.014, -0.062, 0.147)),
+    ("thigh.R", "pelvis", (-0.095, 0, 0), ()), ("shin.R", "thigh.R", (-0.017, -0.33, 0), ()),
+    ("foot.R", "shin.R", (-0.017, -0.32, 0), (-0.014, -0.062, 0.147)),
+)
+
+
+def _no_hands_rig_bvh(names: dict[str, str] | None = None, n_frames: int = 20) -> str:
+    """A figure on :data:`_NO_HANDS_RIG` (joints renamed by ``names``) standing in its rest pose, its pelvis
+    swaying sideways."""
+    names = names or {}
+    kids: dict[str | None, list[str]] = {}
+    for name, parent, _, _ in _NO_HANDS_RIG:
+        kids.setdefault(parent, []).append(name)
+    rig = {name: (off, end) for name, _, off, end in _NO_HANDS_RIG}
+
+    def block(name: str, depth: int) -> list[str]:
+        pad = "  " * depth
+        off, end = rig[name]
+        chans = "CHANNELS 6 Xposition Yposition Zposition Xrotation Yrotation Zrotation" if depth == 0 else \
+            "CHANNELS 3 Xrotation Yrotation Zrotation"
+        out = [pad + ("ROOT " if depth == 0 else "JOINT ") + names.get(name, name), pad + "{",
+               f"{pad}  OFFSET {' '.join(str(v) for v in off)}", f"{pad}  {chans}"]
+        for kid in kids.get(name, []):
+            out += block(kid, depth + 1)
+        if end:
+            out += [f"{pad}  End Site", pad + "  {", f"{pad}    OFFSET {' '.join(str(v) for v in end)}", pad + "  }"]
+        return out + [pad + "}"]
+
+    n_rot = len(_NO_HANDS_RIG) - 1
+    rows = [" ".join(f"{v:.4f}" for v in (0.05 * np.sin(0.3 * k), 0.9, 0.0, 0, 0, 0, *[0.0] * (3 * n_rot)))
+            for k in range(n_frames)]
+    return "\n".join(["HIERARCHY", *block("pelvis", 0), "MOTION", f"Frames: {n_frames}", "Frame Time: 0.0416667",
+                      *rows]) + "\n"
+
+
+def test_an_arm_without_a_hand_ends_at_its_forearm_end_site(tmp_path):
+    """By name, ``forearm.L``'s end site is the left wrist, ``spine.001`` the chest and ``face`` the head; by
+    structure (the names anonymised), an arm without fingers is read as a leg is, and gives the same joints.
+    Before, the names left the wrists and the head unmatched, and structure took the last joint of each arm as
+    its wrist: the shoulders sat on the spine, where the clavicles start."""
+    named = tmp_path / "no_hands.bvh"
+    named.write_text(_no_hands_rig_bvh())
+    rec = BvhRecording(named)
+    assert all(how.startswith("name") for _, how in rec.matches.values())
+    expected = {"SHOULDER_LEFT": "upper_arm.L", "ELBOW_LEFT": "forearm.L", "WRIST_LEFT": "forearm.LEnd",
+                "WRIST_RIGHT": "forearm.REnd", "SPINE_CHEST": "spine.001", "HEAD": "face", "FOOT_LEFT": "foot.LEnd"}
+    assert {k: rec.mapping[k] for k in expected} == expected
+    pos = rec.performer.pos_world[0]
+    shoulders = pos[JOINT_INDEX["SHOULDER_LEFT"]] - pos[JOINT_INDEX["SHOULDER_RIGHT"]]
+    assert 0.25 < np.linalg.norm(shoulders) * 1.75 / rec.stature_m < 0.4  # [m], at his 1.75 m
+    anonymous = tmp_path / "no_hands_anonymous.bvh"
+    anonymous.write_text(_anonymous(named.read_text()))
+    order = [name for name, _, _, _ in _NO_HANDS_RIG]
+    by_structure = BvhRecording(anonymous).mapping
+    for canon, name in rec.mapping.items():
+        got = by_structure[canon]
+        assert order[int(got[1:].removesuffix("End"))] + ("End" if got.endswith("End") else "") == name, canon
 
 
 def test_a_tree_that_is_no_humanoid_fails_with_the_missing_segments():

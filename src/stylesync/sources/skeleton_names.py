@@ -7,7 +7,8 @@ A joint name is read as (side, segment word):
 2. The side is a marker as prefix or suffix: ``Left``/``Right``, ``L``/``R`` as a word (``L_``, ``_L``, ``.L``,
    ``Bip01 L Thigh``), or a lower-case ``l``/``r`` before a capital (Poser/DAZ ``lThigh``, ``rShin``). A fully
    lower-case name takes ``left``/``right``/``l``/``r`` as prefix when the rest is a known segment word.
-3. The rest is split into words (case changes, spaces, dots, dashes, underscores), lower-cased and joined; ``bend``
+3. The rest is split into words (case changes, spaces, dots, dashes, underscores), lower-cased (numbers without
+   their leading zeros: Blender's ``spine.001`` and Unreal's ``spine_01`` read ``spine1``) and joined; ``bend``
    (DAZ's main bones, ``lThighBend``) is dropped, and joints whose name holds ``twist`` or ``roll`` are helpers
    that are never matched (``lThighTwist``, ``upperarm_twist_01_l``).
 
@@ -15,7 +16,9 @@ Each canonical joint then takes the first joint, in the file's depth-first order
 its synonyms (``SIDE_SYNONYMS``, ``CENTRE_SYNONYMS``). The ranking resolves names whose meaning differs between
 conventions: MotionBuilder's ``LeftShoulder`` is the clavicle and ``LeftArm`` the upper arm, 3ds Max's
 ``LeftShoulder`` is the upper arm; "arm" is tried before "shoulder", so each file gets its own meaning. End sites
-appear as words ending in ``end`` (``lFoot`` end site → ``footend``), the toe of a skeleton without toe joints.
+appear as words ending in ``end`` (``lFoot`` end site → ``footend``, ``foot.L``'s → left ``footend``), the toe of a
+skeleton without toe joints, and the forearm's the wrist of an arm without a hand (a simple Blender metarig's, whose
+head joint is ``face``).
 A file joint stands for one canonical joint at most, taken in the order of ``SIDE_SYNONYMS``: where a skeleton has
 an ``Ankle`` joint (SMPL's ``L_Ankle``, Xsens's ``LeftAnkle``), that is the ankle and its ``Foot`` child the toe;
 where it has none (MotionBuilder's ``LeftFoot``), the foot joint is the ankle. OptiTrack Motive's upper arm and
@@ -42,14 +45,14 @@ SIDE_SYNONYMS: dict[str, tuple[str, ...]] = {
     "FOOT": ("toebase", "toe0", "toes", "toe", "ball", "foot", "footend", "ankleend"),
     "SHOULDER": ("arm", "upperarm", "shldr", "uparm", "uarm", "shoulder"),
     "ELBOW": ("forearm", "lowerarm", "elbow", "lowarm", "farm"),
-    "WRIST": ("wrist", "hand"),
+    "WRIST": ("wrist", "hand", "forearmend", "lowerarmend"),
 }
 CENTRE_SYNONYMS: dict[str, tuple[str, ...]] = {
     "PELVIS": ("hips", "pelvis", "hip", "root"),
-    "SPINE_CHEST": ("spine2", "chest2", "upperchest", "chestupper", "spine1", "chest", "chestlower", "spine",
+    "SPINE_CHEST": ("spine3", "spine2", "chest2", "upperchest", "chestupper", "spine1", "chest", "chestlower", "spine",
                     "abdomen2", "abdomenupper", "abdomen"),
     "NECK": ("neck", "lowerneck", "necklower", "neck1"),
-    "HEAD": ("head",),
+    "HEAD": ("head", "face"),
 }
 _KNOWN_WORDS = frozenset(w for ws in (*SIDE_SYNONYMS.values(), *CENTRE_SYNONYMS.values()) for w in ws)
 
@@ -70,13 +73,18 @@ def parse_name(name: str) -> ParsedName:
     m = re.match(r"^([lr])(?=[A-Z])", s)
     if m:
         side, s = ("left" if m.group(1) == "l" else "right"), s[1:]
-    words = [w.lower() for w in _WORD.findall(s)]
+    words = [str(int(w)) if w.isdigit() else w.lower() for w in _WORD.findall(s)]  # spine.001 -> spine 1
     if words and words[0] == "c" and len(words) > 1:  # VRM's centre marker, J_Bip_C_Hips
         words = words[1:]
+    end_site = len(words) > 2 and words[-1] == "end"  # the loader's end-site suffix after a side: foot.L + End
+    if end_site:
+        words.pop()
     for pos in (0, -1):
         if side is None and len(words) > 1 and (words[pos] in _LEFT or words[pos] in _RIGHT):
             side = "left" if words[pos] in _LEFT else "right"
             words.pop(pos)
+    if end_site:
+        words.append("end")
     helper = any(w in _HELPER_WORDS for w in words)
     word = "".join(w for w in words if w not in _DROPPED_WORDS)
     if side is None and word not in _KNOWN_WORDS:

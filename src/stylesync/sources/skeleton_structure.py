@@ -13,8 +13,9 @@ geometry (file units and axes; only directions and ratios are used):
 3. In a leg (the path from its first joint to its farthest end), the two adjacent segments of greatest summed
    length are the thigh and shank (hip, knee, ankle); the joint after the ankle is the toe. In an arm, the wrist
    is the joint where the hand branches into fingers (or the first joint placed on it: a hand segment of no
-   length), else the arm's last joint; the elbow and the shoulder are the two joints before it (a clavicle before
-   the shoulder, however long, is left out).
+   length), and the elbow and the shoulder are the two joints before it (a clavicle before the shoulder, however
+   long, is left out); an arm without fingers is read as a leg is: its two adjacent segments of greatest summed
+   length are the upper arm and forearm, and the wrist may be the forearm's end site (an arm without a hand).
 4. Left and right: ``up`` runs from the pelvis to the head, ``forward`` along the feet (ankle to toe), and the
    chain whose first joint lies further along ``up × forward`` is the left one.
 """
@@ -77,7 +78,10 @@ def _arm(tree: _Tree, first: int, origin: np.ndarray, end_sites: frozenset[int])
     path, seg = _path_segments(tree, first, origin)
     real = [k for k in range(len(path)) if path[k] not in end_sites]
     branching = [k for k in real[1:] if len([c for c in tree.children[path[k]] if c not in end_sites]) >= 2]
-    w = branching[0] if branching else real[-1]
+    if not branching:  # no fingers: the upper arm and forearm are the two adjacent segments of greatest length,
+        i = int(np.argmax(seg[:-1] + seg[1:]))  # as the leg's; the wrist may be the forearm's end site (no hand)
+        return path[i:i + 3]
+    w = branching[0]
     while w > 0 and seg[w - 1] < _COINCIDENT * seg.max():  # a joint placed on the wrist (a hand with no length)
         w -= 1
     if w < 2:
