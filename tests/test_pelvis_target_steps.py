@@ -28,8 +28,9 @@ def _largest_drop_m(**motion) -> float:
             drop[0] = max(drop[0], last[0] - z)
         last[:] = [z]
 
-    def configure(cfg):
-        return dataclasses.replace(cfg, motion=dataclasses.replace(cfg.motion, **motion), duration_s=3.2)
+    def configure(cfg):  # traced without the pelvis target's floor (pelvis_min_height_m), which bounds the drop too
+        motion_cfg = dataclasses.replace(cfg.motion, **{"pelvis_min_height_m": None, **motion})
+        return dataclasses.replace(cfg, motion=motion_cfg, duration_s=3.2)
 
     suite_run("builtin:spinkick", 0, MotionConfig(), ControlConfig(), on_tick=on_tick, configure=configure)
     return drop[0]

@@ -72,8 +72,10 @@ def test_the_spins_leap_does_not_fold_the_stance_leg():
 
         # traced before the joints' no-load speed (with it, this seed falls in the spin: docs/decisions.md) and
         # while a lift-off onto a sole the capture point has passed waited only the weight shift's time (with that
-        # wait and without the no-load speed, it falls too; by default the spin of this seed completes)
-        result = suite_run("builtin:spin", 8, MotionConfig(airborne_ankle_height_leg=share, liftoff_behind_waits=False),
+        # wait and without the no-load speed, it falls too; by default the spin of this seed completes), and without
+        # the pelvis target's floor (pelvis_min_height_m), which keeps the target up as well
+        result = suite_run("builtin:spin", 8, MotionConfig(airborne_ankle_height_leg=share, liftoff_behind_waits=False,
+                                                           pelvis_min_height_m=None),
                            ControlConfig(whole_body=WholeBodyConfig(joint_speed_limit_rad_s=None)), watch=watch)
         return low, result
 

@@ -431,6 +431,11 @@ class MotionConfig:
     # 0.67 m for a control tick (the humanoid3d spinning kick; docs/decisions.md, "The pelvis target's steps within a
     # control tick"; False: from the ankles)
     ds_anchor_ground_height: bool = False
+    # The pelvis target of Eq. 9 no lower than this: the session counts a pelvis below 0.5 m as a fall
+    # (session.FALL_ROOT_HEIGHT_M), and a character that followed his deepest crouch there (his pelvis 0.4 m up,
+    # scaled) was counted fallen while it stood on both feet (docs/decisions.md, "A crouch deeper than the fall
+    # height"). None: as deep as he goes [m]
+    pelvis_min_height_m: float | None = 0.6
 
     def __post_init__(self) -> None:
         lo, hi = self.step_outside_capture_point_m
@@ -453,6 +458,8 @@ class MotionConfig:
         _positive("MotionConfig.stance_height_threshold_m", self.stance_height_threshold_m)
         if self.airborne_ankle_height_leg is not None:
             _positive("MotionConfig.airborne_ankle_height_leg", self.airborne_ankle_height_leg)
+        if self.pelvis_min_height_m is not None:
+            _positive("MotionConfig.pelvis_min_height_m", self.pelvis_min_height_m)
         _non_negative("MotionConfig.recovery_step_margin_m", self.recovery_step_margin_m)
         if self.double_stance_keeps_momentum_m is not None:
             _non_negative("MotionConfig.double_stance_keeps_momentum_m", self.double_stance_keeps_momentum_m)

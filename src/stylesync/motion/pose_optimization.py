@@ -548,6 +548,10 @@ class MotionOptimizer:
         tick.pelvis_vel_z = scale * float(self._pelvis_h_rate(p_h)[2])
         if self._his_rise is not None:
             tick.pelvis_vel_z = self._his_rise.rise_mps(tick.pelvis_vel_z, tick.op_state is Stance.DS)
+        floor_m = self.cfg.pelvis_min_height_m
+        if floor_m is not None and tick.pelvis_d[2] < floor_m:  # his crouch followed no deeper than a fall's height
+            tick.pelvis_d[2] = floor_m
+            tick.pelvis_vel_z = max(tick.pelvis_vel_z, 0.0)
         # The operator's COM height reflects his own mass distribution, not the character's: the vertical is left
         # to the pelvis height (Eq. 9) through the leg IK, and the COM target keeps the character's own height.
         tick.com_d = np.array([com_xy[0], com_xy[1], com_c[2]])
