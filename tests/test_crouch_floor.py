@@ -7,12 +7,14 @@ import dataclasses
 
 import numpy as np
 import pytest
+from conftest import suite_run
 
-from stylesync.config import MotionConfig, SessionConfig
+from stylesync.config import ControlConfig, MotionConfig, SessionConfig
 from stylesync.errors import ConfigError
 from stylesync.experiments import squat_jump
 from stylesync.experiments.common import run_session
 from stylesync.model.state import CONTACT_FORCE_N
+from stylesync.motion import pose_optimization
 from stylesync.session import FALL_ROOT_HEIGHT_M, Session
 from stylesync.sources.builtin_operator import sensed
 from stylesync.sources.human_model import HumanModel
@@ -46,6 +48,18 @@ def test_a_crouch_deeper_than_the_fall_height_is_followed_no_deeper_than_the_flo
     assert FALL_ROOT_HEIGHT_M + 0.08 < pelvis_z.min() < 0.65  # measured: 0.603 m
     # his crouch is followed to the floor: the character went down more than a normal squat's 0.2 m
     assert pelvis_z[0] - pelvis_z.min() > 0.2
+
+
+def test_an_operator_who_lies_down_is_followed_to_the_ground(monkeypatch):
+    """The floor holds a crouch, his trunk upright, not a body he takes to the ground: in the humanoid3d get-up
+    (face up, seed 0) he lies on his back, and the character goes down with him, a fall by the session's rule (out
+    of reach, as before the floor). Held at the floor whatever his trunk does, it stays up, crouched, while he lies,
+    imitating nothing of it (measured: it falls at 2.90 s, against 1.34 s)."""
+    followed = suite_run("builtin:getup_faceup", 0, MotionConfig(), ControlConfig())
+    assert followed.fell and followed.fall_time_s < 2.0  # measured: 1.34 s
+    monkeypatch.setattr(pose_optimization, "_CROUCH_TRUNK_COS", -2.0)  # every trunk taken for upright
+    held = suite_run("builtin:getup_faceup", 0, MotionConfig(), ControlConfig())
+    assert not held.fell or held.fall_time_s > followed.fall_time_s + 1.0
 
 
 def test_the_pelvis_floor_must_be_positive():

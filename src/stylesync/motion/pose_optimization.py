@@ -93,6 +93,9 @@ _HINGE_JOINTS = [k for k, j in enumerate(JOINTS) if j.kind is not JointKind.BALL
 _VELOCITY_SMOOTHING = 0.2  # per tick, exponential average of the desired COM velocity
 _GAIT_AXIS_COS = math.cos(math.radians(GAIT_AXIS_DEG))
 _SIDE_UP = {"left": "LEFT", "right": "RIGHT"}
+# A crouch: his trunk (pelvis to neck) within this of the vertical. Lying, crawling, rolling, it is further [deg]
+CROUCH_TRUNK_MAX_DEG = 60.0
+_CROUCH_TRUNK_COS = math.cos(math.radians(CROUCH_TRUNK_MAX_DEG))
 _LINK = {n: i for i, n in enumerate(LINK_NAMES)}
 _ROOT_LINK = _LINK["root"]
 CHAR_LEG_LENGTH_M = THIGH_LENGTH_M + SHANK_LENGTH_M
@@ -234,6 +237,11 @@ def _sole_within_m(state: CharacterState, side: str, gap_m: float) -> bool:
     """Whether the lowest corner of the sole on ``side`` is within ``gap_m`` of the ground (model/sole.py)."""
     ankle = _LINK[f"{side}_ankle"]
     return sole_within_m(state.link_origin_world[ankle], state.link_quat_wxyz[ankle], gap_m)
+
+
+def _trunk_upright(pelvis_to_neck: np.ndarray) -> bool:
+    """Whether his trunk (the (3,) pelvis-to-neck vector, world, z up) is within CROUCH_TRUNK_MAX_DEG of vertical."""
+    return bool(pelvis_to_neck[2] > _CROUCH_TRUNK_COS * np.linalg.norm(pelvis_to_neck))
 
 
 class MotionOptimizer:
@@ -549,8 +557,8 @@ class MotionOptimizer:
         if self._his_rise is not None:
             tick.pelvis_vel_z = self._his_rise.rise_mps(tick.pelvis_vel_z, tick.op_state is Stance.DS)
         floor_m = self.cfg.pelvis_min_height_m
-        if floor_m is not None and tick.pelvis_d[2] < floor_m:  # his crouch followed no deeper than a fall's height
-            tick.pelvis_d[2] = floor_m
+        if floor_m is not None and tick.pelvis_d[2] < floor_m and _trunk_upright(s.pos["NECK"] - p_h):
+            tick.pelvis_d[2] = floor_m  # his crouch followed down to the floor, above a fall's height
             tick.pelvis_vel_z = max(tick.pelvis_vel_z, 0.0)
         # The operator's COM height reflects his own mass distribution, not the character's: the vertical is left
         # to the pelvis height (Eq. 9) through the leg IK, and the COM target keeps the character's own height.
