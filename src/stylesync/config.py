@@ -431,10 +431,11 @@ class MotionConfig:
     # 0.67 m for a control tick (the humanoid3d spinning kick; docs/decisions.md, "The pelvis target's steps within a
     # control tick"; False: from the ankles)
     ds_anchor_ground_height: bool = False
-    # The pelvis target of Eq. 9 no lower than this: the session counts a pelvis below 0.5 m as a fall
-    # (session.FALL_ROOT_HEIGHT_M), and a character that followed his deepest crouch there (his pelvis 0.4 m up,
-    # scaled) was counted fallen while it stood on both feet (docs/decisions.md, "A crouch deeper than the fall
-    # height"). None: as deep as he goes [m]
+    # The pelvis target of Eq. 9 no lower than this while he crouches, his trunk upright (pose_optimization.
+    # CROUCH_TRUNK_MAX_DEG; lying, crawling or rolling he is followed to the ground): the session counts a pelvis below
+    # 0.5 m as a fall (session.FALL_ROOT_HEIGHT_M), and a character that followed his deepest crouch there (his pelvis
+    # 0.4 m up, scaled) was counted fallen while it stood on both feet (docs/decisions.md, "A crouch deeper than the
+    # fall height"). None: as deep as he goes [m]
     pelvis_min_height_m: float | None = 0.6
 
     def __post_init__(self) -> None:
