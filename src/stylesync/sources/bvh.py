@@ -63,10 +63,11 @@ def rest_stands_upright(pelvis: np.ndarray, ankles: list[np.ndarray], head: np.n
     lay every bone along x at rest, legs and spine alike, or one leg along +x and the other along -x (Bandai Namco's
     motion dataset): there the ankles' midpoint can lie below the pelvis although neither leg does."""
     spine = np.asarray(head) - pelvis
+    cos_min = np.cos(np.radians(UPRIGHT_REST_MIN_DEG))
     for ankle in ankles:
         leg = np.asarray(ankle) - pelvis
         norms = float(np.linalg.norm(leg) * np.linalg.norm(spine))
-        if norms <= 0 or float(leg @ spine) / norms >= np.cos(np.radians(UPRIGHT_REST_MIN_DEG)):
+        if norms <= 0 or float(leg @ spine) / norms >= cos_min:
             return False
     return True
 
@@ -308,10 +309,9 @@ class BvhRecording:
             world_R[j] = rot.batch_matrix_from_quat(world_q[j])
 
         # The file's up axis and stature: from the rest pose when it stands upright, otherwise from the frames.
-        ankles = 0.5 * (rest[idx["ANKLE_LEFT"]] + rest[idx["ANKLE_RIGHT"]])
-        up_vec = rest[idx["HEAD"]] - ankles
-        posed = not rest_stands_upright(rest[idx["PELVIS"]], [rest[idx["ANKLE_LEFT"]], rest[idx["ANKLE_RIGHT"]]],
-                                         rest[idx["HEAD"]])
+        rest_ankles = [rest[idx["ANKLE_LEFT"]], rest[idx["ANKLE_RIGHT"]]]
+        up_vec = rest[idx["HEAD"]] - 0.5 * (rest_ankles[0] + rest_ankles[1])
+        posed = not rest_stands_upright(rest[idx["PELVIS"]], rest_ankles, rest[idx["HEAD"]])
         up_t = world_pos[idx["HEAD"]] - 0.5 * (world_pos[idx["ANKLE_LEFT"]] + world_pos[idx["ANKLE_RIGHT"]])
         if posed:
             # Rigs whose bones lie along one axis at rest (joint frames with x along the bone): the pose at rest is

@@ -66,10 +66,16 @@ def _path_segments(tree: _Tree, first: int, origin: np.ndarray) -> tuple[list[in
     return path, np.linalg.norm(np.diff(tree.rest[path], axis=0), axis=1)
 
 
+def _longest_pair(seg: np.ndarray) -> int:
+    """The index of the first of the two adjacent segments of greatest summed length (a thigh and shank, an upper arm
+    and forearm)."""
+    return int(np.argmax(seg[:-1] + seg[1:]))
+
+
 def _leg(tree: _Tree, first: int, origin: np.ndarray) -> list[int]:
     """(hip, knee, ankle[, toe]): the two adjacent segments of greatest summed length on the path to the foot."""
     path, seg = _path_segments(tree, first, origin)
-    i = int(np.argmax(seg[:-1] + seg[1:]))
+    i = _longest_pair(seg)
     return path[i:i + 4]
 
 
@@ -78,8 +84,8 @@ def _arm(tree: _Tree, first: int, origin: np.ndarray, end_sites: frozenset[int])
     path, seg = _path_segments(tree, first, origin)
     real = [k for k in range(len(path)) if path[k] not in end_sites]
     branching = [k for k in real[1:] if len([c for c in tree.children[path[k]] if c not in end_sites]) >= 2]
-    if not branching:  # no fingers: the upper arm and forearm are the two adjacent segments of greatest length,
-        i = int(np.argmax(seg[:-1] + seg[1:]))  # as the leg's; the wrist may be the forearm's end site (no hand)
+    if not branching:  # no fingers: read as a leg; the wrist may be the forearm's end site (no hand)
+        i = _longest_pair(seg)
         return path[i:i + 3]
     w = branching[0]
     while w > 0 and seg[w - 1] < _COINCIDENT * seg.max():  # a joint placed on the wrist (a hand with no length)
