@@ -296,3 +296,45 @@ def test_a_light_link_does_not_spin_up_within_a_control_tick():
     unlimited, limited = run(None), run(30.0)
     assert unlimited.fell and "diverged" in unlimited.fall_reason and unlimited.fall_time_s < 4.0
     assert not limited.fell
+
+
+def _walk_with_attribution(attribute: bool) -> tuple[np.ndarray, list]:
+    """The built-in walk's first 1.6 s (seed 0), ``plan_attribution`` called on every control tick from 1.2 s if
+    ``attribute``: the final joint positions and the attributions."""
+    cfg = SessionConfig(duration_s=1.6, operator=OperatorConfig(clip="walk"))
+    source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
+    session = Session(cfg, source)
+    plans: list = []
+    last: dict = {}
+
+    def tick(state, ref):
+        last["q"] = state.joint_pos.copy()
+        if attribute and state.time_s >= 1.2:
+            plans.append((session.controller.plan_attribution(), session.controller.telemetry.com_force_n.copy(),
+                          session.mass.total_kg))
+
+    session.on_tick = tick
+    session.run()
+    return last["q"], plans
+
+
+def test_the_plans_attribution_leaves_the_run_as_it_is_and_names_each_tasks_share():
+    """WholeBodyController.plan_attribution solves the last QP again by a solver of its own: the run is the same bit
+    for bit with it; the planned ground force carries the body's weight, and without the momentum task it no longer
+    follows the force that task asks for."""
+    q_plain, _ = _walk_with_attribution(False)
+    q_attributed, plans = _walk_with_attribution(True)
+    np.testing.assert_array_equal(q_plain, q_attributed)
+    assert len(plans) > 20
+    weight = plans[0][2] * 9.8
+    errors_with, errors_without = [], []
+    for plan, asked, _ in plans:
+        forces = plan.ground_force_n
+        assert {"", "posture", "pelvis_orientation", "centroidal_momentum"} <= set(forces)
+        assert 0.6 * weight < forces[""][2] < 1.6 * weight
+        errors_with.append(float(np.linalg.norm(forces[""][:2] - asked[:2])))
+        errors_without.append(float(np.linalg.norm(forces["centroidal_momentum"][:2] - asked[:2])))
+        assert plan.posture_cost.shape == plan.posture_desired_rad_s2.shape == plan.posture_planned_rad_s2.shape
+        assert np.all(plan.posture_cost >= 0.0)
+    assert np.median(errors_with) < 0.5 * np.median(errors_without), (np.median(errors_with),
+                                                                        np.median(errors_without))

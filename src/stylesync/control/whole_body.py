@@ -28,6 +28,7 @@ to their limits as always, and the failed solve's last iterate is not applied.
 from __future__ import annotations
 
 import logging
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -36,7 +37,7 @@ from stylesync.config import ControlConfig
 from stylesync.control.contacts import SoleContact, feasible_horizontal_force, sole_touches
 from stylesync.control.controller import TORQUE_LIMIT, ControllerBase, ControlTelemetry, supporting_weights
 from stylesync.control.crvc import com_virtual_force, root_orientation_error, root_pd
-from stylesync.control.formulation import WholeBodyFormulation, hinge_limits
+from stylesync.control.formulation import QpProblem, WholeBodyFormulation, hinge_limits
 from stylesync.control.gravity_compensation import LEG_JOINTS
 from stylesync.control.joint_speed_limit import limit_joint_speed
 from stylesync.control.model_compensation import bounded_lipm_sync_force
@@ -103,6 +104,18 @@ HAND_REACH_SHARE = 1.0
 _TORQUE_LIMIT_FLAT = flatten_joint_values(np.repeat(TORQUE_LIMIT, 3, axis=1))
 
 
+@dataclass(frozen=True)
+class PlanAttribution:
+    """WholeBodyController.plan_attribution: the ground force the last QP plans [N], as solved (key "") and with each
+    task switched off (key: its name), and the posture task's per-DOF cost, desired and planned joint accelerations
+    (n_joint_dofs,) in the solution as solved [-, rad/s², rad/s²]."""
+
+    ground_force_n: dict[str, np.ndarray]
+    posture_cost: np.ndarray
+    posture_desired_rad_s2: np.ndarray
+    posture_planned_rad_s2: np.ndarray
+
+
 def recovery_landing_due(target_world: np.ndarray) -> bool:
     """Whether a recovery step's ankle target (3,) [m] is below the ground, i.e. its landing is due."""
     return bool(target_world[2] < ANKLE_HEIGHT_M - LANDING_DUE_BELOW_M)
@@ -158,6 +171,8 @@ class WholeBodyController(ControllerBase):
         self.toe_contacts = {s: ToeContact(s, friction, mass.total_kg * gravity_mps2) for s in SIDES}
         self.on_toes: set[str] = set()  # the supporting feet on their toes this tick
         self.solver = DaqpSolver()
+        # What the last tick's QP was built from, its soles, bounds and problem (plan_attribution)
+        self._last_qp: tuple[list, list, QpProblem] | None = None
 
     def update(self, state: CharacterState, ref: ReferencePose) -> None:
         cfg, wb = self.cfg, self.wb
@@ -268,6 +283,7 @@ class WholeBodyController(ControllerBase):
         bounds = ([own_step_push_bound(model, contacts[0].corners_world, m, self.g)]
                   if bounded and len(contacts) == 1 else [])
         problem = self.formulation.build(model, contacts, bounds)
+        self._last_qp = (contacts, bounds, problem)
         result = self.solver.solve(problem)
         if not result.solved and self.wb.relax_limits_when_infeasible:
             failed = result.exitflag
@@ -284,6 +300,35 @@ class WholeBodyController(ControllerBase):
             limit_joint_speed(tau, state.joint_vel, wb.joint_speed_limit_rad_s)
         self._tau = Torques(np.minimum(np.maximum(tau, -TORQUE_LIMIT), TORQUE_LIMIT))
         self.telemetry = ControlTelemetry(force, f_lipm, moment)
+
+    def plan_attribution(self) -> PlanAttribution:
+        """What each task of the last tick's QP does to the ground force it plans: the QP solved again (by a solver
+        of its own, so that the run's warm starts stay as they are) as it was, and with each active task switched off
+        in turn, each solution's total ground force (3,) [N] (the rate of the linear momentum, Ȧ_g v + A_g q̈, plus
+        the body's weight), keyed by the task's name; and the joint posture task's cost per DOF in the solution as it
+        was. A tool for explaining where a planned force comes from (benchmarks/qp_attribution.py)."""
+        if self._last_qp is None:
+            raise RuntimeError("plan_attribution needs a control tick first")
+        contacts, bounds, problem = self._last_qp
+        solver, model, f = DaqpSolver(), self.model, self.formulation
+        weight = np.array([0.0, 0.0, self.mass.total_kg * self.g])
+
+        def ground_force(x: np.ndarray) -> np.ndarray:
+            return model.centroidal_map[:3] @ x[:ROOT_DOFS + N_JOINT_DOFS] + model.centroidal_map_dot_v[:3] + weight
+
+        x = solver.solve(problem).x
+        forces = {"": ground_force(x)}
+        for task in f.tasks:
+            if not task.active:
+                continue
+            task.active = False
+            try:
+                forces[task.name] = ground_force(solver.solve(f.build(model, contacts, bounds)).x)
+            finally:
+                task.active = True
+        rows = self.posture.rows(model)
+        cost = 0.5 * rows.weight * (x[ROOT_DOFS:ROOT_DOFS + N_JOINT_DOFS] - rows.target) ** 2
+        return PlanAttribution(forces, cost, rows.target.copy(), x[ROOT_DOFS:ROOT_DOFS + N_JOINT_DOFS].copy())
 
     def _toe_off(self, state: CharacterState, support: list[str], com_world: np.ndarray) -> set[str]:
         """The supporting feet that stand on their toes this tick (toe_contact.toe_off_sides)."""
