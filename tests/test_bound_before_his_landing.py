@@ -30,9 +30,10 @@ def _followed_walk(bounded: bool) -> tuple[float, int, float, bool]:
 
     def configure(cfg):
         cfg = follow_path(cfg)
-        # Traced before the rule for a foot lying on the ground (landing_reach_ground_gap_m): pinned off
+        # Traced before the rule for a foot lying on the ground (landing_reach_ground_gap_m) and before the pelvis
+        # target came down as his swing went (swing_landing_within_reach): pinned off
         motion = dataclasses.replace(cfg.motion, capture_bound_before_his_landing=bounded,
-                                     landing_reach_ground_gap_m=None)
+                                     landing_reach_ground_gap_m=None, swing_landing_within_reach=False)
         return dataclasses.replace(cfg, motion=motion)
 
     result = suite_run("builtin:walk", 0, MotionConfig(), ControlConfig(), watch=watch, configure=configure)

@@ -97,7 +97,8 @@ def test_a_chain_of_own_steps_in_the_rest_is_not_pushed_on(push_bound):
     own steps push its COM from 1.1 to 3 m/s (horizontally) and it falls 1.4 s into the rest. With the bound in the
     steps taken while he stands (the default), it comes to rest. Traced with the pelvis height's regulator alone
     (WholeBodyConfig.pelvis_rate_share 0), and while a lift-off onto a sole the capture point has passed waited only
-    the weight shift's time (MotionConfig.liftoff_behind_waits off: with it, the run without the bound stands too)."""
+    the weight shift's time (MotionConfig.liftoff_behind_waits off: with it, the run without the bound stands too),
+    and before the pelvis target came down as his swing went (MotionConfig.swing_landing_within_reach off)."""
     speeds = []
     control = ControlConfig(whole_body=WholeBodyConfig(own_step_push_bound=push_bound, pelvis_rate_share=0.0,
                                                        recovery_foot_target_rate="differenced"))
@@ -105,8 +106,8 @@ def test_a_chain_of_own_steps_in_the_rest_is_not_pushed_on(push_bound):
     def watch(session):
         return lambda state, ref: speeds.append(float(np.hypot(*session.mass.com_velocity(state)[:2])))
 
-    result = suite_run(f"bvh:{MOCAP / 'cmu-dev' / '08_08.bvh'}", 11, MotionConfig(liftoff_behind_waits=False), control,
-                       watch=watch)
+    result = suite_run(f"bvh:{MOCAP / 'cmu-dev' / '08_08.bvh'}", 11,
+                       MotionConfig(liftoff_behind_waits=False, swing_landing_within_reach=False), control, watch=watch)
     if push_bound == "off":
         assert result.fell and max(speeds) > 2.5
     else:

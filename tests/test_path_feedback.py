@@ -195,8 +195,9 @@ def test_a_gait_double_stance_bounded_by_what_a_step_catches_keeps_fast_walks_up
     stance (gait_capture_step_s None) these walks fell at ``fall_s``, their own steps beginning with the capture point
     0.24-0.29 m out (docs/decisions.md, "Where `--follow-path`'s chains of own steps begin"); bounded to what a step
     0.3 s later catches (about 0.21 m out), none falls in the first 5.5 s. (Traced before the step of a double stance
-    beyond a step's reach, the bound before his landing, the resting foot's gap and the bound on the targets' lead,
-    off here: the first catches the first of those falls as well.)"""
+    beyond a step's reach, the bound before his landing, the resting foot's gap, the bound on the targets' lead and
+    the pelvis target that comes down as his swing goes, off here: the first catches the first of those falls as
+    well.)"""
     import logging
 
     from conftest import suite_run
@@ -209,7 +210,8 @@ def test_a_gait_double_stance_bounded_by_what_a_step_catches_keeps_fast_walks_up
             cfg = cfg.replace(motion=dataclasses.replace(cfg.motion, recovery_ds_beyond_reach=False,
                                                          capture_bound_before_his_landing=True,
                                                          landing_reach_ground_gap_m=None,
-                                                         reference_lead_max_m=None))
+                                                         reference_lead_max_m=None,
+                                                         swing_landing_within_reach=False))
             if not bounded:
                 cfg = cfg.replace(motion=dataclasses.replace(cfg.motion, gait_capture_step_s=None))
             return cfg

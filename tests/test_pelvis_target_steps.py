@@ -28,8 +28,10 @@ def _largest_drop_m(**motion) -> float:
             drop[0] = max(drop[0], last[0] - z)
         last[:] = [z]
 
-    def configure(cfg):  # traced without the pelvis target's floor (pelvis_min_height_m), which bounds the drop too
-        motion_cfg = dataclasses.replace(cfg.motion, **{"pelvis_min_height_m": None, **motion})
+    def configure(cfg):  # traced without the pelvis target's floor (pelvis_min_height_m), which bounds the drop too,
+        # and before it came down as his swing went (swing_landing_within_reach)
+        motion_cfg = dataclasses.replace(cfg.motion, **{"pelvis_min_height_m": None,
+                                                        "swing_landing_within_reach": False, **motion})
         return dataclasses.replace(cfg, motion=motion_cfg, duration_s=3.2)
 
     suite_run("builtin:spinkick", 0, MotionConfig(), ControlConfig(), on_tick=on_tick, configure=configure)

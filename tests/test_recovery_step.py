@@ -52,10 +52,10 @@ def traced_motion(**kwargs) -> MotionConfig:
     it. They were traced before a recovery step's timing adapted to its reach (``recovery_swing_min_s`` None), and
     before a lift-off waited for the other foot to be down (``liftoff_needs_other_foot_down`` off), and while a
     lift-off onto a sole the capture point has passed waited only the weight shift's time (``liftoff_behind_waits``
-    off)."""
+    off), and before the pelvis target came down as his swing went (``swing_landing_within_reach`` off)."""
     return MotionConfig(**{"swing_landing": "his_foot_now", "recovery_overdue_swing_horizon": False,
                            "recovery_swing_min_s": None, "liftoff_needs_other_foot_down": False,
-                           "liftoff_behind_waits": False,
+                           "liftoff_behind_waits": False, "swing_landing_within_reach": False,
                            "recovery_cross_nearest": False, "recovery_cross_stance_frame": False,
                            "recovery_landing_foot_waits": False, "fraction_needs_feet_in_his_order": False,
                            **kwargs})
@@ -1095,6 +1095,7 @@ def test_a_swing_past_its_usual_time_is_landed_before_the_capture_point_runs_out
         control = ControlConfig(whole_body=WholeBodyConfig(joint_speed_limit_rad_s=None,
                                                            recovery_foot_target_rate="differenced"))
         motion = MotionConfig(recovery_overdue_swing_horizon=flag, fraction_needs_feet_in_his_order=False,
+                              swing_landing_within_reach=False,
                               recovery_swing_min_s=None)
         return taken, suite_run(spec, 7, motion, control, watch=watch)
 
@@ -1141,8 +1142,9 @@ def test_a_recovery_step_just_short_of_its_crossover_clearance_lands_on_the_capt
 
     # Traced before a foot in the air nearer the capture point was left to land (recovery_landing_foot_waits): the
     # left foot, over the right sole and a centimetre nearer the capture point, now lands first and the right steps.
-    new = run(MotionConfig(recovery_landing_foot_waits=False))
-    old = run(MotionConfig(recovery_landing_foot_waits=False, recovery_cross_nearest=False,
+    new = run(MotionConfig(recovery_landing_foot_waits=False, swing_landing_within_reach=False))
+    old = run(MotionConfig(recovery_landing_foot_waits=False, swing_landing_within_reach=False,
+                           recovery_cross_nearest=False,
                            recovery_cross_stance_frame=False))
     assert new["side"] == old["side"] == "left"
     assert new["foot_xy"][0] > 0.3 and old["foot_xy"][0] < 0.0  # measured: 0.42 m ahead; 0.12 m behind
@@ -1232,7 +1234,7 @@ def test_a_recovery_foot_follows_its_swing_profiles_velocity_not_the_landings_re
             return tick
 
         control = ControlConfig(whole_body=WholeBodyConfig(recovery_foot_target_rate=rate, pelvis_rate_share=0.0))
-        result = suite_run("builtin:run", 14, MotionConfig(), control, watch=watch)
+        result = suite_run("builtin:run", 14, MotionConfig(swing_landing_within_reach=False), control, watch=watch)
         return reversals[0], result
 
     (differenced, fell), (profile, completed) = run("differenced"), run("profile")
@@ -1371,6 +1373,7 @@ def test_a_recovery_step_whose_landing_is_due_is_pressed_onto_the_ground():
             last_tick_s[0] = state.time_s
 
         result = suite_run(spec, 1, MotionConfig(recovery_cross_nearest=False, recovery_cross_stance_frame=False,
+                                                 swing_landing_within_reach=False,
                                                  fraction_needs_feet_in_his_order=False, recovery_swing_min_s=None,
                                                  liftoff_needs_other_foot_down=False, liftoff_behind_waits=False),
                            ControlConfig(whole_body=WholeBodyConfig(recovery_foot_landing_weight=landing_weight,

@@ -29,9 +29,10 @@ def _run(lead_max_m: float | None) -> tuple[float, bool, float | None]:
         if state.time_s >= CLIP_END_S:
             ahead[0] = max(ahead[0], float(np.linalg.norm(ref.pelvis_world[:2] - state.root_pos_world[:2])))
 
-    def configure(cfg):
+    def configure(cfg):  # traced before the pelvis target came down as his swing went (swing_landing_within_reach)
         cfg = follow_path(cfg)
-        return dataclasses.replace(cfg, motion=dataclasses.replace(cfg.motion, reference_lead_max_m=lead_max_m))
+        return dataclasses.replace(cfg, motion=dataclasses.replace(cfg.motion, reference_lead_max_m=lead_max_m,
+                                                                   swing_landing_within_reach=False))
 
     result = suite_run(f"bvh:{CLIP}", 10, MotionConfig(), ControlConfig(), on_tick=on_tick, configure=configure)
     return ahead[0], result.fell, result.fall_time_s

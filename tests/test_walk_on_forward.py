@@ -28,9 +28,9 @@ def _dance(forward: bool) -> tuple[bool, float | None, int]:
                 backwards[0] += 1
         return on_tick
 
-    def configure(cfg):
+    def configure(cfg):  # traced before the pelvis target came down as his swing went (swing_landing_within_reach)
         cfg = follow_path(cfg)
-        motion = dataclasses.replace(cfg.motion, recovery_walk_on_forward=forward)
+        motion = dataclasses.replace(cfg.motion, recovery_walk_on_forward=forward, swing_landing_within_reach=False)
         return dataclasses.replace(cfg, duration_s=6.5, motion=motion)
 
     result = suite_run("builtin:dance_a", 2, MotionConfig(), ControlConfig(), watch=watch, configure=configure)

@@ -164,9 +164,9 @@ def test_a_qp_with_no_feasible_point_does_not_throw_the_limbs():
                                                            joint_speed_limit_rad_s=None,
                                                            recovery_foot_target_rate="differenced"))
         # traced before the joints' no-load speed, the crossover steps, the earlier touchdown of a recovery step's
-        # foot and the swing aimed at the operator's last landing
+        # foot, the swing aimed at the operator's last landing and the pelvis target that comes down as his swing goes
         motion = MotionConfig(recovery_cross_clear_m=None, recovery_touchdown_share=1.0, recovery_landing_gap_m=None,
-                              swing_landing="his_foot_now")
+                              swing_landing="his_foot_now", swing_landing_within_reach=False)
         result = suite_run(spec, 2, motion, control, watch=watch)
         return result, sessions[0].controller.relaxed_solves
 
@@ -290,7 +290,8 @@ def test_a_light_link_does_not_spin_up_within_a_control_tick():
         control = ControlConfig(whole_body=WholeBodyConfig(joint_speed_limit_rad_s=limit, own_step_push_bound="off",
                                                             recovery_foot_target_rate="differenced",
                                                             pelvis_rate_share=0.0))
-        motion = MotionConfig(fraction_needs_feet_in_his_order=False, recovery_swing_min_s=None)
+        motion = MotionConfig(fraction_needs_feet_in_his_order=False, recovery_swing_min_s=None,
+                              swing_landing_within_reach=False)  # and before the pelvis came down as his swing went
         return suite_run("builtin:dance_a", 2, motion, control)
 
     unlimited, limited = run(None), run(30.0)

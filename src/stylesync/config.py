@@ -328,6 +328,13 @@ class MotionConfig:
     # humanoid3d spinning kick (docs/decisions.md, "The pelvis target's steps within a control tick"; None: at
     # once) [m/s]
     landing_pelvis_descent_mps: float | None = None
+    # As his swing goes, the pelvis target comes down towards the height from which the swing foot reaches its
+    # landing on the ground (the landing reach, from the target's hip), by the swing's progress (a smooth step over
+    # his usual swing time), instead of all at once when a late contact holds the reference: there it dropped by up
+    # to 0.11 m within one control tick, the stance leg's joint targets jumped with it, and the whole-body QP planned
+    # a brake of 90-140 N that no task asked for (docs/decisions.md, "A late contact's brake, attributed"). False:
+    # lowered only for a foot that must land now (the scenario tests traced before it pin it off).
+    swing_landing_within_reach: bool = True
     # The pelvis target (Eq. 9) no higher than this share of the leg's length reaches above each planted stance foot
     # (hip to ankle, from the target's hip). His pelvis, scaled, can sit above what the character's straight legs
     # reach (CMU 02_01: 0.94 m against 0.88 m): the stance leg is then held straight, and the lowering above for a

@@ -675,6 +675,17 @@ class MotionOptimizer:
                 if lowered < tick.pelvis_d[2]:
                     tick.pelvis_d[2] = lowered
                     tick.pelvis_vel_z = 0.0
+        if (self.cfg.swing_landing_within_reach and sw is not None
+                and not self.char_fsm.recovery_step and not self.char_fsm.hold_reference
+                and tick.swing_landing_xy is not None):
+            # His swing: the target comes down by the swing's progress towards where its landing is within reach
+            # (MotionConfig.swing_landing_within_reach), so that a late contact does not lower it within a tick.
+            landing = np.array([*tick.swing_landing_xy, ANKLE_HEIGHT_M - LATE_CONTACT_PRESS_M])
+            reach_z = self._pelvis_within_m(tick, sw, 1.0 if sw == "left" else -1.0, _LANDING_REACH_M,
+                                            ankle_target=landing)
+            progress = smooth_step((state.time_s - self._swing_t0_s) / self._op_swing_s)
+            tick.pelvis_d[2] = min(float(tick.pelvis_d[2]),
+                                   unlowered_z - progress * max(unlowered_z - reach_z, 0.0))
         rate = self.cfg.landing_pelvis_descent_mps
         if rate is not None:  # the lowering no faster than rate from the last tick's target
             if self._last_pelvis_z is not None and tick.pelvis_d[2] < unlowered_z:
@@ -683,15 +694,16 @@ class MotionOptimizer:
             self._last_pelvis_z = float(tick.pelvis_d[2])
 
     def _pelvis_within_m(self, tick: _Tick, side: str, sign: float, reach_m: float,
-                         hip_xy: np.ndarray | None = None) -> float:
+                         hip_xy: np.ndarray | None = None, ankle_target: np.ndarray | None = None) -> float:
         """The highest pelvis target [m] from which the leg on ``side`` (``sign`` +1 left, -1 right) reaches its
-        ankle target at ``reach_m`` hip to ankle, from ``hip_xy`` (default: the pelvis target's hip), no lower than
-        landing_pelvis_floor_share of the landing reach above the target."""
+        ankle target (``ankle_target``, default this tick's) at ``reach_m`` hip to ankle, from ``hip_xy`` (default:
+        the pelvis target's hip), no lower than landing_pelvis_floor_share of the landing reach above the target."""
         if hip_xy is None:
             hip_xy = (tick.pelvis_d + tick.R_root_d @ np.array([0.0, sign * HIP_HALF_WIDTH_M, 0.0]))[:2]
-        d2 = float(np.sum((tick.targets[side][:2] - hip_xy) ** 2))
+        target = tick.targets[side] if ankle_target is None else ankle_target
+        d2 = float(np.sum((target[:2] - hip_xy) ** 2))
         above_foot = max(float(np.sqrt(max(reach_m * reach_m - d2, 0.0))), self._landing_pelvis_floor_m)
-        return float(tick.targets[side][2]) + above_foot
+        return float(target[2]) + above_foot
 
     def _his_gait(self, tick: _Tick, his_ankles_world: dict[str, np.ndarray]) -> bool:
         """Whether the operator's double stance on ``his_ankles_world`` is a gait's: his COM moves from one foot
