@@ -232,6 +232,12 @@ class MotionConfig:
     # ran on beyond the landing planned for the swing's end (docs/decisions.md, "Recovery steps that touch down on
     # time") [-]
     recovery_touchdown_share: float = 0.9
+    # A swing taken over in the air (RecoveryStepper.take_over) keeps its foot at least recovery_step_height_m up
+    # until the foot itself has come this share of the way from where it was taken over to its landing, and comes
+    # down over the rest: lowered with the target's travel, the foot, trailing its target, came down beside the
+    # stance foot, short of the landing, and a step of the other foot followed (docs/decisions.md, "A taken-over
+    # swing that comes down short"). None: lowered along the target's travel [-]
+    recovery_takeover_clearance_share: float | None = None
     # ... and it has landed once its horizontal travel is over and the lowest corner of its sole is within this of
     # the ground, not only once it presses with CONTACT_FORCE_N: a foot that came down on a corner, tilted, rested
     # there with less than that while the stance leg, straight, held the pelvis above its target, and the body ran
@@ -490,6 +496,10 @@ class MotionConfig:
             raise ConfigError(f"MotionConfig.recovery_touchdown_share must be within (0, 1], "
                               f"got {self.recovery_touchdown_share}")
         _non_negative("MotionConfig.recovery_step_height_m", self.recovery_step_height_m)
+        clearance = self.recovery_takeover_clearance_share
+        if clearance is not None and not 0.0 <= clearance < 1.0:
+            raise ConfigError(f"MotionConfig.recovery_takeover_clearance_share must be within [0, 1), "
+                              f"got {self.recovery_takeover_clearance_share}")
         if self.pelvis_stance_reach_share is not None and not 0.0 < self.pelvis_stance_reach_share <= 1.0:
             raise ConfigError(f"MotionConfig.pelvis_stance_reach_share must be within (0, 1] or None, got "
                               f"{self.pelvis_stance_reach_share}")

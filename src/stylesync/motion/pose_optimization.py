@@ -625,7 +625,8 @@ class MotionOptimizer:
                            if self.cfg.recovery_landing_without_swing else tick.com_vel_c)
                 tick.targets[side] = self.recovery.swing_target(
                     state.time_s, tick.com_c, com_vel, tick.a_c[other],
-                    state.link_quat_wxyz[_LINK[f"{other}_ankle"]], tick.R_root_d, self._walk_on(tick))
+                    state.link_quat_wxyz[_LINK[f"{other}_ankle"]], tick.R_root_d, self._walk_on(tick),
+                    state.link_origin_world[_LINK[f"{side}_ankle"]])
                 tick.foot_yaw[side] = (float(np.arctan2(tick.R_root_d[1, 0], tick.R_root_d[0, 0]))
                                        if self.cfg.foot_yaw_control  # along the heading, as its landing is planned
                                        else rot.twist_angle(state.link_quat_wxyz[_LINK[f"{side}_ankle"]], _UP))
