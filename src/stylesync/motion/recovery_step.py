@@ -473,27 +473,23 @@ class RecoveryStepper:
         moved_rate = 6.0 * along * (1.0 - along) / (HORIZONTAL_SHARE * step.duration_s) if along < 1.0 else 0.0
         target = step.lift_off_world + moved * (landing - step.lift_off_world)
         vel = moved_rate * (landing - step.lift_off_world)
-        if phase < 1.0 and step.taken_over and cfg.recovery_takeover_clearance_share is not None \
-                and swing_ankle_world is not None:
-            # Already in the air: lowered from where it is to the ground by the time it is over the landing, but
-            # no lower than a step's height until the foot itself has come the clearance share of its way to the
-            # landing, and from there down to the ground by a smooth step over the rest of its way.
+        if phase < 1.0 and step.taken_over:
+            # Already in the air: lowered from where it is to the ground by the time it is over the landing ...
             target[2] = step.lift_off_world[2] + moved * (ANKLE_HEIGHT_M - step.lift_off_world[2])
             vel[2] = moved_rate * (ANKLE_HEIGHT_M - step.lift_off_world[2])
             share = cfg.recovery_takeover_clearance_share
-            way = (landing - step.lift_off_world)[:2]
-            way_sq = float(way @ way)
-            gone = (float((np.asarray(swing_ankle_world)[:2] - step.lift_off_world[:2]) @ way) / way_sq
-                    if way_sq > 1e-8 else 1.0)
-            down = min(max((gone - share) / (1.0 - share), 0.0), 1.0)
-            floor = ANKLE_HEIGHT_M + (1.0 - smooth_step(down)) * cfg.recovery_step_height_m
-            if floor > target[2]:
-                target[2] = floor
-                vel[2] = -6.0 * down * (1.0 - down) / (1.0 - share) * moved_rate * cfg.recovery_step_height_m
-        elif phase < 1.0 and step.taken_over:
-            # Already in the air: lowered from where it is to the ground by the time it is over the landing.
-            target[2] = step.lift_off_world[2] + moved * (ANKLE_HEIGHT_M - step.lift_off_world[2])
-            vel[2] = moved_rate * (ANKLE_HEIGHT_M - step.lift_off_world[2])
+            if share is not None and swing_ankle_world is not None:
+                # ... but no lower than a step's height until the foot itself has come the clearance share of its
+                # way to the landing, and from there down to the ground by a smooth step over the rest of its way.
+                way = (landing - step.lift_off_world)[:2]
+                way_sq = float(way @ way)
+                gone = (float((np.asarray(swing_ankle_world)[:2] - step.lift_off_world[:2]) @ way) / way_sq
+                        if way_sq > 1e-8 else 1.0)
+                down = min(max((gone - share) / (1.0 - share), 0.0), 1.0)
+                floor = ANKLE_HEIGHT_M + (1.0 - smooth_step(down)) * cfg.recovery_step_height_m
+                if floor > target[2]:
+                    target[2] = floor
+                    vel[2] = -6.0 * down * (1.0 - down) / (1.0 - share) * moved_rate * cfg.recovery_step_height_m
         elif phase < cfg.recovery_touchdown_share:
             # Up and down again by the touchdown share of the swing: the foot trails its target, and reaches the
             # ground near the swing's end, when the landing is planned for.
