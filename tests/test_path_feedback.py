@@ -224,5 +224,7 @@ def test_a_gait_double_stance_bounded_by_what_a_step_catches_keeps_fast_walks_up
                for bounded in (False, True)}
     finally:
         logging.disable(logging.NOTSET)
-    assert out[False].fell and out[False].fall_time_s == pytest.approx(fall_s, abs=0.01)
+    # The fall's time to within 0.2 s: the traces are chaotic, and another processor's floating point moved 12_01's
+    # from 4.30 to 4.39 s
+    assert out[False].fell and out[False].fall_time_s == pytest.approx(fall_s, abs=0.2)
     assert not out[True].fell
