@@ -612,6 +612,11 @@ class WholeBodyConfig:
     # runner's rear foot back too: 323 of 352 suite runs completed against 337 (runs 33 of 48 against 42), and 324
     # with --free-swing against 336 without it: off, and not part of --free-swing.
     press_holds_foot: bool = False
+    # In the character's double stance, a foot off the ground is pressed down whatever its stance weight: with the
+    # COM over the other foot its weight is zero, and, neither pressed nor bearing, it rose 0.19 m with the posture
+    # until the weight came back to it and neither sole bore any (docs/decisions.md, "A double stance's unweighted
+    # foot"). Off: with `--follow-path` the humanoid3d jump fell on 8 runs more
+    press_double_stance_feet: bool = False
     hand_task_kp: float = 100.0
     hand_task_kd: float = 20.0
     hand_task_weight: float = 100.0
