@@ -78,7 +78,7 @@ from stylesync.model.sole import (
     sole_within_m,
 )
 from stylesync.model.state import CharacterState
-from stylesync.processing.interpolation import smooth_step
+from stylesync.processing.interpolation import smooth_step, smooth_step_slope
 
 MIN_FOOT_SEPARATION_M = 1.2 * HIP_HALF_WIDTH_M  # the swing ankle lands at least this far outwards of the stance one
 LANDING_PRESS_M = 0.02  # after the nominal swing time the foot is aimed this far below the ground [m]
@@ -470,7 +470,7 @@ class RecoveryStepper:
         along = phase / HORIZONTAL_SHARE
         moved = smooth_step(min(along, 1.0))
         # d(moved)/dt of the smooth step 3x² - 2x³, x = t / (HORIZONTAL_SHARE T) [1/s]
-        moved_rate = 6.0 * along * (1.0 - along) / (HORIZONTAL_SHARE * step.duration_s) if along < 1.0 else 0.0
+        moved_rate = smooth_step_slope(along) / (HORIZONTAL_SHARE * step.duration_s)
         target = step.lift_off_world + moved * (landing - step.lift_off_world)
         vel = moved_rate * (landing - step.lift_off_world)
         if phase < 1.0 and step.taken_over:
@@ -489,7 +489,7 @@ class RecoveryStepper:
                 floor = ANKLE_HEIGHT_M + (1.0 - smooth_step(down)) * cfg.recovery_step_height_m
                 if floor > target[2]:
                     target[2] = floor
-                    vel[2] = -6.0 * down * (1.0 - down) / (1.0 - share) * moved_rate * cfg.recovery_step_height_m
+                    vel[2] = -smooth_step_slope(down) / (1.0 - share) * moved_rate * cfg.recovery_step_height_m
         elif phase < cfg.recovery_touchdown_share:
             # Up and down again by the touchdown share of the swing: the foot trails its target, and reaches the
             # ground near the swing's end, when the landing is planned for.

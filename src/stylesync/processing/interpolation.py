@@ -21,6 +21,11 @@ def smooth_step(x: float) -> float:
     return x * x * (3.0 - 2.0 * x)
 
 
+def smooth_step_slope(x: float) -> float:
+    """d smooth_step / dx: 6 x (1 - x) within [0, 1], 0 outside."""
+    return 6.0 * x * (1.0 - x) if 0.0 <= x <= 1.0 else 0.0
+
+
 class LinearRamp:
     """Eq. 7 for a vector of scalars (positions [m], angles [rad])."""
 
