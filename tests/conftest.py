@@ -12,15 +12,20 @@ from stylesync.model.character import JOINTS, STANDING_ROOT_HEIGHT_M, JointKind
 # recovery_foot_landing_weight) and before the joints' no-load speed (joint_speed_limit_rad_s): with them, the
 # contrast runs of some of them no longer fall; before the bound on the push of the character's own steps
 # (own_step_push_bound); before a recovery foot followed its swing profile's velocity (recovery_foot_target_rate); and
-# before the pelvis tracked a jump's push (pelvis_rate_share).
+# before the pelvis tracked a jump's push (pelvis_rate_share); and before a double stance's unweighted foot was
+# pressed down (press_double_stance_feet).
 TRACED_BEFORE_LANDING_WEIGHT = ControlConfig(whole_body=WholeBodyConfig(
     recovery_foot_landing_weight=WholeBodyConfig().recovery_foot_task_weight, joint_speed_limit_rad_s=None,
-    own_step_push_bound="off", recovery_foot_target_rate="differenced", pelvis_rate_share=0.0))
+    own_step_push_bound="off", recovery_foot_target_rate="differenced", pelvis_rate_share=0.0,
+    press_double_stance_feet=False))
 # Scenarios traced before a recovery foot followed its swing profile's velocity: its target's velocity was differenced
 # from tick to tick (WholeBodyConfig.recovery_foot_target_rate), and their runs' own steps land otherwise without it;
-# and before the pelvis tracked a jump's push (pelvis_rate_share 0: the regulator alone).
+# before the pelvis tracked a jump's push (pelvis_rate_share 0: the regulator alone); and before the press above.
 TRACED_DIFFERENCED = ControlConfig(whole_body=WholeBodyConfig(recovery_foot_target_rate="differenced",
-                                                              pelvis_rate_share=0.0))
+                                                              pelvis_rate_share=0.0, press_double_stance_feet=False))
+# Scenarios traced before a double stance's foot off the ground was pressed down whatever its stance weight
+# (WholeBodyConfig.press_double_stance_feet): their runs part from the traced ones where such a foot rose.
+TRACED_BEFORE_PRESS = ControlConfig(whole_body=WholeBodyConfig(press_double_stance_feet=False))
 
 
 def _standing(root_quat_wxyz: np.ndarray):

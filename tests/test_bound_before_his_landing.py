@@ -7,9 +7,9 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
-from conftest import suite_run
+from conftest import TRACED_BEFORE_PRESS, suite_run
 
-from stylesync.config import ControlConfig, MotionConfig, follow_path
+from stylesync.config import MotionConfig, follow_path
 from stylesync.metrics.summary import imitation_metrics
 from stylesync.motion.stance_fsm import Stance
 
@@ -36,7 +36,7 @@ def _followed_walk(bounded: bool) -> tuple[float, int, float, bool]:
                                      landing_reach_ground_gap_m=None, swing_landing_within_reach=False)
         return dataclasses.replace(cfg, motion=motion)
 
-    result = suite_run("builtin:walk", 0, MotionConfig(), ControlConfig(), watch=watch, configure=configure)
+    result = suite_run("builtin:walk", 0, MotionConfig(), TRACED_BEFORE_PRESS, watch=watch, configure=configure)
     progress = imitation_metrics(result)["path_progress"]
     return float(np.mean(speeds)), len(speeds), progress, result.fell
 

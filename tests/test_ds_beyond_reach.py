@@ -7,9 +7,9 @@ import dataclasses
 from pathlib import Path
 
 import pytest
-from conftest import suite_run
+from conftest import TRACED_BEFORE_PRESS, suite_run
 
-from stylesync.config import ControlConfig, MotionConfig, follow_path
+from stylesync.config import MotionConfig, follow_path
 from stylesync.model.character import LINK_NAMES
 from stylesync.motion.recovery_step import capture_point, soles_on_ground, support_outside_m
 from stylesync.motion.stance_fsm import Stance
@@ -49,7 +49,7 @@ def _followed_walk(beyond_reach: bool) -> tuple[float, bool, float | None]:
                                      landing_reach_ground_gap_m=None)
         return dataclasses.replace(cfg, motion=motion)
 
-    result = suite_run(f"bvh:{WALK}", 0, MotionConfig(), ControlConfig(), watch=watch, configure=configure)
+    result = suite_run(f"bvh:{WALK}", 0, MotionConfig(), TRACED_BEFORE_PRESS, watch=watch, configure=configure)
     return longest, result.fell, result.fall_time_s
 
 

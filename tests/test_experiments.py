@@ -146,7 +146,8 @@ def test_a_stance_foot_off_the_ground_is_held_where_it_came_off():
 
     out = {}
     for hold in (False, True):
-        control = ControlConfig(whole_body=WholeBodyConfig(press_holds_foot=hold))  # with --free-swing
+        # traced before a double stance's unweighted foot was pressed down (press_double_stance_feet)
+        control = ControlConfig(whole_body=WholeBodyConfig(press_holds_foot=hold, press_double_stance_feet=False))
         result, m, _ = kick.run_one("kick", 14, control=control)
         t = result.log.array("t")
         shift = (t > kick.KICK_START_S) & (t < kick.KICK_START_S + kick.SHIFT_S + 0.25)  # before any lift-off

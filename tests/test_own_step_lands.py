@@ -8,9 +8,9 @@ import dataclasses
 from pathlib import Path
 
 import pytest
-from conftest import suite_run
+from conftest import TRACED_BEFORE_PRESS, suite_run
 
-from stylesync.config import ControlConfig, MotionConfig, WholeBodyConfig, follow_path
+from stylesync.config import MotionConfig, WholeBodyConfig, follow_path
 from stylesync.control.whole_body import recovery_landing_due
 from stylesync.errors import ConfigError
 from stylesync.model.character import ANKLE_HEIGHT_M, LINK_NAMES
@@ -41,7 +41,7 @@ def _hover(gains: tuple[float, float] | None) -> tuple[int, int, bool]:
         return dataclasses.replace(cfg, duration_s=3.6, motion=motion,
                                    control=dataclasses.replace(cfg.control, whole_body=wb))
 
-    result = suite_run(f"bvh:{CLIP}", 5, MotionConfig(), ControlConfig(), on_tick=on_tick, configure=configure)
+    result = suite_run(f"bvh:{CLIP}", 5, MotionConfig(), TRACED_BEFORE_PRESS, on_tick=on_tick, configure=configure)
     return hover[0], due[0], result.fell
 
 

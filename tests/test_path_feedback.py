@@ -200,9 +200,9 @@ def test_a_gait_double_stance_bounded_by_what_a_step_catches_keeps_fast_walks_up
     well.)"""
     import logging
 
-    from conftest import suite_run
+    from conftest import TRACED_BEFORE_PRESS, suite_run
 
-    from stylesync.config import ControlConfig, follow_path
+    from stylesync.config import follow_path
 
     def configure(bounded):
         def with_bound(cfg):
@@ -219,7 +219,7 @@ def test_a_gait_double_stance_bounded_by_what_a_step_catches_keeps_fast_walks_up
 
     logging.disable(logging.WARNING)
     try:
-        out = {bounded: suite_run(f"bvh:{_CMU_DEV / clip}.bvh", seed, MotionConfig(), ControlConfig(),
+        out = {bounded: suite_run(f"bvh:{_CMU_DEV / clip}.bvh", seed, MotionConfig(), TRACED_BEFORE_PRESS,
                                   configure=configure(bounded))
                for bounded in (False, True)}
     finally:

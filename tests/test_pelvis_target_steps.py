@@ -8,9 +8,9 @@ from __future__ import annotations
 import dataclasses
 
 import pytest
-from conftest import suite_run
+from conftest import TRACED_BEFORE_PRESS, suite_run
 
-from stylesync.config import ControlConfig, MotionConfig
+from stylesync.config import MotionConfig
 from stylesync.errors import ConfigError
 
 DESCENT_MPS = 2.0
@@ -34,7 +34,7 @@ def _largest_drop_m(**motion) -> float:
                                                         "swing_landing_within_reach": False, **motion})
         return dataclasses.replace(cfg, motion=motion_cfg, duration_s=3.2)
 
-    suite_run("builtin:spinkick", 0, MotionConfig(), ControlConfig(), on_tick=on_tick, configure=configure)
+    suite_run("builtin:spinkick", 0, MotionConfig(), TRACED_BEFORE_PRESS, on_tick=on_tick, configure=configure)
     return drop[0]
 
 

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import TRACED_BEFORE_LANDING_WEIGHT, TRACED_DIFFERENCED, suite_run
+from conftest import TRACED_BEFORE_LANDING_WEIGHT, TRACED_BEFORE_PRESS, TRACED_DIFFERENCED, suite_run
 
 from stylesync import rotations as rot
 from stylesync.config import ControlConfig, MotionConfig, OperatorConfig, SessionConfig, WholeBodyConfig
@@ -285,9 +285,11 @@ def test_a_lift_off_waits_while_the_lifted_foot_is_the_only_one_down():
 # (before WholeBodyConfig.stance_leg_tracking_share and single_stance_pelvis_share). Each scenario is one clip and
 # seed on which a feature decides a fall; a change of the controller changes which runs fall, so the feature is
 # tested where its effect was traced, and the default controller where the test says "default". All of them were
-# traced before the pelvis tracked a jump's push (WholeBodyConfig.pelvis_rate_share 0: the regulator alone).
+# traced before the pelvis tracked a jump's push (WholeBodyConfig.pelvis_rate_share 0: the regulator alone) and before
+# a double stance's unweighted foot was pressed down (press_double_stance_feet).
 TRACED = ControlConfig(whole_body=WholeBodyConfig(stance_leg_tracking_share=1.0, single_stance_pelvis_share=1.0,
-                                                   recovery_foot_task_weight=0.0, pelvis_rate_share=0.0))
+                                                   recovery_foot_task_weight=0.0, pelvis_rate_share=0.0,
+                                                   press_double_stance_feet=False))
 # The default controller before WholeBodyConfig.single_stance_pelvis_share (and the recovery foot task), which
 # the scenarios of the stopping step and the overdue double stance were traced with.
 PELVIS_LEVEL = ControlConfig(whole_body=WholeBodyConfig(single_stance_pelvis_share=1.0, recovery_foot_task_weight=0.0,
@@ -302,8 +304,9 @@ TRACED_MOTION = {"recovery_step_reach_share": 0.6, "recovery_on_stopping_step": 
                  "swing_within_reach": False}
 # The scenarios traced before MotionConfig.foot_yaw_control run with the feet's twist left where it was (and the
 # weight shift from standing, the recovery steps' landing and the step timing as they were then; with the
-# controller, the recovery foot task off: NO_FOOT_TASK).
-NO_FOOT_TASK = ControlConfig(whole_body=WholeBodyConfig(recovery_foot_task_weight=0.0))
+# controller, the recovery foot task off, and a double stance's unweighted foot not pressed down: NO_FOOT_TASK).
+NO_FOOT_TASK = ControlConfig(whole_body=WholeBodyConfig(recovery_foot_task_weight=0.0,
+                                                        press_double_stance_feet=False))
 TWIST_FREE = {"foot_yaw_control": False, "liftoff_shift_tolerance_m": None, "recovery_landing_without_swing": False,
               "landing_pelvis_floor_share": 0.0, "recovery_on_reach_limit": False, "recovery_min_stance_s": 0.1,
               "recovery_ds_on_reach_limit": False, "recovery_cross_clear_m": None, "recovery_touchdown_share": 1.0,
@@ -954,7 +957,7 @@ def test_recovery_steps_that_land_where_the_body_will_be_keep_a_walk_on_rough_gr
     """CMU-dev 03_02 (walking over uneven ground, seed 1) fell 2.2 s in with the recovery step's foot driven by the
     joint posture alone and its landing planned on the capture point its own swing moved (measured)."""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '03_02.bvh'}"
-    assert not suite_run(spec, 1, traced_motion(**WAIT_TRACED), ControlConfig()).fell
+    assert not suite_run(spec, 1, traced_motion(**WAIT_TRACED), TRACED_BEFORE_PRESS).fell
     old = suite_run(spec, 1, traced_motion(recovery_landing_without_swing=False, **WAIT_TRACED), NO_FOOT_TASK)
     assert old.fell
 
@@ -1093,7 +1096,8 @@ def test_a_swing_past_its_usual_time_is_landed_before_the_capture_point_runs_out
         # 10's fraction from the rear foot to the front one after the character's own step (with it, too) and before
         # a recovery step's timing adapted to its reach (with it, too)
         control = ControlConfig(whole_body=WholeBodyConfig(joint_speed_limit_rad_s=None,
-                                                           recovery_foot_target_rate="differenced"))
+                                                           recovery_foot_target_rate="differenced",
+                                                           press_double_stance_feet=False))
         motion = MotionConfig(recovery_overdue_swing_horizon=flag, fraction_needs_feet_in_his_order=False,
                               swing_landing_within_reach=False,
                               recovery_swing_min_s=None)
@@ -1137,7 +1141,7 @@ def test_a_recovery_step_just_short_of_its_crossover_clearance_lands_on_the_capt
                     found["xi_out_m"] = support_outside_m(xi, ankles, quats, soles_on_ground(state) or ["left"])
             return on_tick
 
-        suite_run("builtin:spin", 0, motion, ControlConfig(), watch=watch)
+        suite_run("builtin:spin", 0, motion, TRACED_BEFORE_PRESS, watch=watch)
         return found
 
     # Traced before a foot in the air nearer the capture point was left to land (recovery_landing_foot_waits): the
@@ -1172,7 +1176,7 @@ def test_the_next_recovery_step_begins_while_both_soles_are_down():
                     steps.append((step.start_s, step.side, len(soles_on_ground(state))))
             return on_tick
 
-        result = suite_run(spec, 2, traced_motion(recovery_min_stance_s=wait_s), ControlConfig(), watch=watch)
+        result = suite_run(spec, 2, traced_motion(recovery_min_stance_s=wait_s), TRACED_BEFORE_PRESS, watch=watch)
         return [x for x in steps if 3.49 < x[0] < 3.7], result
 
     after, result = run(traced_motion().recovery_min_stance_s)

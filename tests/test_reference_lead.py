@@ -9,9 +9,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import suite_run
+from conftest import TRACED_BEFORE_PRESS, suite_run
 
-from stylesync.config import ControlConfig, MotionConfig, follow_path
+from stylesync.config import MotionConfig, follow_path
 from stylesync.errors import ConfigError
 
 MOCAP = Path(__file__).resolve().parents[2] / "shared" / "mocap"
@@ -34,7 +34,7 @@ def _run(lead_max_m: float | None) -> tuple[float, bool, float | None]:
         return dataclasses.replace(cfg, motion=dataclasses.replace(cfg.motion, reference_lead_max_m=lead_max_m,
                                                                    swing_landing_within_reach=False))
 
-    result = suite_run(f"bvh:{CLIP}", 10, MotionConfig(), ControlConfig(), on_tick=on_tick, configure=configure)
+    result = suite_run(f"bvh:{CLIP}", 10, MotionConfig(), TRACED_BEFORE_PRESS, on_tick=on_tick, configure=configure)
     return ahead[0], result.fell, result.fall_time_s
 
 

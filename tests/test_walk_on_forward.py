@@ -6,10 +6,10 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
-from conftest import suite_run
+from conftest import TRACED_BEFORE_PRESS, suite_run
 
 from stylesync import rotations as rot
-from stylesync.config import ControlConfig, MotionConfig, follow_path
+from stylesync.config import MotionConfig, follow_path
 
 
 def _dance(forward: bool) -> tuple[bool, float | None, int, float]:
@@ -35,7 +35,7 @@ def _dance(forward: bool) -> tuple[bool, float | None, int, float]:
         motion = dataclasses.replace(cfg.motion, recovery_walk_on_forward=forward, swing_landing_within_reach=False)
         return dataclasses.replace(cfg, duration_s=6.5, motion=motion)
 
-    result = suite_run("builtin:dance_a", 2, MotionConfig(), ControlConfig(), watch=watch, configure=configure)
+    result = suite_run("builtin:dance_a", 2, MotionConfig(), TRACED_BEFORE_PRESS, watch=watch, configure=configure)
     return result.fell, result.fall_time_s, backwards[0], speed[0]
 
 

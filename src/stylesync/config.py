@@ -615,8 +615,8 @@ class WholeBodyConfig:
     # In the character's double stance, a foot off the ground is pressed down whatever its stance weight: with the
     # COM over the other foot its weight is zero, and, neither pressed nor bearing, it rose 0.19 m with the posture
     # until the weight came back to it and neither sole bore any (docs/decisions.md, "A double stance's unweighted
-    # foot"). Off: with `--follow-path` the humanoid3d jump fell on 8 runs more
-    press_double_stance_feet: bool = False
+    # foot"). False: only a foot with a stance weight is pressed down.
+    press_double_stance_feet: bool = True
     hand_task_kp: float = 100.0
     hand_task_kd: float = 20.0
     hand_task_weight: float = 100.0
