@@ -11,7 +11,7 @@ from stylesync.model.character import JOINTS, STANDING_ROOT_HEIGHT_M, JointKind
 # Scenarios traced before a recovery step's due landing weighed more than its swing (WholeBodyConfig.
 # recovery_foot_landing_weight) and before the joints' no-load speed (joint_speed_limit_rad_s): with them, the
 # contrast runs of some of them no longer fall; before the bound on the push of the character's own steps
-# (own_step_push_bound); before a recovery foot followed its swing profile's velocity (recovery_foot_target_rate); and
+# (own_step_push_bound); before a recovery foot followed its swing profile's velocity (recovery_foot_target_rate);
 # before the pelvis tracked a jump's push (pelvis_rate_share); and before a double stance's unweighted foot was
 # pressed down (press_double_stance_feet).
 TRACED_BEFORE_LANDING_WEIGHT = ControlConfig(whole_body=WholeBodyConfig(
@@ -20,7 +20,8 @@ TRACED_BEFORE_LANDING_WEIGHT = ControlConfig(whole_body=WholeBodyConfig(
     press_double_stance_feet=False))
 # Scenarios traced before a recovery foot followed its swing profile's velocity: its target's velocity was differenced
 # from tick to tick (WholeBodyConfig.recovery_foot_target_rate), and their runs' own steps land otherwise without it;
-# before the pelvis tracked a jump's push (pelvis_rate_share 0: the regulator alone); and before the press above.
+# before the pelvis tracked a jump's push (pelvis_rate_share 0: the regulator alone); and before a double stance's
+# unweighted foot was pressed down (press_double_stance_feet).
 TRACED_DIFFERENCED = ControlConfig(whole_body=WholeBodyConfig(recovery_foot_target_rate="differenced",
                                                               pelvis_rate_share=0.0, press_double_stance_feet=False))
 # Scenarios traced before a double stance's foot off the ground was pressed down whatever its stance weight

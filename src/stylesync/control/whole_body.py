@@ -243,7 +243,8 @@ class WholeBodyController(ControllerBase):
         # otherwise be lifted by the other's reaction), and so is a swing foot the reference is held for.
         swing = swing_side(ref.character_stance)
         for s, task in self.foot_press.items():
-            # A stance foot off the ground; in the character's double stance (press_double_stance_feet) any foot
+            # A stance foot off the ground; in the character's double stance (press_double_stance_feet) either foot
+            # off it, whatever its stance weight
             lifted = w[s] <= 0 and (ref.stance_weight[s] > 0 or (wb.press_double_stance_feet and swing is None))
             task.active = lifted or (ref.press_swing_foot and s == swing)
             hold = self.foot_hold.get(s)
