@@ -168,6 +168,10 @@ class MotionConfig:
     # in the heading frame) and his raised foot is behind it, his single stance is read as a double stance.
     # None: off.
     rear_foot_support_margin_m: float | None = 0.02
+    # ... but not while his way over the ground (operator_way.py, the last second's) goes towards the raised foot at
+    # least this fast: that foot steps, as in a backward walk, where his capture point lies behind the stance heel
+    # at every step (docs/decisions.md, "A backward walk"). None: whatever his way [m/s].
+    rear_foot_stepping_way_mps: float | None = 0.3
     # Early contact (Sec. 5.1) only counts once the swing has lasted this long (a lifting foot still touches).
     min_swing_s: float = 0.12
     stance_hip_weight_w0: float = 0.5  # Eq. 11 weight w0 (not given in the paper)
@@ -470,6 +474,8 @@ class MotionConfig:
             raise ConfigError(f"MotionConfig.swing_placement must be one of {', '.join(SWING_PLACEMENTS)}, "
                               f"got '{self.swing_placement}'")
         _positive("MotionConfig.stance_height_threshold_m", self.stance_height_threshold_m)
+        if self.rear_foot_stepping_way_mps is not None:
+            _non_negative("MotionConfig.rear_foot_stepping_way_mps", self.rear_foot_stepping_way_mps)
         if self.airborne_ankle_height_leg is not None:
             _positive("MotionConfig.airborne_ankle_height_leg", self.airborne_ankle_height_leg)
         if self.pelvis_min_height_m is not None:
