@@ -1,5 +1,5 @@
 """A backward walk's steps: his raised rear foot is not read as bearing weight while his way over the ground goes
-towards it (MotionConfig.rear_foot_stepping_way_mps; docs/decisions.md, "A backward walk")."""
+backwards in his own frame (MotionConfig.rear_foot_stepping_way_mps; docs/decisions.md, "A backward walk")."""
 
 from __future__ import annotations
 
@@ -37,7 +37,7 @@ def _steps(path: Path, stepping_way_mps: float | None) -> tuple[int, int, bool]:
 def test_a_backward_walk_is_read_as_steps(tmp_path):
     """Walking backwards, his raised foot is behind his stance foot and his capture point behind its heel at every
     step, which read him as standing on both feet (a stealthy stride's rear foot on its toes): one step in 5 s, the
-    character standing. His way goes towards that foot: it steps. Measured: 8 steps of his and 8 of the
+    character standing. His way goes backwards in his own frame: that foot steps. Measured: 8 steps of his and 8 of the
     character's, no fall; the forward clip gives him 9."""
     his, _, _ = _steps(_backward(tmp_path), None)
     assert his <= 2

@@ -168,9 +168,9 @@ class MotionConfig:
     # in the heading frame) and his raised foot is behind it, his single stance is read as a double stance.
     # None: off.
     rear_foot_support_margin_m: float | None = 0.02
-    # ... but not while his way over the ground (operator_way.py, the last second's) goes towards the raised foot at
-    # least this fast: that foot steps, as in a backward walk, where his capture point lies behind the stance heel
-    # at every step (docs/decisions.md, "A backward walk"). None: whatever his way [m/s].
+    # ... but not while his way over the ground (operator_way.py, the last second's, in his own heading frame) goes
+    # backwards at least this fast: the raised rear foot steps, as in a backward walk, where his capture point lies
+    # behind the stance heel at every step (docs/decisions.md, "A backward walk"). None: whatever his way [m/s].
     rear_foot_stepping_way_mps: float | None = 0.3
     # Early contact (Sec. 5.1) only counts once the swing has lasted this long (a lifting foot still touches).
     min_swing_s: float = 0.12

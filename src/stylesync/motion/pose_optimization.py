@@ -406,11 +406,10 @@ class MotionOptimizer:
         point is more than ``rear_foot_support_margin_m`` behind his stance sole's heel (the character's sole scaled
         to him), in the heading frame. Nobody stands on one foot with his capture point behind its heel: his rear
         foot, its heel raised above the stance threshold, still stands on its toes (a long, low stealthy stride).
-        In a walk the rear foot lifts with the capture point ahead of the front ankle; walking backwards, he lifts it
-        with his capture point behind the heel, his way over the ground going towards it (``rear_foot_stepping_way_mps``:
-        it steps). Not before the operator's
-        COM velocity has settled (OPERATOR_VELOCITY_SETTLE_S): a recording that starts mid-stride starts with his
-        filtered velocity at rest, his capture point on his COM, between his feet."""
+        In a walk the rear foot lifts with the capture point ahead of the front ankle; walking backwards, with it
+        behind the heel, his way going backwards in his own frame (``rear_foot_stepping_way_mps``): that foot steps.
+        Not before the operator's COM velocity has settled (OPERATOR_VELOCITY_SETTLE_S): a recording that starts
+        mid-stride starts with his filtered velocity at rest, his capture point on his COM, between his feet."""
         margin = self.cfg.rear_foot_support_margin_m
         if margin is None or self._op_leg_m is None or sample.time_s < OPERATOR_VELOCITY_SETTLE_S:
             return False
