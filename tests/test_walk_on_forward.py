@@ -31,8 +31,9 @@ def _dance(forward: bool) -> tuple[bool, float | None, int, float]:
         return on_tick
 
     def configure(cfg):  # traced before the pelvis target came down as his swing went (swing_landing_within_reach)
-        cfg = follow_path(cfg)
-        motion = dataclasses.replace(cfg.motion, recovery_walk_on_forward=forward, swing_landing_within_reach=False)
+        cfg = follow_path(cfg)  # ... and before a backward way made his raised rear foot a stepping one
+        motion = dataclasses.replace(cfg.motion, recovery_walk_on_forward=forward, swing_landing_within_reach=False,
+                                     rear_foot_stepping_way_mps=None)
         return dataclasses.replace(cfg, duration_s=6.5, motion=motion)
 
     result = suite_run("builtin:dance_a", 2, MotionConfig(), TRACED_BEFORE_PRESS, watch=watch, configure=configure)

@@ -290,8 +290,10 @@ def test_a_light_link_does_not_spin_up_within_a_control_tick():
         control = ControlConfig(whole_body=WholeBodyConfig(joint_speed_limit_rad_s=limit, own_step_push_bound="off",
                                                             recovery_foot_target_rate="differenced",
                                                             pelvis_rate_share=0.0))
+        # and before the pelvis came down as his swing went, and before a backward way made his raised rear foot a
+        # stepping one
         motion = MotionConfig(fraction_needs_feet_in_his_order=False, recovery_swing_min_s=None,
-                              swing_landing_within_reach=False)  # and before the pelvis came down as his swing went
+                              swing_landing_within_reach=False, rear_foot_stepping_way_mps=None)
         return suite_run("builtin:dance_a", 2, motion, control)
 
     unlimited, limited = run(None), run(30.0)
