@@ -47,7 +47,8 @@ def _run(job: tuple[str, int, float, str]) -> dict:
     return {"clip": Path(spec[4:]).stem, "seed": seed, "version": version, **run_clip(spec, seed, duration_s, version)}
 
 
-def _summary(rows: list[dict]) -> str:
+def summary(rows: list[dict]) -> str:
+    """One line of figures over ``rows`` (run_clip's results, with "clip" and "seed")."""
     ok = [r for r in rows if "error" not in r]
     complete = [r for r in ok if not r["fell"]]
     uhc = [r["uhc_fall_time_s"] for r in ok if r["uhc_fall_time_s"] is not None]
@@ -82,13 +83,18 @@ def main() -> None:
             jobs = [(f"bvh:{c}", seed, duration_s, version) for c in clips for seed in range(args.seeds)]
             with ProcessPoolExecutor(args.workers) as pool:
                 rows = list(pool.map(_run, jobs))
-            print(f"{version:>24}: {_summary(rows)}")
-            for r in rows:
-                if r.get("error"):
-                    print(f"{'':>26}{r['clip']} seed {r['seed']}: not opened: {r['error']}")
-                elif r["fell"]:
-                    print(f"{'':>26}{r['clip']} seed {r['seed']}: fell at {r['fall_time_s']:.2f} s "
-                          f"(its clip ends at {r['clip_end_s']:.2f} s; {r['fall_reason']})")
+            print(f"{version:>24}: {summary(rows)}")
+            print_falls(rows)
+
+
+def print_falls(rows: list[dict]) -> None:
+    """Each run of ``rows`` that was not opened or fell, one line each."""
+    for r in rows:
+        if r.get("error"):
+            print(f"{'':>26}{r['clip']} seed {r['seed']}: not opened: {r['error']}")
+        elif r["fell"]:
+            print(f"{'':>26}{r['clip']} seed {r['seed']}: fell at {r['fall_time_s']:.2f} s "
+                  f"(its clip ends at {r['clip_end_s']:.2f} s; {r['fall_reason']})")
 
 
 if __name__ == "__main__":
