@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import tempfile
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
@@ -51,10 +52,19 @@ def deepmimic_variant(source: Path, target: Path, reverse: bool, speed: float) -
     target.write_text(json.dumps({**clip, "Frames": frames}))
 
 
+def parse_variant(variant: str) -> tuple[bool, float]:
+    """(reversed, speed) of a variant's name, ``reversed`` or ``speedX`` with X > 0; ValueError otherwise."""
+    if variant == "reversed":
+        return True, 1.0
+    speed = float(variant.removeprefix("speed")) if variant.startswith("speed") else math.nan
+    if not speed > 0.0:
+        raise ValueError(f"unknown variant '{variant}': reversed or speedX with X > 0")
+    return False, speed
+
+
 def variant_specs(mocap: Path, categories: set[str], variant: str, folder: Path) -> list[tuple[str, str]]:
     """(spec, name) of each recorded clip of ``categories`` as ``variant``, written into ``folder``."""
-    reverse = variant == "reversed"
-    speed = 1.0 if reverse else float(variant.removeprefix("speed"))
+    reverse, speed = parse_variant(variant)
     out = []
     for spec, name, category in clip_specs(mocap):
         kind, _, path = spec.partition(":")
@@ -85,8 +95,10 @@ def main() -> None:
         raise SystemExit(f"no shared mocap folder at {args.mocap} (--mocap)")
     variants = [v.strip() for v in args.variants.split(",") if v.strip()]
     for v in variants:
-        if v != "reversed" and not (v.startswith("speed") and _positive_number(v.removeprefix("speed"))):
-            raise SystemExit(f"unknown variant '{v}': reversed or speedX with X > 0")
+        try:
+            parse_variant(v)
+        except ValueError as exc:
+            raise SystemExit(f"unknown variant '{v}': reversed or speedX with X > 0") from exc
     categories = {c.strip() for c in args.categories.split(",")}
     versions = ("stylesync", FOLLOW_PATH_VERSION) if args.follow_path else ("stylesync",)
     with tempfile.TemporaryDirectory() as tmp:
@@ -99,13 +111,6 @@ def main() -> None:
                     rows = list(pool.map(_run, jobs))
                 print(f"{version:>24}: {summary(rows)}")
                 print_falls(rows)
-
-
-def _positive_number(text: str) -> bool:
-    try:
-        return float(text) > 0.0
-    except ValueError:
-        return False
 
 
 if __name__ == "__main__":

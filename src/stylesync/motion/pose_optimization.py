@@ -267,8 +267,9 @@ class MotionOptimizer:
         self._pelvis_h_rate = _SmoothedRate(self.dt_s)  # operator pelvis velocity [m/s]
         self._his_rise = HisRise() if cfg.rise_begun_on_both_feet else None  # his_rise.py
         self.way = OperatorWay(cfg.operator_way_time_s, self.dt_s)  # his way over the ground (operator_way.py)
-        # His way in his own heading frame (x forwards), whatever the settings (_rear_foot_bears_weight)
-        self._travel = OperatorWay(cfg.operator_way_time_s, self.dt_s)
+        # His way in his own heading frame (x forwards; its velocity_world holds heading-frame axes), kept up when
+        # rear_foot_stepping_way_mps reads it (_rear_foot_bears_weight)
+        self._way_heading = OperatorWay(cfg.operator_way_time_s, self.dt_s)
         # only a gait's speed or a walk-on along his way reads it: otherwise it is not kept up each tick
         self._tracks_way = cfg.gait_min_way_speed_mps is not None or cfg.recovery_walk_on_his_way
         self.bounds = bounds if bounds is not None else BoundsMonitor()
@@ -420,7 +421,8 @@ class MotionOptimizer:
         if float((sample.pos[f"ANKLE_{raised}"] - a)[:2] @ forward[:2]) >= 0.0:
             return False
         stepping_mps = self.cfg.rear_foot_stepping_way_mps
-        if stepping_mps is not None and self._travel.goes(stepping_mps) and self._travel.velocity_world[0] < 0.0:
+        if (stepping_mps is not None and self._way_heading.goes(stepping_mps)
+                and self._way_heading.velocity_world[0] < 0.0):
             return False  # his way goes backwards in his own frame, towards the raised foot: it steps
         h_h = max(sample.com_world[2] - a[2], 0.1)
         xi_h = sample.com_world + self._com_h_rate.rate * np.sqrt(h_h / self.g)
@@ -578,9 +580,10 @@ class MotionOptimizer:
         tick.com_vel_h = self._com_h_rate(com_h)
         if self._tracks_way:
             self.way.update(scale * tick.com_vel_h)
-        # ... and in his heading frame: a walk backwards goes backwards in it for as long as it lasts, a spin's way
-        # turns round in it and averages out
-        self._travel.update(tick.R_root_d[:2, :2].T @ (scale * tick.com_vel_h[:2]))
+        if self.cfg.rear_foot_stepping_way_mps is not None:
+            # ... and in his heading frame: a walk backwards goes backwards in it for as long as it lasts, a spin's
+            # way turns round in it and averages out
+            self._way_heading.update(tick.R_root_d[:2, :2].T @ (scale * tick.com_vel_h[:2]))
         keep_m = self.cfg.double_stance_keeps_momentum_m
         if (keep_m is not None and anchor is Stance.DS and self._his_gait(tick, a_hs)
                 and self._capture_near_support(tick, state, keep_m)):
