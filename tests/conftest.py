@@ -1,11 +1,21 @@
 import dataclasses
+import inspect
 import time
 
 import numpy as np
 import pytest
 
 from stylesync import rotations as rot
-from stylesync.config import ControlConfig, MotionConfig, WholeBodyConfig, WorldConfig
+from stylesync.config import (
+    IN_PLACE_MOTION,
+    IN_PLACE_OPERATOR,
+    IN_PLACE_WHOLE_BODY,
+    ControlConfig,
+    MotionConfig,
+    OperatorConfig,
+    WholeBodyConfig,
+    WorldConfig,
+)
 from stylesync.model.character import JOINTS, STANDING_ROOT_HEIGHT_M, JointKind
 
 # Scenarios traced before a recovery step's due landing weighed more than its swing (WholeBodyConfig.
@@ -13,7 +23,8 @@ from stylesync.model.character import JOINTS, STANDING_ROOT_HEIGHT_M, JointKind
 # contrast runs of some of them no longer fall; before the bound on the push of the character's own steps
 # (own_step_push_bound); before a recovery foot followed its swing profile's velocity (recovery_foot_target_rate);
 # before the pelvis tracked a jump's push (pelvis_rate_share); and before a double stance's unweighted foot was
-# pressed down (press_double_stance_feet).
+# pressed down (press_double_stance_feet). All of them were traced in place (config.in_place; the tests that run them
+# carry the in_place marker): the push of the character's own steps bounded only while he stands.
 TRACED_BEFORE_LANDING_WEIGHT = ControlConfig(whole_body=WholeBodyConfig(
     recovery_foot_landing_weight=WholeBodyConfig().recovery_foot_task_weight, joint_speed_limit_rad_s=None,
     own_step_push_bound="off", recovery_foot_target_rate="differenced", pelvis_rate_share=0.0,
@@ -23,10 +34,34 @@ TRACED_BEFORE_LANDING_WEIGHT = ControlConfig(whole_body=WholeBodyConfig(
 # before the pelvis tracked a jump's push (pelvis_rate_share 0: the regulator alone); and before a double stance's
 # unweighted foot was pressed down (press_double_stance_feet).
 TRACED_DIFFERENCED = ControlConfig(whole_body=WholeBodyConfig(recovery_foot_target_rate="differenced",
-                                                              pelvis_rate_share=0.0, press_double_stance_feet=False))
+                                                              pelvis_rate_share=0.0, press_double_stance_feet=False,
+                                                              own_step_push_bound="he_stands"))
 # Scenarios traced before a double stance's foot off the ground was pressed down whatever its stance weight
 # (WholeBodyConfig.press_double_stance_feet): their runs part from the traced ones where such a foot rose.
-TRACED_BEFORE_PRESS = ControlConfig(whole_body=WholeBodyConfig(press_double_stance_feet=False))
+TRACED_BEFORE_PRESS = ControlConfig(whole_body=WholeBodyConfig(press_double_stance_feet=False,
+                                                               own_step_push_bound="he_stands"))
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "in_place: a scenario traced with the settings before the character followed "
+                                       "its operator's path by default (config.in_place): every MotionConfig, "
+                                       "WholeBodyConfig and OperatorConfig made during the test defaults to them")
+
+
+@pytest.fixture(autouse=True)
+def _in_place_defaults(request, monkeypatch):
+    """Under the ``in_place`` marker, the defaults of MotionConfig, WholeBodyConfig and OperatorConfig are those of
+    config.in_place for the test's duration (what a test sets explicitly stays as it sets it)."""
+    if request.node.get_closest_marker("in_place") is None:
+        return
+    for cls, values in ((MotionConfig, IN_PLACE_MOTION), (WholeBodyConfig, IN_PLACE_WHOLE_BODY),
+                        (OperatorConfig, IN_PLACE_OPERATOR)):
+        init = cls.__init__
+        names = [n for n, p in inspect.signature(init).parameters.items()
+                 if n != "self" and p.default is not inspect.Parameter.empty]
+        assert len(names) == len(init.__defaults__) and set(values) <= set(names)
+        monkeypatch.setattr(init, "__defaults__",
+                            tuple(values.get(n, d) for n, d in zip(names, init.__defaults__, strict=True)))
 
 
 def _standing(root_quat_wxyz: np.ndarray):

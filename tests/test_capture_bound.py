@@ -142,6 +142,7 @@ def test_the_share_is_checked():
         MotionConfig(capture_bound_sole_share=1.2)
 
 
+@pytest.mark.in_place
 def test_a_lunge_the_character_cannot_stop_from_is_not_asked_for():
     """The built-in punch (seed 1): the operator lunges and punches. Without the bound the character's COM target
     leans past its feet in double stance, it runs forward into the operator's step and falls (measured: 3.3 s); with
@@ -217,6 +218,7 @@ ZOMBIE = Path(__file__).resolve().parents[2] / "shared" / "mocap" / "deepmimic" 
 
 
 @pytest.mark.skipif(not ZOMBIE.exists(), reason="../shared/mocap/deepmimic/humanoid3d_zombie_walk.txt is not available")
+@pytest.mark.in_place
 def test_a_long_single_stance_keeps_the_capture_point_where_the_landing_catches_it_when_opted_in():
     """The zombie walk (seed 0): its operator holds each single stance about 0.8 s with his COM 0.13-0.20 m (scaled)
     inwards of his stance ankle. The character's COM target follows it there, its COM falls inwards over the stance

@@ -1,5 +1,6 @@
 """Bad command lines end with exit 2 and one line naming the option, before anything runs."""
 
+import json
 from pathlib import Path
 
 import pytest
@@ -124,19 +125,34 @@ def test_a_report_on_a_damaged_folder_is_written_and_says_so(tmp_path, capsys, m
     assert metrics == "{}" or "not readable as JSON" in text or "not a JSON object" in text
 
 
-def test_follow_path_is_taken_and_recorded(tmp_path, capsys):
-    from stylesync.config import FOLLOW_PATH_MOTION, FOLLOW_PATH_WHOLE_BODY
+def test_follow_path_and_in_place_are_taken_and_recorded(tmp_path, capsys):
+    """``--follow-path`` adds the targets' pull onto his path to the defaults (which follow it by the landings),
+    ``--in-place`` sets the settings before that; each run's session file records them, and the two together are
+    refused with one line."""
+    from stylesync.config import FOLLOW_PATH_MOTION, IN_PLACE_MOTION, IN_PLACE_OPERATOR, IN_PLACE_WHOLE_BODY
     from stylesync.export.session_file import read_session
 
-    assert cli_main(["demo", "--follow-path", "--duration", "0.2", "--out", str(tmp_path / "fp")]) == 0
-    assert cli_main(["demo", "--duration", "0.2", "--out", str(tmp_path / "plain")]) == 0
-    follow = read_session(tmp_path / "fp" / "session.jsonl").header["config"]
-    plain = read_session(tmp_path / "plain" / "session.jsonl").header["config"]
-    assert follow["operator"]["start_with_clip_velocity"] and not plain["operator"]["start_with_clip_velocity"]
+    for name in ("fp", "ip", "plain"):
+        flags = {"fp": ["--follow-path"], "ip": ["--in-place"], "plain": []}[name]
+        assert cli_main(["demo", *flags, "--duration", "0.2", "--out", str(tmp_path / name)]) == 0
+    header = {name: read_session(tmp_path / name / "session.jsonl").header for name in ("fp", "ip", "plain")}
+    follow, in_place, plain = (header[n]["config"] for n in ("fp", "ip", "plain"))
     for name, value in FOLLOW_PATH_MOTION.items():
-        assert follow["motion"][name] == value != plain["motion"][name]
-    for name, value in FOLLOW_PATH_WHOLE_BODY.items():
-        assert follow["control"]["whole_body"][name] == value != plain["control"]["whole_body"][name]
+        assert follow["motion"][name] == value
+    assert follow["motion"]["path_target_share"] > 0.0 == plain["motion"]["path_target_share"]
+    for section, values in ((("motion",), IN_PLACE_MOTION), (("control", "whole_body"), IN_PLACE_WHOLE_BODY),
+                            (("operator",), IN_PLACE_OPERATOR)):
+        ip, pl = in_place, plain
+        for key in section:
+            ip, pl = ip[key], pl[key]
+        for name, value in values.items():
+            assert ip[name] == value
+            assert pl[name] != value or name == "path_target_share", name
+    assert plain["operator"]["start_with_clip_velocity"] and not in_place["operator"]["start_with_clip_velocity"]
+    metrics = {n: json.loads((tmp_path / n / "metrics.json").read_text()) for n in ("ip", "plain")}
+    assert metrics["ip"]["in_place"] and not metrics["plain"]["in_place"]
+    assert cli_main(["demo", "--in-place", "--follow-path", "--duration", "0.2", "--out", str(tmp_path / "both")]) == 2
+    assert "--in-place and --follow-path" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize("flag, settings, section", [("--free-swing", "FREE_SWING_MOTION", ("motion",)),

@@ -50,6 +50,7 @@ def test_a_crouch_deeper_than_the_fall_height_is_followed_no_deeper_than_the_flo
     assert pelvis_z[0] - pelvis_z.min() > 0.2
 
 
+@pytest.mark.in_place
 def test_an_operator_who_lies_down_is_followed_to_the_ground(monkeypatch):
     """The floor holds a crouch, his trunk upright, not a body he takes to the ground: in the humanoid3d get-up
     (face up, seed 0) he lies on his back, and the character goes down with him, a fall by the session's rule (out

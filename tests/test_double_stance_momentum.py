@@ -1,4 +1,5 @@
 import numpy as np
+import pytest
 from conftest import suite_run
 
 from stylesync.config import ControlConfig, MotionConfig
@@ -28,6 +29,7 @@ def test_along_an_oblique_walk_only_the_component_along_it_changes():
     np.testing.assert_allclose(out, [0.3, 0.4, 0.0], atol=1e-12)
 
 
+@pytest.mark.in_place
 def test_the_built_in_walk_goes_further_along_the_operators_path_when_opted_in():
     """The built-in walk (seed 0, the development suite's run): without the kept momentum the double stances brake
     the character, which then covers less of its operator's way (0.39 measured); with it (0.1 m, the measured

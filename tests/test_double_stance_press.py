@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 
+import pytest
 from conftest import suite_run
 
 from stylesync.config import ControlConfig, MotionConfig
@@ -38,6 +39,7 @@ def _spinning_kick(press: bool) -> tuple[bool, float]:
     return result.fell, longest[0]
 
 
+@pytest.mark.in_place
 def test_a_double_stance_foot_that_comes_off_is_pressed_down_again():
     # Traced: with the COM over the right foot the left one's stance weight is zero; it came off at 2.33 s, rose to
     # 0.19 m over 0.23 s, and when the weight shifted back onto it both soles bore nothing: a fall at 2.87 s.

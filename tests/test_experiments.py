@@ -122,6 +122,7 @@ def test_a_free_swing_carries_the_kicks_strike_to_the_ball():
     assert not reach[False]["kicked"] and reach[False]["closest_foot_m"] > 0.25
 
 
+@pytest.mark.in_place
 def test_a_kick_does_not_lift_off_with_the_weight_already_beyond_the_stance_ankle():
     """The scripted kick with the free swing, seed 0: lifting off with its capture point 2.4 cm outside its stance
     ankle (and moving out), the character could not bring it back; the strike pushed it out of the sole, the swing
@@ -136,6 +137,7 @@ def test_a_kick_does_not_lift_off_with_the_weight_already_beyond_the_stance_ankl
     assert out[0.01]["kicked"] and not out[0.01]["fell"]
 
 
+@pytest.mark.in_place
 def test_a_stance_foot_off_the_ground_is_held_where_it_came_off():
     """The scripted kick, seed 14: while the weight shifts onto the left foot the right one bears no force and comes
     a few millimetres off the ground. Pressed down only, it slid 0.2 m forwards and inwards (the QP swung the free leg

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 
+import pytest
 from conftest import suite_run
 
 from stylesync.config import ControlConfig, MotionConfig
@@ -46,6 +47,7 @@ def _run(waits: bool) -> tuple[float, bool, float | None]:
     return worst, result.fell, result.fall_time_s
 
 
+@pytest.mark.in_place
 def test_a_lift_off_onto_a_sole_the_capture_point_has_passed_waits():
     """The character stood on both feet, its right foot behind on its toes, while the operator, a stride ahead of it
     in his gait, stood on his right and lifted his left. The lift-off waited the weight shift's 0.25 s for the

@@ -74,6 +74,7 @@ def test_a_mirrored_source_passes_on_what_the_wrapped_source_knows():
     assert closed == [True]
 
 
+@pytest.mark.in_place
 def test_the_character_follows_the_mirror_image_of_the_operator():
     # The built-in walk and its mirror image, seed 0, 4 s: the operator side (sensor noise, interpolation, 1€
     # filter, floor filter) gives exactly the reflected ankles, and the character lifts the other foot first, on

@@ -46,6 +46,7 @@ PATH_OPT_INS = {"double_stance_keeps_momentum_m": 0.1, "capture_bound_in_his_gai
 
 
 @pytest.mark.skipif(not ZOMBIE.exists(), reason="../shared/mocap/deepmimic/humanoid3d_zombie_walk.txt is not available")
+@pytest.mark.in_place
 def test_the_zombie_walk_goes_his_way_when_its_own_steps_walk_on_only_along_it():
     """The zombie walk (seed 0, as the development suite runs it) with the path settings: its own steps walked on
     along the capture point's divergence, sideways too, and the character walked 3.6 m to the side of his path, its

@@ -92,6 +92,7 @@ needs_cmu_dev = pytest.mark.skipif(not (MOCAP / "cmu-dev").is_dir(),
 
 @needs_cmu_dev
 @pytest.mark.parametrize("push_bound", ["off", "he_stands"])
+@pytest.mark.in_place
 def test_a_chain_of_own_steps_in_the_rest_is_not_pushed_on(push_bound):
     """CMU-dev 08_08, seed 11 (traced): after the clip's end the operator stands; without the bound the character's
     own steps push its COM from 1.1 to 3 m/s (horizontally) and it falls 1.4 s into the rest. With the bound in the

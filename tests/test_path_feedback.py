@@ -65,40 +65,53 @@ def test_the_landing_shift_is_bounded():
     assert shift / np.linalg.norm(shift) == pytest.approx([-0.6, 0.8])  # along the error: behind, it lands behind
 
 
-def test_off_by_default_and_validated():
-    assert MotionConfig().path_feedback_share == 0.0
-    assert not PathReference(MotionConfig().path_feedback_share, 0.2).enabled
+def test_on_by_default_off_in_place_and_validated():
+    from stylesync.config import SessionConfig, in_place
+
+    assert MotionConfig().path_feedback_share == 0.5
+    assert PathReference(MotionConfig().path_feedback_share, 0.2).enabled
+    assert not PathReference(in_place(SessionConfig()).motion.path_feedback_share, 0.2).enabled
     with pytest.raises(ConfigError, match="path_feedback_share"):
         MotionConfig(path_feedback_share=-0.1)
 
 
-def test_follow_path_sets_the_opt_ins_and_the_start_at_speed():
+def test_follow_path_adds_the_pull_and_in_place_sets_the_former_defaults():
     from stylesync.config import (
         FOLLOW_PATH_MOTION,
         FOLLOW_PATH_START_SPEED_MAX_MPS,
         FOLLOW_PATH_WHOLE_BODY,
+        IN_PLACE_MOTION,
+        IN_PLACE_WHOLE_BODY,
         SessionConfig,
         follow_path,
+        in_place,
     )
 
-    cfg = follow_path(SessionConfig())
-    assert cfg.operator.start_with_clip_velocity and not SessionConfig().operator.start_with_clip_velocity
-    assert cfg.operator.start_speed_max_mps == FOLLOW_PATH_START_SPEED_MAX_MPS
-    assert SessionConfig().operator.start_speed_max_mps is None
+    cfg, default, placed = follow_path(SessionConfig()), SessionConfig(), in_place(SessionConfig())
+    assert cfg.operator.start_with_clip_velocity and default.operator.start_with_clip_velocity
+    assert cfg.operator.start_speed_max_mps == FOLLOW_PATH_START_SPEED_MAX_MPS == default.operator.start_speed_max_mps
+    assert not placed.operator.start_with_clip_velocity and placed.operator.start_speed_max_mps is None
     for name, value in FOLLOW_PATH_MOTION.items():
-        assert getattr(cfg.motion, name) == value != getattr(SessionConfig().motion, name)
+        assert getattr(cfg.motion, name) == value
+        assert (getattr(default.motion, name) == value) == (name not in ("path_target_share",
+                                                                           "landing_reach_ground_gap_m")), name
     for name, value in FOLLOW_PATH_WHOLE_BODY.items():
-        assert getattr(cfg.control.whole_body, name) == value != getattr(SessionConfig().control.whole_body, name)
+        assert getattr(cfg.control.whole_body, name) == value == getattr(default.control.whole_body, name)
+    for name, value in IN_PLACE_MOTION.items():
+        assert getattr(placed.motion, name) == value
+    for name, value in IN_PLACE_WHOLE_BODY.items():
+        assert getattr(placed.control.whole_body, name) == value != getattr(default.control.whole_body, name)
+    # follow_path over in_place gives follow_path's settings whatever the base
+    assert follow_path(placed) == cfg
 
 
 @pytest.mark.parametrize("seed", [0, 1])
-def test_the_built_in_walk_keeps_to_its_operators_path_longer_with_follow_path(seed):
-    """Measured (3.5 s of the built-in walk): by default the UHC termination comes at 2.42-2.45 s, the character
-    0.28-0.32 of the operator's way along; with follow_path at 2.79-3.00 s, 0.54-0.60 of it (2.99-3.05 s and
-    0.61-0.62 before its own steps walked on only along his way and a gait needed him to go somewhere)."""
+def test_the_built_in_walk_keeps_to_its_operators_path_longer_than_in_place(seed):
+    """Measured (3.5 s of the built-in walk): in place the UHC termination comes at 2.42-2.45 s, the character
+    0.28-0.32 of the operator's way along; by default (following his path by the landings) at 2.85-2.90 s."""
     import logging
 
-    from stylesync.config import OperatorConfig, SessionConfig, follow_path
+    from stylesync.config import OperatorConfig, SessionConfig, in_place
     from stylesync.metrics.summary import summarize
     from stylesync.session import Session
     from stylesync.sources.builtin_operator import builtin_operator
@@ -106,18 +119,18 @@ def test_the_built_in_walk_keeps_to_its_operators_path_longer_with_follow_path(s
     logging.disable(logging.WARNING)
     try:
         out = {}
-        for follow in (False, True):
+        for placed in (True, False):
             cfg = SessionConfig(duration_s=3.5, seed=seed, operator=OperatorConfig(clip="walk"))
-            if follow:
-                cfg = follow_path(cfg)
+            if placed:
+                cfg = in_place(cfg)
             source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, seed)
-            out[follow] = summarize(Session(cfg, source).run())
+            out[placed] = summarize(Session(cfg, source).run())
     finally:
         logging.disable(logging.NOTSET)
     assert not out[False]["fell"] and not out[True]["fell"]
-    assert out[False]["uhc_fall_time_s"] < 2.6
-    assert out[True]["uhc_fall_time_s"] is None or out[True]["uhc_fall_time_s"] > 2.7
-    assert out[True]["path_progress"] > 1.6 * out[False]["path_progress"]
+    assert out[True]["uhc_fall_time_s"] < 2.6
+    assert out[False]["uhc_fall_time_s"] is None or out[False]["uhc_fall_time_s"] > 2.7
+    assert out[False]["path_progress"] > 1.6 * out[True]["path_progress"], out
 
 
 def test_the_targets_pull_to_his_com_on_the_characters_path():

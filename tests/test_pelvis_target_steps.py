@@ -44,6 +44,7 @@ def test_his_kick_in_the_air_does_not_drop_the_pelvis_target_of_a_double_stance(
     assert _largest_drop_m(ds_anchor_ground_height=True, landing_pelvis_descent_mps=None) < 0.45
 
 
+@pytest.mark.in_place
 def test_the_lowering_for_a_landing_foot_comes_down_at_a_bounded_speed():
     # Without the bound the lowering for a landing foot out of reach steps the target by 0.39 m (3.09 s)
     assert _largest_drop_m(ds_anchor_ground_height=True, landing_pelvis_descent_mps=None) > 0.3

@@ -289,11 +289,11 @@ def test_a_lift_off_waits_while_the_lifted_foot_is_the_only_one_down():
 # a double stance's unweighted foot was pressed down (press_double_stance_feet).
 TRACED = ControlConfig(whole_body=WholeBodyConfig(stance_leg_tracking_share=1.0, single_stance_pelvis_share=1.0,
                                                    recovery_foot_task_weight=0.0, pelvis_rate_share=0.0,
-                                                   press_double_stance_feet=False))
+                                                   press_double_stance_feet=False, own_step_push_bound="he_stands"))
 # The default controller before WholeBodyConfig.single_stance_pelvis_share (and the recovery foot task), which
 # the scenarios of the stopping step and the overdue double stance were traced with.
 PELVIS_LEVEL = ControlConfig(whole_body=WholeBodyConfig(single_stance_pelvis_share=1.0, recovery_foot_task_weight=0.0,
-                                                        pelvis_rate_share=0.0))
+                                                        pelvis_rate_share=0.0, own_step_push_bound="he_stands"))
 # ... and the motion stage's balance layer as it was then: recovery steps of 0.6 leg lengths, and a swing the
 # operator stops on not yet landed at once (with either, several of the traced falls come later or not at all).
 TRACED_MOTION = {"recovery_step_reach_share": 0.6, "recovery_on_stopping_step": False,
@@ -306,7 +306,8 @@ TRACED_MOTION = {"recovery_step_reach_share": 0.6, "recovery_on_stopping_step": 
 # weight shift from standing, the recovery steps' landing and the step timing as they were then; with the
 # controller, the recovery foot task off, and a double stance's unweighted foot not pressed down: NO_FOOT_TASK).
 NO_FOOT_TASK = ControlConfig(whole_body=WholeBodyConfig(recovery_foot_task_weight=0.0,
-                                                        press_double_stance_feet=False))
+                                                        press_double_stance_feet=False,
+                                                        own_step_push_bound="he_stands"))
 TWIST_FREE = {"foot_yaw_control": False, "liftoff_shift_tolerance_m": None, "recovery_landing_without_swing": False,
               "landing_pelvis_floor_share": 0.0, "recovery_on_reach_limit": False, "recovery_min_stance_s": 0.1,
               "recovery_ds_on_reach_limit": False, "recovery_cross_clear_m": None, "recovery_touchdown_share": 1.0,
@@ -367,6 +368,7 @@ def test_a_recovery_step_lands_when_its_capture_landing_would_leave_the_legs_rea
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "02_03.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/02_03.bvh is not available")
+@pytest.mark.in_place
 def test_a_run_that_stops_comes_to_rest_on_steps_that_land_before_the_capture_point_leaves_the_reach(monkeypatch):
     """CMU-dev 02_03 (a run; it ends at 1.41 s, then the operator holds his last pose), seed 0, as the development
     suite runs it. The character stops from running speed on recovery steps. With their nominal 0.2 s each landed at
@@ -413,6 +415,7 @@ def test_a_walk_cut_mid_stride_comes_to_rest_with_its_own_last_step():
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "08_04.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/08_04.bvh is not available")
+@pytest.mark.in_place
 def test_a_swing_he_stops_on_is_landed_at_once_where_the_capture_point_goes(monkeypatch):
     """CMU-dev 08_04 ends (3.99 s) on the operator's right foot; he lowers the raised left one over 0.5 s as he comes
     to rest. The stopping landing moves the character's left foot to catch its capture point, and a recovery step
@@ -445,6 +448,7 @@ def test_a_swing_he_stops_on_is_landed_at_once_where_the_capture_point_goes(monk
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "07_05.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/07_05.bvh is not available")
+@pytest.mark.in_place
 def test_a_double_stance_whose_capture_point_has_run_out_ends_in_a_step_of_its_own(monkeypatch):
     """CMU-dev 07_05, seed 0: the character lands a recovery step (3.63 s) while the operator is still on one foot,
     its step for his counted as taken; he lands (4.0 s) and stands to the clip's end (4.27 s). Its capture point is
@@ -513,6 +517,7 @@ def test_a_swing_taken_over_in_the_air_is_lowered_from_where_it_is_to_the_captur
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "08_01.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/08_01.bvh is not available")
+@pytest.mark.in_place
 def test_a_late_contact_hold_keeps_the_walk_going():
     """CMU 08_01, seed 1: the character's foot often lands after the operator's (late contact, Sec. 5.1). Held
     reference targets that stop where he was brake the character (measured: a fall at 3.0 s, in the rest after the
@@ -549,6 +554,7 @@ def test_a_sideways_drift_steps_with_the_foot_that_can_catch_it_not_the_one_that
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "07_01.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/07_01.bvh is not available")
+@pytest.mark.in_place
 def test_a_recovery_step_lets_the_body_move_as_its_landing_assumes():
     """CMU 07_01, seed 0, in the rest after the clip (2.6 s): the frozen operator's COM is over one of his feet, and
     a COM task pulling the character's there while its recovery step is in the air lands the foot where the capture
@@ -565,6 +571,7 @@ def test_a_recovery_step_lets_the_body_move_as_its_landing_assumes():
     assert pulled.fell and pulled.fall_time_s is not None and pulled.fall_time_s > 2.6
 
 
+@pytest.mark.in_place
 def test_the_walk_goes_the_operators_way_with_its_swing_aimed_at_his_last_landing():
     """The built-in walk, 8 s, seed 0: each swing goes from where the character's foot lifted off to a landing placed
     from its capture point as his last landing was from his, and the character goes his way. Aimed at the offset
@@ -585,6 +592,7 @@ def test_the_walk_goes_the_operators_way_with_its_swing_aimed_at_his_last_landin
     assert progress["his_foot_now"] < 0.0
 
 
+@pytest.mark.in_place
 def test_targets_that_follow_the_operator_keep_the_walk_up_with_him():
     """The built-in walk, 7 s: with the feet-anchored targets the character covers about a third of the operator's
     (scaled) distance, braked at each stance change; with the targets advancing at his velocity it covers most."""
@@ -637,6 +645,7 @@ def test_the_fsm_keeps_a_foot_down_until_the_weight_is_over_the_other_or_the_wai
 
 @pytest.mark.skipif(not (MOCAP / "cmu" / "131_01.bvh").exists(),
                     reason="../shared/mocap/cmu/131_01.bvh is not available")
+@pytest.mark.in_place
 def test_a_step_from_standing_waits_for_the_weight_to_shift():
     """CMU 131_01 (a styled walk), seed 0: the operator stands, then lifts his right foot with his capture point over
     his left sole; the character's was 7 cm outside its left sole and it fell sideways off it at 1.9 s. Waiting
@@ -653,6 +662,7 @@ def test_a_step_from_standing_waits_for_the_weight_to_shift():
     assert not shifted.fell or (shifted.fall_time_s is not None and shifted.fall_time_s > 2.5)
 
 
+@pytest.mark.in_place
 def test_a_kick_waits_until_the_weight_is_over_the_stance_ankle_as_the_operators():
     """The built-in kick in place, seed 0: the operator stands, shifts his weight over his left foot (his capture
     point over his ankle) and kicks with his right. Lifting the foot once its capture point was within 2 cm of the
@@ -674,6 +684,7 @@ def test_a_kick_waits_until_the_weight_is_over_the_stance_ankle_as_the_operators
 
 @pytest.mark.skipif(not (MOCAP / "deepmimic" / "humanoid3d_stealthy_walk.txt").exists(),
                     reason="../shared/mocap/deepmimic/humanoid3d_stealthy_walk.txt is not available")
+@pytest.mark.in_place
 def test_a_rear_foot_on_its_toes_is_read_as_still_standing():
     """The stealthy walk's long, low stride (2.6-3.2 s): the rear ankle rises 6-10 cm above the front one while
     its toes stay down and the operator's capture point stays 0.1-0.2 m behind his front heel. Read by ankle heights
@@ -710,6 +721,7 @@ def test_a_rear_foot_on_its_toes_is_read_as_still_standing():
 
 @pytest.mark.skipif(not (MOCAP / "cmu" / "02_01.bvh").exists(),
                     reason="../shared/mocap/cmu/02_01.bvh is not available")
+@pytest.mark.in_place
 def test_a_recovery_step_that_must_land_lowers_the_body_until_its_foot_reaches_the_ground():
     """CMU 02_01, seed 2, in the rest after the clip: the first recovery step's landing is near the leg's full
     reach (0.43 m ahead of the stance ankle); with the pelvis at the operator's height the foot hovered 5-10 cm
@@ -738,6 +750,7 @@ def test_a_step_counted_as_taken_leaves_the_character_waiting_in_double_stance()
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "05_01.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/05_01.bvh is not available")
+@pytest.mark.in_place
 def test_a_character_waiting_with_its_step_counted_may_still_step_on_its_own():
     """CMU-dev 05_01, seed 2, in the rest after the clip (4.9 s): the operator's held last frame is on one foot,
     lowering the other; the character, its step for his counted as taken, stood on both feet with its capture point
@@ -775,6 +788,7 @@ def test_a_character_waiting_with_its_step_counted_may_still_step_on_its_own():
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "07_11.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/07_11.bvh is not available")
+@pytest.mark.in_place
 def test_a_rear_foot_stays_down_while_the_capture_point_is_behind_the_front_heel():
     """CMU-dev 07_11, seed 4: the walker sets off from rest with his feet apart. The character, still at rest, lifted
     its rear foot with him while its capture point was behind its front heel: on the front foot alone it could
@@ -793,6 +807,7 @@ def test_a_rear_foot_stays_down_while_the_capture_point_is_behind_the_front_heel
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "02_03.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/02_03.bvh is not available")
+@pytest.mark.in_place
 def test_a_lighter_pelvis_on_one_foot_lets_a_running_stride_swing_forward():
     """CMU-dev 02_03 (a run), seed 0: with the pelvis orientation at full weight in single stance, the first swing
     on the left foot (0.42-0.73 s) goes backwards while the operator's goes forward, lands beside the stance foot,
@@ -837,6 +852,7 @@ def test_a_capture_point_out_of_reach_after_the_wait_is_told_from_one_a_step_the
 
 @pytest.mark.skipif(not (MOCAP / "deepmimic" / "humanoid3d_zombie_walk.txt").exists(),
                     reason="../shared/mocap/deepmimic/humanoid3d_zombie_walk.txt is not available")
+@pytest.mark.in_place
 def test_a_double_stance_that_would_wait_out_of_reach_steps_at_once():
     """The DeepMimic zombie walk, seed 1: at 3.67 s the operator lifts his right foot; the character, on both feet,
     has its capture point 8 cm outside them and moving out. Without the rule, its right swing (taken over) landed at
@@ -916,6 +932,7 @@ def test_the_com_velocity_with_a_leg_carried_leaves_out_only_the_legs_own_motion
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "09_06.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/09_06.bvh is not available")
+@pytest.mark.in_place
 def test_the_swing_foot_of_a_recovery_step_follows_its_target():
     """CMU-dev 09_06 (a run, seed 0) steps on its own from 0.96 s. Through the joint posture alone the swing ankle
     trailed its target by 0.2-0.3 m at mid-swing (traced); the recovery foot task keeps it close. Run with the step
@@ -969,6 +986,7 @@ def test_the_pelvis_floor_share_is_checked():
         traced_motion(landing_pelvis_floor_share=-0.1)
 
 
+@pytest.mark.in_place
 def test_a_landing_foot_out_of_reach_does_not_put_the_pelvis_target_on_the_ground():
     """The kick in place, seed 1 (the development suite's run): from 2.2 s the kicking foot is held for its late
     contact while the operator's pelvis target is 0.45 m to the side of the body. Measured from there, the foot is
@@ -997,6 +1015,7 @@ def test_a_landing_foot_out_of_reach_does_not_put_the_pelvis_target_on_the_groun
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "09_06.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/09_06.bvh is not available")
+@pytest.mark.in_place
 def test_an_operator_swing_is_aimed_within_the_legs_reach():
     """CMU-dev 09_06 (a run, seed 1): placed as the runner's are, relative to his capture point and his stance foot,
     the slower character's swing feet were aimed up to 2.3 m from their hip (measured), beyond where the leg can
@@ -1031,6 +1050,7 @@ def test_an_operator_swing_is_aimed_within_the_legs_reach():
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "07_11.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/07_11.bvh is not available")
+@pytest.mark.in_place
 def test_a_swing_that_would_land_out_of_reach_is_landed_by_the_balance():
     """CMU-dev 07_11 (a walk, seed 1): from 1.89 s the character, faster than its operator, stands on its right foot
     while his left swing goes on at his pace. Followed to his landing, it vaulted over its stance foot: the pelvis
@@ -1066,6 +1086,7 @@ def test_a_swing_that_would_land_out_of_reach_is_landed_by_the_balance():
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "09_01.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/09_01.bvh is not available")
+@pytest.mark.in_place
 def test_a_swing_past_its_usual_time_is_landed_before_the_capture_point_runs_out_of_reach():
     """CMU-dev 09_01 (a run), seed 7: the clip ends at 1.20 s with the operator on his right foot, his left foot
     raised and then lowered slowly (the held last frame). His usual swing time is past from about 1.27 s, and his
@@ -1111,6 +1132,7 @@ def test_a_swing_past_its_usual_time_is_landed_before_the_capture_point_runs_out
     assert result_old.fell and result_old.fall_time_s < 3.0  # measured: 2.25 s
 
 
+@pytest.mark.in_place
 def test_a_recovery_step_just_short_of_its_crossover_clearance_lands_on_the_capture_points_side():
     """The built-in spin, seed 0: the operator leaps forward and to the right while he turns. At 2.51 s the
     character stands on its right foot with the capture point ahead of it and to its right, and its left foot steps.
@@ -1157,6 +1179,7 @@ def test_a_recovery_step_just_short_of_its_crossover_clearance_lands_on_the_capt
 
 @pytest.mark.skipif(not (MOCAP / "deepmimic" / "humanoid3d_stealthy_walk.txt").exists(),
                     reason="../shared/mocap/deepmimic/humanoid3d_stealthy_walk.txt is not available")
+@pytest.mark.in_place
 def test_the_next_recovery_step_begins_while_both_soles_are_down():
     """The DeepMimic stealthy walk, seed 2: a recovery step's right foot lands at 3.49 s with the capture point 4 cm
     outside the soles and moving out to the left. With 0.1 s of double stance kept before the next step, the right
@@ -1211,6 +1234,7 @@ def test_the_swing_profiles_velocity_is_its_targets_rate_with_the_landing_held()
         WholeBodyConfig(recovery_foot_target_rate="finite")
 
 
+@pytest.mark.in_place
 def test_a_recovery_foot_follows_its_swing_profiles_velocity_not_the_landings_replanning():
     """The humanoid3d run, seed 14, as the suite runs it. Each tick a recovery step's landing is planned again on the
     capture point, which the swing leg's own reaction moves; with the foot task's target velocity differenced from
@@ -1265,6 +1289,7 @@ def test_the_swing_target_is_back_at_the_ground_by_the_touchdown_share():
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "07_11.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/07_11.bvh is not available")
+@pytest.mark.in_place
 def test_recovery_steps_that_touch_down_on_time_stop_a_walk():
     """CMU-dev 07_11 (a walk, seed 2) stops in the rest after its clip (from 2.58 s) with steps of its own. With the
     foot target at the ground only at the swing's end, the feet trailed it and touched down late (its three recovery
@@ -1302,6 +1327,7 @@ def test_a_landing_gap_must_be_positive():
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "08_08.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/08_08.bvh is not available")
+@pytest.mark.in_place
 def test_a_recovery_step_that_reaches_the_ground_on_a_corner_has_landed():
     """CMU-dev 08_08 (a fast walk, seed 3). Counted as landed only once it pressed the ground with 5 N, the recovery
     step begun at 2.34 s lasted 0.43 s against its nominal 0.2 s: from 2.61 s its foot rested on a corner of its sole
@@ -1344,6 +1370,7 @@ def test_a_recovery_step_that_reaches_the_ground_on_a_corner_has_landed():
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "08_08.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/08_08.bvh is not available")
+@pytest.mark.in_place
 def test_a_recovery_step_whose_landing_is_due_is_pressed_onto_the_ground():
     """CMU-dev 08_08, seed 1, in the rest after the clip: with the recovery foot's task at its swing weight after the
     landing is due (its target below the ground), a step's foot hovered above the ground from 2.83 s while the body

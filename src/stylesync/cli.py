@@ -23,6 +23,7 @@ from stylesync.config import (
     SessionConfig,
     follow_path,
     free_swing,
+    in_place,
     no_track_rise,
 )
 from stylesync.errors import ConfigError, SourceError, StylesyncError
@@ -174,6 +175,7 @@ def _demo(args: argparse.Namespace) -> int:
                                                       "lipm_time_sync": not args.no_lipm,
                                                       "mirror": args.mirror,
                                                       "follow_path": args.follow_path,
+                                                      "in_place": args.in_place,
                                                       "free_swing": args.free_swing,
                                                       "track_rise": not args.no_track_rise}, args)
 
@@ -186,7 +188,12 @@ def _suite_operator(args: argparse.Namespace) -> OperatorConfig:
 
 
 def _motion_options(cfg: SessionConfig, args: argparse.Namespace) -> SessionConfig:
-    """``cfg`` with the options asked for on the command line (--follow-path, --free-swing, --no-track-rise)."""
+    """``cfg`` with the options asked for on the command line (--in-place, --follow-path, --free-swing,
+    --no-track-rise)."""
+    if args.in_place and args.follow_path:
+        raise ConfigError("--in-place and --follow-path contradict each other: give one of them")
+    if args.in_place:
+        cfg = in_place(cfg)
     if args.follow_path:
         cfg = follow_path(cfg)
     if args.free_swing:
@@ -224,6 +231,7 @@ def _run(args: argparse.Namespace) -> int:
                                                               "lipm_time_sync": not args.no_lipm,
                                                               "mirror": args.mirror,
                                                               "follow_path": args.follow_path,
+                                                              "in_place": args.in_place,
                                                               "free_swing": args.free_swing,
                                                               "track_rise": not args.no_track_rise,
                                                               **opened.extras}, args)
@@ -269,22 +277,28 @@ def _bench(args: argparse.Namespace) -> int:
 
     shared = Path(args.shared) if args.shared else SHARED_DIR
     if args.suite == "dev":
-        from stylesync.metrics.dev_suite import FOLLOW_PATH_VERSION, ORDER, SUITE_CONTROLLERS, run_dev_suite
+        from stylesync.metrics.dev_suite import (
+            FOLLOW_PATH_VERSION,
+            IN_PLACE_VERSION,
+            ORDER,
+            SUITE_CONTROLLERS,
+            run_dev_suite,
+        )
 
         only = tuple(c.strip() for c in args.only.split(",") if c.strip()) if args.only else ()
         unknown = [c for c in only if c not in ORDER]
         if unknown:
             raise ConfigError(f"unknown categories {', '.join(unknown)}; expected some of {', '.join(ORDER)}")
         mocap = shared / "mocap"
-        # the follow-path version beside stylesync's (the first), before the baselines
-        follow = (FOLLOW_PATH_VERSION,) if args.follow_path else ()
-        controllers = (*SUITE_CONTROLLERS[:1], *follow, *SUITE_CONTROLLERS[1:])
+        # the follow-path and in-place versions beside stylesync's (the first), before the baselines
+        versions = ((FOLLOW_PATH_VERSION,) if args.follow_path else ()) + ((IN_PLACE_VERSION,) if args.in_place else ())
+        controllers = (*SUITE_CONTROLLERS[:1], *versions, *SUITE_CONTROLLERS[1:])
         report = run_dev_suite(Path(args.out), args.seeds, args.duration, mocap if mocap.is_dir() else None, only,
                                controllers=controllers, workers=args.workers, executor=args.executor,
                                first_seed=args.seed, operator=_suite_operator(args))
     else:
         for flag, given in (("--mirror", args.mirror), ("--sensor-noise", args.sensor_noise != 1.0),
-                            ("--follow-path", args.follow_path)):
+                            ("--follow-path", args.follow_path), ("--in-place", args.in_place)):
             if given:
                 raise ConfigError(f"{flag} is a dev-suite option: use it with --suite dev")
         report = run_bench(Path(args.out), args.duration, args.seed, shared if shared.is_dir() else None,
@@ -339,8 +353,13 @@ def _add_session_args(p: argparse.ArgumentParser, out_default: str, realtime_hel
                    help="the operator's mirror image drives the character (his right side its left), as a person "
                         "facing it on a screen expects")
     p.add_argument("--follow-path", action="store_true",
-                   help="keep to the operator's path over the ground (a recording starts at its speed); "
-                        "its own steps between his make the transition delays longer (README, status)")
+                   help="keep closer still to the operator's path over the ground: the targets pulled onto it "
+                        "besides the steps placed along it; its own steps between his make the transition delays "
+                        "longer (README, status)")
+    p.add_argument("--in-place", action="store_true",
+                   help="the character's steps planned to stop the body and its targets anchored on its own feet: "
+                        "it stays about where it started, trailing an operator who walks off, and a recording "
+                        "starts at rest (README, status)")
     p.add_argument("--free-swing", action="store_true",
                    help="a swing foot follows the operator's while both stand balanced on the other foot, lifted "
                         "only with the weight over that ankle (a kick strikes); by default every swing goes to a "
@@ -495,6 +514,9 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--follow-path", action="store_true",
                        help="dev suite: also the controller with --follow-path's settings, in the same run (the "
                             "'follow-path' rows, paired with stylesync's)")
+    bench.add_argument("--in-place", action="store_true",
+                       help="dev suite: also the controller with --in-place's settings, in the same run (the "
+                            "'in-place' rows, paired with stylesync's)")
     bench.add_argument("--workers", type=typed.integer(1, 256), default=2,
                        help="runs in parallel (with --executor processes or ray, and for the dev suite)")
     bench.add_argument("--executor", choices=("processes", "ray", "inline"),

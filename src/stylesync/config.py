@@ -126,15 +126,15 @@ class MotionConfig:
     # After the character's own step (a recovery step), Eq. 10's fraction along the heading from his rear foot to his
     # front one, on its rear and front feet, rather than from his left foot to his right on its left and right ones
     fraction_needs_feet_in_his_order: bool = True
-    # Opt-in (0: off): the pelvis and COM targets advance at the operator's scaled COM velocity and are pulled towards
-    # the feet-anchored targets of Eq. 10 with this time constant [s]. The character then keeps up with the operator
-    # over the ground (about twice the distance on the walk set) but falls more often (docs/decisions.md).
-    reference_follows_operator_s: float = 0.0
+    # The pelvis and COM targets advance at the operator's scaled COM velocity and are pulled towards the feet-anchored
+    # targets of Eq. 10 with this time constant: the character keeps up with the operator over the ground
+    # (docs/decisions.md, "Following his path by default"; 0: the anchored targets, `--in-place`) [s]
+    reference_follows_operator_s: float = 0.5
     # ... and the targets so advanced at most this far from the anchored ones (None: no bound). Advanced at a
     # runner's speed the character cannot step at, they ran 1.7 m ahead of it, and when he stopped they came back at
     # 2-3 m/s while the COM task still pulled the body on towards them: it reached his stop too fast to stop
     # (docs/decisions.md, "Targets that ran ahead of the character") [m]
-    reference_lead_max_m: float | None = None
+    reference_lead_max_m: float | None = 0.3
     # Weight shift before a lift-off from standing (pose_optimization._can_lift): the operator lifts a foot after a
     # double stance of at least liftoff_after_stand_s [s] with his capture point over his other sole (within
     # liftoff_margin_m [m] of its inner edge, sideways); while the character's is further than that inwards of its
@@ -331,7 +331,8 @@ class MotionConfig:
     # ... but a foot whose sole's lowest corner is within this of the ground is on it, pressing or not, and needs no
     # lowering: a supporting foot resting unloaded (0-4 N, below CONTACT_FORCE_N) read as one that must land, and the
     # pelvis target dropped to its floor (0.3 m) and back on alternate control ticks while the stance knee folded
-    # (docs/decisions.md, "A foot on the ground that must land"; None: by its pressing alone) [m]
+    # (docs/decisions.md, "A foot on the ground that must land"; None: by its pressing alone; 0.003 in `--follow-path`:
+    # by default the standing character drifted 4.2 cm in 60 s with it, 1.3 cm without) [m]
     landing_reach_ground_gap_m: float | None = None
     # The pelvis target lowered for a foot that must land comes down at most at this speed from the last control
     # tick's: the lowering to a foot out of reach came as one step of 0.3-0.4 m within a tick at landings of the
@@ -373,37 +374,37 @@ class MotionConfig:
     # only "sideways" (across the heading), or "off". Measured on the development suite, neither gains beyond the
     # spread between seeds, and "all" halves the walks' progress along the operator's path (docs/decisions.md).
     landing_capture_bound: str = "off"
-    # Opt-in: in the operator's double stance, the desired COM velocity along his scaled COM velocity is not below
+    # In the operator's double stance, the desired COM velocity along his scaled COM velocity is not below
     # the character's own, up to his (motion/double_stance_momentum.py): a character slower than its operator is not
     # braked at each double stance of a walk. Only while his COM moves from one of his feet towards the other
     # (double_stance_momentum.GAIT_AXIS_DEG), and while the character's capture point is within this distance
     # outside the support polygon of its feet on the ground: a body already beyond what its feet can stop is braked
     # as before. The walks then cover more of his way with as many runs completing, but the built-in walk's
     # character steps on its own and falls out of step with him (docs/decisions.md, "Momentum kept through a double
-    # stance"). 0.1 m is the measured setting; None: off [m].
-    double_stance_keeps_momentum_m: float | None = None
+    # stance"). 0.1 m is the measured setting; None: off (`--in-place`) [m].
+    double_stance_keeps_momentum_m: float | None = 0.1
     # In the character's double stance the COM target's capture point is kept within its soles
     # (capture_bound_sole_share); False: not while the operator walks from one foot onto the other
     # (double_stance_momentum.moves_between_feet), whose capture point runs ahead of his front foot.
-    capture_bound_in_his_gait: bool = True
-    # ... and where it is False, opt-in: in his gait's double stance the COM target's capture point runs ahead of the
+    capture_bound_in_his_gait: bool = False
+    # ... and where it is False: in his gait's double stance the COM target's capture point runs ahead of the
     # soles by at most what a step this long from now catches within a recovery step's reach
     # (capture_bound.gait_capture_margin_m: reach e^(-ω T)); None: unbounded there [s].
-    gait_capture_step_s: float | None = None
+    gait_capture_step_s: float | None = 0.3
     # While the operator is on one foot of his gait (he goes somewhere, his COM moving his way, his capture point
     # outside the sole he stands on) and the character on both (its step landed before his), the COM target's capture
     # point is kept within its soles; False: there too the bound is his gait's double stance's (gait_capture_step_s;
     # none where that is None), not the soles', which braked the character to a stop before each of his landings
     # (docs/decisions.md, "A step landed before his").
-    capture_bound_before_his_landing: bool = True
+    capture_bound_before_his_landing: bool = False
     # While the operator walks (his capture point outside his soles), a recovery step lands with the capture point
     # this far ahead of its ankle instead of on its sole's trailing edge: a step that walks on with him rather than
     # one that stops the body (recovery_step.capture_landing). None: every recovery step stops it [m].
-    recovery_walk_on_m: float | None = None
+    recovery_walk_on_m: float | None = 0.1
     # The walk-on above along the operator's way over the ground (his COM's direction of motion), as far as the
     # capture point diverges that way; across it the step catches the body on its ankle (recovery_step.WalkOn).
     # False: along the capture point's own divergence, which carries a sideways drift on from step to step.
-    recovery_walk_on_his_way: bool = False
+    recovery_walk_on_his_way: bool = True
     # ... and only as far as his way goes forwards: the walk-on times the share of his way along his heading's
     # forward axis (none where he goes sideways or backwards, and the step stops the body). Walked on sideways, a
     # dance's own steps, which cannot cross or lengthen as a forward stride does, ran the body away from its feet
@@ -415,7 +416,7 @@ class MotionConfig:
     # capture_bound_in_his_gait do not apply) and the character's own steps stop the body (no walk-on). None: any
     # double stance whose COM moves between his feet is a gait's [m/s].
     operator_way_time_s: float = 1.0
-    gait_min_way_speed_mps: float | None = None
+    gait_min_way_speed_mps: float | None = 0.3
     # His pelvis's upward speed handed on to the controller (ReferencePose.pelvis_vel_z_mps, a share of it tracked on
     # both feet, WholeBodyConfig.pelvis_rate_share) only while he stands on both feet and began the rise on them: a
     # jump's push, not a run's stride (his FSM passes through double stance in its flight) nor a vault onto one foot
@@ -425,7 +426,7 @@ class MotionConfig:
     # character's capture point is moved so that a step removes this share of the capture point's error from his,
     # scaled onto the character's path from where both started (the divergent component of motion: 1 removes it
     # in one step, above 2 it grows), the move at most path_feedback_max_m. 0: off [-], [m].
-    path_feedback_share: float = 0.0
+    path_feedback_share: float = 0.5
     path_feedback_max_m: float = 0.2
     # Following the operator over the ground by the targets (motion/path_feedback.py, PathReference.target_pull_xy):
     # the pelvis and COM targets of Eq. 10 are moved this share of the way from the COM target to his COM, scaled
@@ -651,8 +652,8 @@ class WholeBodyConfig:
     # it (control/own_step_push.py): the step's swing is not driven by pushing the body further the way it already
     # diverges (docs/decisions.md, "A character's own steps that push it on"). "off", "he_stands" (in the steps
     # taken while the operator stands: the steps that are to stop the body; traced on a chain of them that ran away
-    # in the rest after a clip) or "always".
-    own_step_push_bound: str = "he_stands"
+    # in the rest after a clip) or "always" (in every step of its own: the default, as the steps walk on with him).
+    own_step_push_bound: str = "always"
     # The joints' no-load speed (control/joint_speed_limit.py): a joint turning faster than this gets no torque along
     # its motion. Human joints peak at about 20-30 rad/s (a kick's knee); the held torques of a control tick spun
     # light links (a lifting stance foot, a hand) to the engine's 100 rad/s within a tick (docs/decisions.md, "The
@@ -772,11 +773,13 @@ class OperatorConfig:
     # started at rest in the clip's pose accelerates behind the reference and walks the clip (docs/decisions.md).
     # On, the 1€ filter and the motion stage's COM rates start from the clip's rates too (no lag of a filter that
     # believes the operator at rest); measured on the walk set, 28 of 56 runs complete against 33-37 started at rest.
-    start_with_clip_velocity: bool = False
+    # With the start bounded below (start_speed_max_mps) and the steps that walk on with him, it is the default
+    # (docs/decisions.md, "Following his path by default").
+    start_with_clip_velocity: bool = True
     # ... at most this fast over the ground: the character's velocities (root and joints) scaled down together so
     # that its root's horizontal speed is no more (None: the clip's as they are). A body started faster than its steps
     # can catch falls forward through them (docs/decisions.md) [m/s]
-    start_speed_max_mps: float | None = None
+    start_speed_max_mps: float | None = 1.0
     # Every source's frames as their mirror image, his right side driving the character's left (sources/mirror.py):
     # for a person facing the character on a screen, who expects it to move like his reflection.
     mirror: bool = False
@@ -820,8 +823,43 @@ class SessionConfig:
         return dataclasses.replace(self, **changes)
 
 
-# The opt-ins that keep the character to its operator's path over the ground, at a cost in falls
-# (docs/decisions.md, "Following the operator's path by the landing"): `--follow-path`.
+# The settings of the character that stays about where it started, its steps planned to stop the body and its
+# targets anchored on its own feet, trailing an operator who walks off (the defaults before "Following his path by
+# default", docs/decisions.md): `--in-place`. It falls a little less often and keeps his gait's timing a little
+# closer; it goes about a third of his way.
+IN_PLACE_MOTION: dict[str, Any] = {
+    "double_stance_keeps_momentum_m": None,  # a gait's double stance brakes the body ...
+    "capture_bound_in_his_gait": True,  # ... to the capture bound of its soles
+    "capture_bound_before_his_landing": True,
+    "gait_capture_step_s": None,
+    "reference_follows_operator_s": 0.0,  # the targets anchored on its feet (Eq. 10)
+    "reference_lead_max_m": None,
+    "path_feedback_share": 0.0,  # no landing moved towards his path
+    "recovery_walk_on_m": None,  # its own steps stop the body
+    "recovery_walk_on_his_way": False,
+    "gait_min_way_speed_mps": None,
+    "path_target_share": 0.0,
+}
+IN_PLACE_WHOLE_BODY: dict[str, Any] = {
+    "own_step_push_bound": "he_stands",
+}
+IN_PLACE_OPERATOR: dict[str, Any] = {
+    "start_with_clip_velocity": False,  # a recording started at rest in its first pose
+    "start_speed_max_mps": None,
+}
+
+
+def in_place(cfg: SessionConfig) -> SessionConfig:
+    """``cfg`` with IN_PLACE_MOTION, IN_PLACE_WHOLE_BODY and IN_PLACE_OPERATOR."""
+    whole_body = dataclasses.replace(cfg.control.whole_body, **IN_PLACE_WHOLE_BODY)
+    return cfg.replace(motion=dataclasses.replace(cfg.motion, **IN_PLACE_MOTION),
+                       control=dataclasses.replace(cfg.control, whole_body=whole_body),
+                       operator=dataclasses.replace(cfg.operator, **IN_PLACE_OPERATOR))
+
+
+# Following the operator's path over the ground closer still, at a cost in falls and in his gait's timing: the
+# targets pulled onto his path besides the settings below, which are the defaults (docs/decisions.md, "Following
+# the operator's path by the landing", "Targets on his path"): `--follow-path`.
 FOLLOW_PATH_MOTION: dict[str, Any] = {
     "double_stance_keeps_momentum_m": 0.1,  # a gait's double stance does not brake it
     "capture_bound_in_his_gait": False,  # nor does the capture bound while he walks

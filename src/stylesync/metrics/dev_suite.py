@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from stylesync.config import OperatorConfig, SessionConfig, follow_path
+from stylesync.config import OperatorConfig, SessionConfig, follow_path, in_place
 from stylesync.errors import StylesyncError
 from stylesync.metrics.bench import CONTROLLERS
 from stylesync.metrics.paired_outcomes import paired_table
@@ -52,6 +52,8 @@ SUITE_CONTROLLERS = ("stylesync", "plain-pd")
 # The stylesync controller with `--follow-path`'s settings (config.follow_path): `stylesync bench --suite dev
 # --follow-path` runs it beside the others, in the same run
 FOLLOW_PATH_VERSION = "follow-path"
+# ... and with `--in-place`'s (config.in_place): `stylesync bench --suite dev --in-place`
+IN_PLACE_VERSION = "in-place"
 
 
 def clip_specs(mocap: Path | None) -> list[tuple[str, str, str]]:
@@ -92,7 +94,7 @@ def run_clip(spec: str, seed: int, duration_s: float, controller: str,
     from stylesync.sources.registry import open_source
 
     logging.disable(logging.WARNING)
-    control, motion = CONTROLLERS["stylesync" if controller == FOLLOW_PATH_VERSION else controller]
+    control, motion = CONTROLLERS["stylesync" if controller in (FOLLOW_PATH_VERSION, IN_PLACE_VERSION) else controller]
     try:
         opened = open_source(spec, operator=operator, seed=seed, duration_s=duration_s)
     except StylesyncError as exc:
@@ -101,6 +103,8 @@ def run_clip(spec: str, seed: int, duration_s: float, controller: str,
     cfg = dataclasses.replace(cfg, control=control, motion=motion)
     if controller == FOLLOW_PATH_VERSION:
         cfg = follow_path(cfg)
+    elif controller == IN_PLACE_VERSION:
+        cfg = in_place(cfg)
     result = run_and_release(cfg, opened.source)
     m = summarize(result)
     keys = ("fell", "fall_time_s", "sim_duration_s", "operator_steps", "character_steps",
