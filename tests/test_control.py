@@ -132,8 +132,8 @@ def test_free_character_stands_60_s_within_2_cm_with_a_standing_operator():
 @pytest.mark.in_place
 def test_the_walk_in_place_over_sensor_noise_seeds_mostly_completes_and_follows_the_operators_steps():
     # In place (config.in_place: the defaults before the character followed his path by its landings; by default
-    # every run takes steps of its own, below). The walk is chaotic (a change in the 15th digit changes which seeds fall), so it is judged over 12 sensor-noise
-    # seeds rather than one. Measured over 48 seeds: 44 to 47 complete 12 s, depending on rounding (before the
+    # every run takes steps of its own, below). The walk is chaotic (a change in the 15th digit changes which seeds
+    # fall), so it is judged over 12 sensor-noise seeds rather than one. Measured over 48 seeds: 44 to 47 complete 12 s, depending on rounding (before the
     # landing fix and the capture-point COM gains, 4 of 24 completed 10 s). At a completion rate of 0.9, fewer
     # than 8 of 12 complete with a probability below 1 %; at the former 0.17, 8 or more with one of 0.02 %. Every
     # run that completes takes >= 80 % of the operator's steps and follows his state transitions within 0.172 s (the
