@@ -131,18 +131,18 @@ def test_free_character_stands_60_s_within_2_cm_with_a_standing_operator():
 
 @pytest.mark.in_place
 def test_the_walk_in_place_over_sensor_noise_seeds_mostly_completes_and_follows_the_operators_steps():
-    # In place (config.in_place: the defaults before the character followed his path by its landings; by default
-    # every run takes steps of its own, below). The walk is chaotic (a change in the 15th digit changes which seeds
-    # fall), so it is judged over 12 sensor-noise seeds rather than one. Measured over 48 seeds: 44 to 47 complete 12 s, depending on rounding (before the
-    # landing fix and the capture-point COM gains, 4 of 24 completed 10 s). At a completion rate of 0.9, fewer
-    # than 8 of 12 complete with a probability below 1 %; at the former 0.17, 8 or more with one of 0.02 %. Every
-    # run that completes takes >= 80 % of the operator's steps and follows his state transitions within 0.172 s (the
-    # paper's figure), but one: with the supporting legs' posture at 0.1 of its weight, seed 6 has one transition
-    # of 13 at 0.188 s (the others of all 12 seeds within 0.097 s); one run is allowed up to 0.2 s. A run the
-    # balance saves with a step of its own (MotionConfig.recovery_step_behind_cos: seed 6, which otherwise falls at
-    # 5.3 s) follows the operator late there (0.68 s): the delays are judged on the runs without one, at most three
-    # (with MotionConfig.recovery_overdue_swing_horizon seeds 7 and 11 take one too, where a swing of the operator's
-    # outlasts his usual swing time; all 12 complete, their largest delays 0.105 and 0.113 s).
+    # In place (config.in_place: the defaults before the character followed his path by its landings; by default every
+    # run takes steps of its own, below). The walk is chaotic (a change in the 15th digit changes which seeds fall), so
+    # it is judged over 12 sensor-noise seeds rather than one. Measured over 48 seeds: 44 to 47 complete 12 s, depending
+    # on rounding (before the landing fix and the capture-point COM gains, 4 of 24 completed 10 s). At a completion rate
+    # of 0.9, fewer than 8 of 12 complete with a probability below 1 %; at the former 0.17, 8 or more with one of 0.02
+    # %. Every run that completes takes >= 80 % of the operator's steps and follows his state transitions within 0.172 s
+    # (the paper's figure), but one: with the supporting legs' posture at 0.1 of its weight, seed 6 has one transition
+    # of 13 at 0.188 s (the others of all 12 seeds within 0.097 s); one run is allowed up to 0.2 s. A run the balance
+    # saves with a step of its own (MotionConfig.recovery_step_behind_cos: seed 6, which otherwise falls at 5.3 s)
+    # follows the operator late there (0.68 s): the delays are judged on the runs without one, at most three (with
+    # MotionConfig.recovery_overdue_swing_horizon seeds 7 and 11 take one too, where a swing of the operator's outlasts
+    # his usual swing time; all 12 complete, their largest delays 0.105 and 0.113 s).
     from stylesync.metrics.summary import summarize
 
     fall_times, completed, own_steps = [], [], 0
