@@ -108,6 +108,7 @@ def test_the_kick_claim_needs_the_walk_to_reach_the_ball_and_the_kick_to_move_it
     assert not kick.claim_holds({"walk-to-ball": walk, "kick": {**kicked, "fell": True}})
 
 
+@pytest.mark.in_place
 def test_a_free_swing_carries_the_kicks_strike_to_the_ball():
     """The scripted kick from standing, seed 1 (`stylesync experiment kick`'s "kick"): with the free swing, the
     swing foot follows his relative to the stance foot while both stand balanced on it, strikes forward and moves

@@ -398,6 +398,7 @@ def test_a_run_that_stops_comes_to_rest_on_steps_that_land_before_the_capture_po
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "08_01.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/08_01.bvh is not available")
+@pytest.mark.in_place
 def test_a_walk_cut_mid_stride_comes_to_rest_with_its_own_last_step():
     """CMU 08_01 ends mid-stride (2.27 s); its operator then holds his last pose. Without the stopping landing and
     recovery steps the character keeps its momentum and falls in the rest (measured: 3.3 s, seed 0)."""
@@ -890,6 +891,7 @@ def test_a_double_stance_that_would_wait_out_of_reach_steps_at_once():
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "10_04.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/10_04.bvh is not available")
+@pytest.mark.in_place
 def test_a_capture_point_behind_both_feet_steps_back_at_once():
     """CMU-dev 10_04, seed 0: a stopping step landed the character's feet side by side with its COM 9 cm behind them
     (1.57 s); the operator walks on forwards. Its capture point ran out behind both feet while it waited for his
@@ -970,6 +972,7 @@ class _Stop(Exception):
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "03_02.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/03_02.bvh is not available")
+@pytest.mark.in_place
 def test_recovery_steps_that_land_where_the_body_will_be_keep_a_walk_on_rough_ground_up():
     """CMU-dev 03_02 (walking over uneven ground, seed 1) fell 2.2 s in with the recovery step's foot driven by the
     joint posture alone and its landing planned on the capture point its own swing moved (measured)."""
