@@ -745,6 +745,11 @@ class ControlConfig:
             raise ConfigError(f"ControlConfig.balance must be one of {BALANCE_METHODS}, got {self.balance!r}")
 
 
+# A recording starts at its own velocities, no faster than this over the ground (OperatorConfig.start_speed_max_mps)
+# [m/s]
+FOLLOW_PATH_START_SPEED_MAX_MPS = 1.0
+
+
 @dataclass(frozen=True)
 class OperatorConfig:
     """The built-in operator: a recorded clip played by a human-scale skeleton through a Kinect-like sensor."""
@@ -779,7 +784,7 @@ class OperatorConfig:
     # ... at most this fast over the ground: the character's velocities (root and joints) scaled down together so
     # that its root's horizontal speed is no more (None: the clip's as they are). A body started faster than its steps
     # can catch falls forward through them (docs/decisions.md) [m/s]
-    start_speed_max_mps: float | None = 1.0
+    start_speed_max_mps: float | None = FOLLOW_PATH_START_SPEED_MAX_MPS
     # Every source's frames as their mirror image, his right side driving the character's left (sources/mirror.py):
     # for a person facing the character on a screen, who expects it to move like his reflection.
     mirror: bool = False
@@ -905,8 +910,7 @@ def no_track_rise(cfg: SessionConfig) -> SessionConfig:
     return cfg.replace(control=dataclasses.replace(cfg.control, whole_body=whole_body))
 
 
-# ... and for a recording: started at its own velocities, no faster than this over the ground [m/s]
-FOLLOW_PATH_START_SPEED_MAX_MPS = 1.0
+# ... and for a recording: started at its own velocities, no faster than FOLLOW_PATH_START_SPEED_MAX_MPS (the default)
 FOLLOW_PATH_OPERATOR: dict[str, Any] = {
     "start_with_clip_velocity": True,
     "start_speed_max_mps": FOLLOW_PATH_START_SPEED_MAX_MPS,
