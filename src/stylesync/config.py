@@ -854,12 +854,20 @@ IN_PLACE_OPERATOR: dict[str, Any] = {
 }
 
 
+def with_settings(cfg: SessionConfig, motion: dict[str, Any] | None = None, whole_body: dict[str, Any] | None = None,
+                  operator: dict[str, Any] | None = None) -> SessionConfig:
+    """``cfg`` with these settings of its MotionConfig, WholeBodyConfig and OperatorConfig (a set of them that a
+    command-line option names)."""
+    control = cfg.control
+    if whole_body:
+        control = dataclasses.replace(control, whole_body=dataclasses.replace(control.whole_body, **whole_body))
+    return cfg.replace(motion=dataclasses.replace(cfg.motion, **(motion or {})), control=control,
+                       operator=dataclasses.replace(cfg.operator, **(operator or {})))
+
+
 def in_place(cfg: SessionConfig) -> SessionConfig:
     """``cfg`` with IN_PLACE_MOTION, IN_PLACE_WHOLE_BODY and IN_PLACE_OPERATOR."""
-    whole_body = dataclasses.replace(cfg.control.whole_body, **IN_PLACE_WHOLE_BODY)
-    return cfg.replace(motion=dataclasses.replace(cfg.motion, **IN_PLACE_MOTION),
-                       control=dataclasses.replace(cfg.control, whole_body=whole_body),
-                       operator=dataclasses.replace(cfg.operator, **IN_PLACE_OPERATOR))
+    return with_settings(cfg, IN_PLACE_MOTION, IN_PLACE_WHOLE_BODY, IN_PLACE_OPERATOR)
 
 
 # Following the operator's path over the ground closer still, at a cost in falls and in his gait's timing: the
@@ -894,7 +902,7 @@ FREE_SWING_MOTION: dict[str, Any] = {
 
 def free_swing(cfg: SessionConfig) -> SessionConfig:
     """``cfg`` with FREE_SWING_MOTION."""
-    return cfg.replace(motion=dataclasses.replace(cfg.motion, **FREE_SWING_MOTION))
+    return with_settings(cfg, motion=FREE_SWING_MOTION)
 
 
 # The pelvis height's law without the operator's rise, the regulator alone (docs/decisions.md, "A jump's rise"):
@@ -906,8 +914,7 @@ NO_TRACK_RISE_WHOLE_BODY: dict[str, Any] = {
 
 def no_track_rise(cfg: SessionConfig) -> SessionConfig:
     """``cfg`` with NO_TRACK_RISE_WHOLE_BODY."""
-    whole_body = dataclasses.replace(cfg.control.whole_body, **NO_TRACK_RISE_WHOLE_BODY)
-    return cfg.replace(control=dataclasses.replace(cfg.control, whole_body=whole_body))
+    return with_settings(cfg, whole_body=NO_TRACK_RISE_WHOLE_BODY)
 
 
 # ... and for a recording: started at its own velocities, no faster than FOLLOW_PATH_START_SPEED_MAX_MPS (the default)
@@ -920,10 +927,7 @@ FOLLOW_PATH_OPERATOR: dict[str, Any] = {
 def follow_path(cfg: SessionConfig) -> SessionConfig:
     """``cfg`` with FOLLOW_PATH_MOTION, FOLLOW_PATH_WHOLE_BODY and FOLLOW_PATH_OPERATOR (a recording's start at its
     own velocities, at most FOLLOW_PATH_START_SPEED_MAX_MPS)."""
-    whole_body = dataclasses.replace(cfg.control.whole_body, **FOLLOW_PATH_WHOLE_BODY)
-    return cfg.replace(motion=dataclasses.replace(cfg.motion, **FOLLOW_PATH_MOTION),
-                       control=dataclasses.replace(cfg.control, whole_body=whole_body),
-                       operator=dataclasses.replace(cfg.operator, **FOLLOW_PATH_OPERATOR))
+    return with_settings(cfg, FOLLOW_PATH_MOTION, FOLLOW_PATH_WHOLE_BODY, FOLLOW_PATH_OPERATOR)
 
 
 def pid_group(joint_name: str) -> str:

@@ -54,6 +54,8 @@ SUITE_CONTROLLERS = ("stylesync", "plain-pd")
 FOLLOW_PATH_VERSION = "follow-path"
 # ... and with `--in-place`'s (config.in_place): `stylesync bench --suite dev --in-place`
 IN_PLACE_VERSION = "in-place"
+# The stylesync controller's versions with a set of settings, and the function that sets them
+VERSION_SETTINGS = {FOLLOW_PATH_VERSION: follow_path, IN_PLACE_VERSION: in_place}
 
 
 def clip_specs(mocap: Path | None) -> list[tuple[str, str, str]]:
@@ -94,17 +96,16 @@ def run_clip(spec: str, seed: int, duration_s: float, controller: str,
     from stylesync.sources.registry import open_source
 
     logging.disable(logging.WARNING)
-    control, motion = CONTROLLERS["stylesync" if controller in (FOLLOW_PATH_VERSION, IN_PLACE_VERSION) else controller]
+    settings = VERSION_SETTINGS.get(controller)
+    control, motion = CONTROLLERS["stylesync" if settings is not None else controller]
     try:
         opened = open_source(spec, operator=operator, seed=seed, duration_s=duration_s)
     except StylesyncError as exc:
         return {"error": str(exc)[:200]}
     cfg, clip_end = suite_config(spec, opened, seed, duration_s, operator)
     cfg = dataclasses.replace(cfg, control=control, motion=motion)
-    if controller == FOLLOW_PATH_VERSION:
-        cfg = follow_path(cfg)
-    elif controller == IN_PLACE_VERSION:
-        cfg = in_place(cfg)
+    if settings is not None:
+        cfg = settings(cfg)
     result = run_and_release(cfg, opened.source)
     m = summarize(result)
     keys = ("fell", "fall_time_s", "sim_duration_s", "operator_steps", "character_steps",
