@@ -30,10 +30,12 @@ def _followed_walk(bounded: bool) -> tuple[float, int, float, bool]:
 
     def configure(cfg):
         cfg = follow_path(cfg)
-        # Traced before the rule for a foot lying on the ground (landing_reach_ground_gap_m) and before the pelvis
-        # target came down as his swing went (swing_landing_within_reach): pinned off
+        # Traced before the rule for a foot lying on the ground (landing_reach_ground_gap_m), before the pelvis
+        # target came down as his swing went (swing_landing_within_reach) and before the targets stood on the anchored
+        # ones while he stands (reference_follows_standing_s): pinned off
         motion = dataclasses.replace(cfg.motion, capture_bound_before_his_landing=bounded,
-                                     landing_reach_ground_gap_m=None, swing_landing_within_reach=False)
+                                     landing_reach_ground_gap_m=None, swing_landing_within_reach=False,
+                                     reference_follows_standing_s=None)
         return dataclasses.replace(cfg, motion=motion)
 
     result = suite_run("builtin:walk", 0, MotionConfig(), TRACED_BEFORE_PRESS, watch=watch, configure=configure)

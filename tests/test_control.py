@@ -123,10 +123,21 @@ def _standing_run(duration_s: float, **options):
     return com, feet
 
 
-def test_free_character_stands_60_s_within_2_cm_with_a_standing_operator():
-    # The acceptance figure with the default configuration (measured: 1.4 cm).
-    com, _ = _standing_run(60.0)
+@pytest.mark.parametrize("seed", [0, 3])
+def test_free_character_stands_60_s_within_2_cm_with_a_standing_operator(seed):
+    # The acceptance figure with the default configuration (measured: 1.39 and 0.60 cm; seeds 0-7 at most 1.39 cm).
+    com, _ = _standing_run(60.0, seed=seed)
     assert np.linalg.norm(com - com[0], axis=1).max() < 0.02
+
+
+def test_targets_that_trail_the_settling_feet_leave_a_stance_that_creeps():
+    # With the walking time constant while he stands (MotionConfig.reference_follows_standing_s None), the targets
+    # trail the anchored ones by up to 1 cm while the feet settle in the first second, and on sensor seed 3 the stance
+    # they leave creeps over the ground at about 1 mm/s (measured: 4.48 cm in 60 s; with the anchored targets from
+    # the first second on instead of the start, 4.44 cm).
+    com, feet = _standing_run(60.0, seed=3, motion=MotionConfig(reference_follows_standing_s=None))
+    assert np.linalg.norm(com - com[0], axis=1).max() > 0.03
+    assert np.abs(feet[-1] - feet[0]).max() > 0.03  # the soles, not the body over them
 
 
 @pytest.mark.in_place

@@ -135,6 +135,11 @@ class MotionConfig:
     # 2-3 m/s while the COM task still pulled the body on towards them: it reached his stop too fast to stop
     # (docs/decisions.md, "Targets that ran ahead of the character") [m]
     reference_lead_max_m: float | None = 0.3
+    # ... and with this time constant instead once he has stood for a second (his COM below 0.05 m/s, now and over
+    # his way) and the targets have come within 5 mm of the anchored ones. With the walking time constant a standing
+    # character's soles crept over the ground, the targets trailing them (4.5 cm in 60 s on one sensor seed;
+    # docs/decisions.md, "A standing character's creep"). None: reference_follows_operator_s throughout [s]
+    reference_follows_standing_s: float | None = 0.0
     # Weight shift before a lift-off from standing (pose_optimization._can_lift): the operator lifts a foot after a
     # double stance of at least liftoff_after_stand_s [s] with his capture point over his other sole (within
     # liftoff_margin_m [m] of its inner edge, sideways); while the character's is further than that inwards of its

@@ -91,6 +91,12 @@ _SCALE_SMOOTHING = 0.02  # per tick, exponential average of the operator's leg l
 _BALL_JOINTS = [k for k, j in enumerate(JOINTS) if j.kind is JointKind.BALL]
 _HINGE_JOINTS = [k for k, j in enumerate(JOINTS) if j.kind is not JointKind.BALL]
 _VELOCITY_SMOOTHING = 0.2  # per tick, exponential average of the desired COM velocity
+# He stands while on both feet with his COM's scaled speed, now and averaged over his way (operator_way.py), below
+# this; the targets then follow the anchored ones with MotionConfig.reference_follows_standing_s once they are within
+# _STANDING_LEAD_M of them (a walk's lead is first taken up at the walking time constant) [m/s], [m]
+_STANDING_SPEED_MPS = 0.05
+_STANDING_FOR_S = 1.0  # ... and has stood so for this long (not a pause between two jumps or in a dance) [s]
+_STANDING_LEAD_M = 0.005
 _GAIT_AXIS_COS = math.cos(math.radians(GAIT_AXIS_DEG))
 _SIDE_UP = {"left": "LEFT", "right": "RIGHT"}
 # A crouch: his trunk (pelvis to neck) within this of the vertical. Lying, crawling, rolling, it is further [deg]
@@ -283,6 +289,8 @@ class MotionOptimizer:
         self._hold_velocity: np.ndarray | None = None  # the desired COM velocity a late-contact hold began with
         self._hold_shift = np.zeros(2)  # the held targets' travel since the hold began [m]
         self._ref_xy: np.ndarray | None = None  # (pelvis, COM) x (x, y) targets that follow the operator [m]
+        # since when he has stood (_STANDING_SPEED_MPS; before the start if he stands from it) [s]
+        self._stands_since_s: float | None = -math.inf
         self._swing: str | None = None
         self._feet_by_own_step = False  # the character's last step was its own (a recovery step), not one of his
         self.path = PathReference(cfg.path_feedback_share, cfg.path_feedback_max_m, cfg.path_target_share,
@@ -540,7 +548,11 @@ class MotionOptimizer:
             pelvis_xy[:2] += pull
             com_xy[:2] += pull
         tau = self.cfg.reference_follows_operator_s
-        if tau > 0:
+        if (self.cfg.reference_follows_standing_s is not None and self._he_stands(state, scale, tick.op_state)
+                and self._ref_xy is not None
+                and float(np.abs(self._ref_xy - np.array([pelvis_xy[:2], com_xy[:2]])).max()) < _STANDING_LEAD_M):
+            tau = self.cfg.reference_follows_standing_s
+        if self.cfg.reference_follows_operator_s > 0:
             # Opt-in: the targets advance at the operator's COM velocity (scaled), pulled towards the anchored ones
             # with time constant tau, instead of taking up each anchor change as a decaying offset (which moves the
             # targets back at every stance change of a character whose steps are shorter than his, and brakes it).
@@ -553,7 +565,7 @@ class MotionOptimizer:
                 self._ref_xy = raw.copy()
             else:
                 pred = self._ref_xy + v_ff * self.dt_s
-                self._ref_xy = pred + (self.dt_s / tau) * (raw - pred)
+                self._ref_xy = pred + min(self.dt_s / max(tau, 1e-9), 1.0) * (raw - pred)
                 lead_max = self.cfg.reference_lead_max_m
                 if lead_max is not None:  # no further from the anchored targets than this
                     lead = self._ref_xy - raw
@@ -592,6 +604,16 @@ class MotionOptimizer:
         if self.path.enabled:
             xi_c, omega = capture_point(com_c, tick.com_vel_c, self.g)
             self.path.update(state.root_pos_world, p_h, xi_c, self._operator_capture_point(tick), scale, omega)
+
+    def _he_stands(self, state: CharacterState, scale: float, op_state: Stance) -> bool:
+        """Whether he has stood on both feet for _STANDING_FOR_S or longer (``op_state`` his stance): his COM's scaled
+        speed below _STANDING_SPEED_MPS, now and averaged over his way (operator_way.py), and no foot lifted (a spin
+        on the spot steps); standing from the start counts from before it."""
+        if op_state is not Stance.DS or self.way.goes(_STANDING_SPEED_MPS, scale * self._com_h_rate.rate[:2]):
+            self._stands_since_s = None
+        elif self._stands_since_s is None:
+            self._stands_since_s = state.time_s
+        return self._stands_since_s is not None and state.time_s - self._stands_since_s >= _STANDING_FOR_S
 
     def _capture_near_support(self, tick: _Tick, state: CharacterState, within_m: float,
                               sides: list[str] | None = None) -> bool:
