@@ -35,8 +35,10 @@ def _drops_for_resting_feet(gap_m: float | None) -> int:
 
     def configure(cfg):
         cfg = follow_path(cfg)
-        # (traced before the bound on the targets' lead, off here)
-        motion = dataclasses.replace(cfg.motion, landing_reach_ground_gap_m=gap_m, reference_lead_max_m=None)
+        # (traced before the bound on the targets' lead and the targets on the anchored ones while he stands, off
+        # here)
+        motion = dataclasses.replace(cfg.motion, landing_reach_ground_gap_m=gap_m, reference_lead_max_m=None,
+                                     reference_follows_standing_s=None)
         return dataclasses.replace(cfg, motion=motion, duration_s=6.75)
 
     suite_run("builtin:dance_a", 15, MotionConfig(), ControlConfig(), on_tick=on_tick, configure=configure)

@@ -135,10 +135,11 @@ class MotionConfig:
     # 2-3 m/s while the COM task still pulled the body on towards them: it reached his stop too fast to stop
     # (docs/decisions.md, "Targets that ran ahead of the character") [m]
     reference_lead_max_m: float | None = 0.3
-    # ... and with this time constant instead once he has stood for a second (his COM below 0.05 m/s, now and over
-    # his way) and the targets have come within 5 mm of the anchored ones. With the walking time constant a standing
-    # character's soles crept over the ground, the targets trailing them (4.5 cm in 60 s on one sensor seed;
-    # docs/decisions.md, "A standing character's creep"). None: reference_follows_operator_s throughout [s]
+    # ... and with this time constant instead once he has stood on both feet for a second (his COM below 0.05 m/s,
+    # now and over his way) and the targets have come within 5 mm of the anchored ones. With the walking time
+    # constant the targets trailed the feet settling in the first second, and the stance left crept over the ground
+    # (4.5 cm in 60 s on one sensor seed; docs/decisions.md, "A standing character's creep"). None:
+    # reference_follows_operator_s throughout [s]
     reference_follows_standing_s: float | None = 0.0
     # Weight shift before a lift-off from standing (pose_optimization._can_lift): the operator lifts a foot after a
     # double stance of at least liftoff_after_stand_s [s] with his capture point over his other sole (within
@@ -843,6 +844,7 @@ IN_PLACE_MOTION: dict[str, Any] = {
     "capture_bound_before_his_landing": True,
     "gait_capture_step_s": None,
     "reference_follows_operator_s": 0.0,  # the targets anchored on its feet (Eq. 10)
+    "reference_follows_standing_s": None,  # (moot with the above; the former default had none)
     "reference_lead_max_m": None,
     "path_feedback_share": 0.0,  # no landing moved towards his path
     "recovery_walk_on_m": None,  # its own steps stop the body
