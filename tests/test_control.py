@@ -130,6 +130,15 @@ def test_free_character_stands_60_s_within_2_cm_with_a_standing_operator(seed):
     assert np.linalg.norm(com - com[0], axis=1).max() < 0.02
 
 
+def test_the_standing_time_constant_is_validated_and_in_place_keeps_none():
+    from stylesync.config import ConfigError, in_place
+
+    assert MotionConfig().reference_follows_standing_s == 0.0
+    assert in_place(SessionConfig()).motion.reference_follows_standing_s is None
+    with pytest.raises(ConfigError, match="reference_follows_standing_s"):
+        MotionConfig(reference_follows_standing_s=-0.1)
+
+
 def test_targets_that_trail_the_settling_feet_leave_a_stance_that_creeps():
     # With the walking time constant while he stands (MotionConfig.reference_follows_standing_s None), the targets
     # trail the anchored ones by up to 1 cm while the feet settle in the first second, and on sensor seed 3 the stance

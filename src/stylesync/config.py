@@ -533,6 +533,8 @@ class MotionConfig:
         _non_negative("MotionConfig.reference_follows_operator_s", self.reference_follows_operator_s)
         if self.reference_lead_max_m is not None:
             _non_negative("MotionConfig.reference_lead_max_m", self.reference_lead_max_m)
+        if self.reference_follows_standing_s is not None:
+            _non_negative("MotionConfig.reference_follows_standing_s", self.reference_follows_standing_s)
         _non_negative("MotionConfig.path_feedback_share", self.path_feedback_share)
         _non_negative("MotionConfig.path_feedback_max_m", self.path_feedback_max_m)
         if not 0.0 <= self.path_target_share <= 1.0:
