@@ -889,6 +889,7 @@ FOLLOW_PATH_MOTION: dict[str, Any] = {
     "gait_capture_step_s": 0.3,  # but its capture point runs ahead no further than a step then catches
     "reference_follows_operator_s": 0.5,  # the targets go on at his speed
     "reference_lead_max_m": 0.3,  # but no further than this from the anchored ones
+    "reference_follows_standing_s": 0.0,  # and are the anchored ones once he has stood for a second
     "path_feedback_share": 0.5,  # each landing takes up half the path's error
     "recovery_walk_on_m": 0.1,  # its own steps walk on while he walks
     "recovery_walk_on_his_way": True,  # along his way over the ground, a divergence across it caught
