@@ -879,28 +879,22 @@ def in_place(cfg: SessionConfig) -> SessionConfig:
     return with_settings(cfg, IN_PLACE_MOTION, IN_PLACE_WHOLE_BODY, IN_PLACE_OPERATOR)
 
 
+def _defaults(cls: type, names: dict[str, Any]) -> dict[str, Any]:
+    """The field defaults of the dataclass ``cls`` for the keys of ``names``."""
+    fields = {f.name: f.default for f in dataclasses.fields(cls)}
+    return {name: fields[name] for name in names}
+
+
 # Following the operator's path over the ground closer still, at a cost in falls and in his gait's timing: the
-# targets pulled onto his path besides the settings below, which are the defaults (docs/decisions.md, "Following
-# the operator's path by the landing", "Targets on his path"): `--follow-path`.
-FOLLOW_PATH_MOTION: dict[str, Any] = {
-    "double_stance_keeps_momentum_m": 0.1,  # a gait's double stance does not brake it
-    "capture_bound_in_his_gait": False,  # nor does the capture bound while he walks
-    "capture_bound_before_his_landing": False,  # nor while its step has landed before his
-    "gait_capture_step_s": 0.3,  # but its capture point runs ahead no further than a step then catches
-    "reference_follows_operator_s": 0.5,  # the targets go on at his speed
-    "reference_lead_max_m": 0.3,  # but no further than this from the anchored ones
-    "reference_follows_standing_s": 0.0,  # and are the anchored ones once he has stood for a second
-    "path_feedback_share": 0.5,  # each landing takes up half the path's error
-    "recovery_walk_on_m": 0.1,  # its own steps walk on while he walks
-    "recovery_walk_on_his_way": True,  # along his way over the ground, a divergence across it caught
-    "gait_min_way_speed_mps": 0.3,  # a gait only while he goes somewhere (not a sway on the spot, not a stop)
+# defaults of every setting `--in-place` changes (so that it gives the same settings over any base), and besides them
+# the targets pulled onto his path (docs/decisions.md, "Following the operator's path by the landing", "Targets on
+# his path"): `--follow-path`.
+FOLLOW_PATH_MOTION: dict[str, Any] = _defaults(MotionConfig, IN_PLACE_MOTION) | {
     "path_target_share": 1.0,  # the targets pulled to his path, at most path_target_max_m (0.3 m) ahead
     "landing_reach_ground_gap_m": 0.003,  # a foot lying on the ground, pressing or not, lowers no pelvis target
 }
-# ... and in the whole-body controller (docs/decisions.md, "Targets on his path")
-FOLLOW_PATH_WHOLE_BODY: dict[str, Any] = {
-    "own_step_push_bound": "always",  # the push of the character's own steps bounded while he walks too
-}
+# ... in the whole-body controller: the push of the character's own steps bounded while he walks too
+FOLLOW_PATH_WHOLE_BODY: dict[str, Any] = _defaults(WholeBodyConfig, IN_PLACE_WHOLE_BODY)
 
 
 # The opt-ins that let a kick strike (docs/decisions.md, "A kick that strikes: the free swing"): `--free-swing`.
@@ -927,11 +921,8 @@ def no_track_rise(cfg: SessionConfig) -> SessionConfig:
     return with_settings(cfg, whole_body=NO_TRACK_RISE_WHOLE_BODY)
 
 
-# ... and for a recording: started at its own velocities, no faster than FOLLOW_PATH_START_SPEED_MAX_MPS (the default)
-FOLLOW_PATH_OPERATOR: dict[str, Any] = {
-    "start_with_clip_velocity": True,
-    "start_speed_max_mps": FOLLOW_PATH_START_SPEED_MAX_MPS,
-}
+# ... and for a recording: started at its own velocities, no faster than FOLLOW_PATH_START_SPEED_MAX_MPS
+FOLLOW_PATH_OPERATOR: dict[str, Any] = _defaults(OperatorConfig, IN_PLACE_OPERATOR)
 
 
 def follow_path(cfg: SessionConfig) -> SessionConfig:

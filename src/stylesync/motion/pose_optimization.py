@@ -548,19 +548,19 @@ class MotionOptimizer:
             pelvis_xy[:2] += pull
             com_xy[:2] += pull
         tau = self.cfg.reference_follows_operator_s
-        if (self.cfg.reference_follows_standing_s is not None and self._he_stands(state, scale, tick.op_state)
-                and self._ref_xy is not None
-                and float(np.abs(self._ref_xy - np.array([pelvis_xy[:2], com_xy[:2]])).max()) < _STANDING_LEAD_M):
-            tau = self.cfg.reference_follows_standing_s
-        if self.cfg.reference_follows_operator_s > 0:
-            # Opt-in: the targets advance at the operator's COM velocity (scaled), pulled towards the anchored ones
-            # with time constant tau, instead of taking up each anchor change as a decaying offset (which moves the
-            # targets back at every stance change of a character whose steps are shorter than his, and brakes it).
+        if tau > 0:
+            # The targets advance at the operator's COM velocity (scaled), pulled towards the anchored ones with time
+            # constant tau, instead of taking up each anchor change as a decaying offset (which moves the targets back
+            # at every stance change of a character whose steps are shorter than his, and brakes it); while he stands,
+            # once they are on the anchored ones, with reference_follows_standing_s.
+            raw = np.array([pelvis_xy[:2], com_xy[:2]])
+            if (self.cfg.reference_follows_standing_s is not None and self._he_stands(state, scale, tick.op_state)
+                    and self._ref_xy is not None and float(np.abs(self._ref_xy - raw).max()) < _STANDING_LEAD_M):
+                tau = self.cfg.reference_follows_standing_s
             if self.char_fsm.hold_reference and self._hold_velocity is not None:
                 v_ff = self._hold_velocity
             else:
                 v_ff = scale * self._com_h_rate.rate[:2]
-            raw = np.array([pelvis_xy[:2], com_xy[:2]])
             if self._ref_xy is None:
                 self._ref_xy = raw.copy()
             else:
