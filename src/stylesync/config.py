@@ -174,6 +174,11 @@ class MotionConfig:
     # in the heading frame) and his raised foot is behind it, his single stance is read as a double stance.
     # None: off.
     rear_foot_support_margin_m: float | None = 0.02
+    # ... and once read so, until his capture point is less than the margin minus this behind the heel: a slow,
+    # low stride (a sneaky walk) keeps his capture point within a centimetre of the margin for a few tenths of a
+    # second, and read without a band his stance flickered between double and single every 0.02-0.1 s, each flicker
+    # a lift-off and a landing of his (docs/decisions.md, "His stance read through a band") [m]
+    rear_foot_support_hysteresis_m: float = 0.02
     # ... but not while his way over the ground (operator_way.py, the last second's, in his own heading frame) goes
     # backwards at least this fast: the raised rear foot steps, as in a backward walk, where his capture point lies
     # behind the stance heel at every step (docs/decisions.md, "A backward walk"). None: whatever his way [m/s].
@@ -483,6 +488,7 @@ class MotionConfig:
         _positive("MotionConfig.stance_height_threshold_m", self.stance_height_threshold_m)
         if self.rear_foot_stepping_way_mps is not None:
             _non_negative("MotionConfig.rear_foot_stepping_way_mps", self.rear_foot_stepping_way_mps)
+        _non_negative("MotionConfig.rear_foot_support_hysteresis_m", self.rear_foot_support_hysteresis_m)
         if self.airborne_ankle_height_leg is not None:
             _positive("MotionConfig.airborne_ankle_height_leg", self.airborne_ankle_height_leg)
         if self.pelvis_min_height_m is not None:
