@@ -422,18 +422,19 @@ class MotionOptimizer:
         mid-stride starts with his filtered velocity at rest, his capture point on his COM, between his feet. Once
         read so, the foot bears weight until his capture point is ``rear_foot_support_hysteresis_m`` less far
         behind the heel than the margin (a band, as the stance threshold's)."""
-        raised = "RIGHT" if op_state is Stance.LS else "LEFT"
-        bears = self._rear_foot_behind_heel(sample, analysis, op_state)
+        stance, raised = ("LEFT", "RIGHT") if op_state is Stance.LS else ("RIGHT", "LEFT")
+        bears = self._rear_foot_behind_heel(sample, analysis, stance, raised)
         self._rear_foot_bearing = raised if bears else None
         return bears
 
-    def _rear_foot_behind_heel(self, sample: OperatorSample, analysis: OperatorAnalysis, op_state: Stance) -> bool:
-        """The test of :meth:`_rear_foot_bears_weight`, with its band."""
+    def _rear_foot_behind_heel(self, sample: OperatorSample, analysis: OperatorAnalysis, stance: str,
+                               raised: str) -> bool:
+        """The test of :meth:`_rear_foot_bears_weight` for his ``stance`` and ``raised`` feet ("LEFT"/"RIGHT"), with
+        its band."""
         margin = self.cfg.rear_foot_support_margin_m
         if margin is None or self._op_leg_m is None or sample.time_s < OPERATOR_VELOCITY_SETTLE_S:
             return False
         scale = CHAR_LEG_LENGTH_M / self._op_leg_m
-        stance, raised = ("LEFT", "RIGHT") if op_state is Stance.LS else ("RIGHT", "LEFT")
         if self._rear_foot_bearing == raised:
             margin -= self.cfg.rear_foot_support_hysteresis_m
         forward = rot.matrix_from_quat(analysis.root_quat_wxyz)[:, 0]
