@@ -52,8 +52,10 @@ def traced_motion(**kwargs) -> MotionConfig:
     it. They were traced before a recovery step's timing adapted to its reach (``recovery_swing_min_s`` None), and
     before a lift-off waited for the other foot to be down (``liftoff_needs_other_foot_down`` off), and while a
     lift-off onto a sole the capture point has passed waited only the weight shift's time (``liftoff_behind_waits``
-    off), and before the pelvis target came down as his swing went (``swing_landing_within_reach`` off)."""
+    off), and before the pelvis target came down as his swing went (``swing_landing_within_reach`` off), and before
+    his raised rear foot was read through a band (``rear_foot_support_hysteresis_m`` 0)."""
     return MotionConfig(**{"swing_landing": "his_foot_now", "recovery_overdue_swing_horizon": False,
+                           "rear_foot_support_hysteresis_m": 0.0,
                            "recovery_swing_min_s": None, "liftoff_needs_other_foot_down": False,
                            "liftoff_behind_waits": False, "swing_landing_within_reach": False,
                            "recovery_cross_nearest": False, "recovery_cross_stance_frame": False,
@@ -1170,10 +1172,12 @@ def test_a_recovery_step_just_short_of_its_crossover_clearance_lands_on_the_capt
         return found
 
     # Traced before a foot in the air nearer the capture point was left to land (recovery_landing_foot_waits): the
-    # left foot, over the right sole and a centimetre nearer the capture point, now lands first and the right steps.
-    new = run(MotionConfig(recovery_landing_foot_waits=False, swing_landing_within_reach=False))
+    # left foot, over the right sole and a centimetre nearer the capture point, now lands first and the right steps;
+    # and before his raised rear foot was read through a band.
+    new = run(MotionConfig(recovery_landing_foot_waits=False, swing_landing_within_reach=False,
+                           rear_foot_support_hysteresis_m=0.0))
     old = run(MotionConfig(recovery_landing_foot_waits=False, swing_landing_within_reach=False,
-                           recovery_cross_nearest=False,
+                           rear_foot_support_hysteresis_m=0.0, recovery_cross_nearest=False,
                            recovery_cross_stance_frame=False))
     assert new["side"] == old["side"] == "left"
     assert new["foot_xy"][0] > 0.3 and old["foot_xy"][0] < 0.0  # measured: 0.42 m ahead; 0.12 m behind

@@ -31,10 +31,11 @@ def _dance(forward: bool) -> tuple[bool, float | None, int, float]:
         return on_tick
 
     def configure(cfg):  # traced before the pelvis target came down as his swing went (swing_landing_within_reach)
-        cfg = follow_path(cfg)  # ... before a backward way made his raised rear foot a stepping one, and before the
-        # targets stood on the anchored ones while he stands
+        cfg = follow_path(cfg)  # ... before a backward way made his raised rear foot a stepping one, before the
+        # targets stood on the anchored ones while he stands, and before his raised rear foot was read through a band
         motion = dataclasses.replace(cfg.motion, recovery_walk_on_forward=forward, swing_landing_within_reach=False,
-                                     rear_foot_stepping_way_mps=None, reference_follows_standing_s=None)
+                                     rear_foot_stepping_way_mps=None, reference_follows_standing_s=None,
+                                     rear_foot_support_hysteresis_m=0.0)
         return dataclasses.replace(cfg, duration_s=6.5, motion=motion)
 
     result = suite_run("builtin:dance_a", 2, MotionConfig(), TRACED_BEFORE_PRESS, watch=watch, configure=configure)
