@@ -267,7 +267,7 @@ class MotionOptimizer:
         self.char_fsm = CharacterStanceFsm(cfg.late_contact_timeout_s, cfg.min_swing_s,
                                            cfg.liftoff_needs_other_foot_down)
         self._op_leg_m: float | None = None
-        self._rear_foot_bearing: str | None = None  # his raised foot read as bearing weight at the last tick
+        self._rear_foot_bearing: str | None = None  # the side of his raised foot read as bearing weight, last tick
         self._held: OperatorSample | None = None
         self._com_d_rate = _SmoothedRate(self.dt_s)  # desired COM velocity [m/s]
         self._com_h_rate = _SmoothedRate(self.dt_s)  # operator COM velocity [m/s]
@@ -420,22 +420,15 @@ class MotionOptimizer:
         behind the heel, his way going backwards in his own frame (``rear_foot_stepping_way_mps``): that foot steps.
         Not before the operator's COM velocity has settled (OPERATOR_VELOCITY_SETTLE_S): a recording that starts
         mid-stride starts with his filtered velocity at rest, his capture point on his COM, between his feet. Once
-        read so, the foot bears weight until his capture point is ``rear_foot_support_hysteresis_m`` less far
-        behind the heel than the margin (a band, as the stance threshold's)."""
-        stance, raised = ("LEFT", "RIGHT") if op_state is Stance.LS else ("RIGHT", "LEFT")
-        bears = self._rear_foot_behind_heel(sample, analysis, stance, raised)
-        self._rear_foot_bearing = raised if bears else None
-        return bears
-
-    def _rear_foot_behind_heel(self, sample: OperatorSample, analysis: OperatorAnalysis, stance: str,
-                               raised: str) -> bool:
-        """The test of :meth:`_rear_foot_bears_weight` for his ``stance`` and ``raised`` feet ("LEFT"/"RIGHT"), with
-        its band."""
+        read so (``_rear_foot_bearing``, the raised side, kept by :meth:`_track_stance`), the foot bears weight
+        until his capture point is ``rear_foot_support_hysteresis_m`` less far behind the heel than the margin (a
+        band, as the stance threshold's)."""
         margin = self.cfg.rear_foot_support_margin_m
         if margin is None or self._op_leg_m is None or sample.time_s < OPERATOR_VELOCITY_SETTLE_S:
             return False
         scale = CHAR_LEG_LENGTH_M / self._op_leg_m
-        if self._rear_foot_bearing == raised:
+        stance, raised = ("LEFT", "RIGHT") if op_state is Stance.LS else ("RIGHT", "LEFT")
+        if self._rear_foot_bearing == swing_side(op_state):
             margin -= self.cfg.rear_foot_support_hysteresis_m
         forward = rot.matrix_from_quat(analysis.root_quat_wxyz)[:, 0]
         a = sample.pos[f"ANKLE_{stance}"]
@@ -455,9 +448,10 @@ class MotionOptimizer:
         """Both stance FSMs, the operator's swing time, and the sample the reference follows (held while the
         character waits for a late contact)."""
         op_state = self.op_fsm.update(sample.pos["ANKLE_LEFT"][2], sample.pos["ANKLE_RIGHT"][2])
-        if op_state is Stance.DS:
-            self._rear_foot_bearing = None  # both feet down by their heights: the band starts afresh
-        elif self._rear_foot_bears_weight(sample, analysis, op_state):
+        # His raised foot read as bearing weight (its side, for the band; none once his ankle heights say DS)
+        bears = op_state is not Stance.DS and self._rear_foot_bears_weight(sample, analysis, op_state)
+        self._rear_foot_bearing = swing_side(op_state) if bears else None
+        if bears:
             op_state = Stance.DS
         contact = self._feet_down(state)
         # Only a lift-off from double stance can wait for the weight to shift.
