@@ -446,6 +446,16 @@ class MotionConfig:
     # his as a lag (docs/decisions.md, "Targets on his path"). 0: off [-], [m].
     path_target_share: float = 0.0
     path_target_max_m: float = 0.3
+    # Steps to where he stands (motion/rest_step.py; docs/decisions.md, "Steps to where he stands"): once he and his
+    # feet have stood still, each of the character's feet has his foot's place on its path; the foot that a step
+    # brings the most nearer its place, by rest_step_min_m at least, steps there on its own (at most
+    # rest_step_reach_m from where it lifts off and from the other foot, its swing rest_step_swing_s long), after the
+    # weight has moved over the other foot (the COM target moved there, and back after the landing, at
+    # rest_step_shift_mps). None: the character stays where it stopped [m], [m/s], [s], [m].
+    rest_step_min_m: float | None = 0.1
+    rest_step_shift_mps: float = 2.0
+    rest_step_swing_s: float = 0.4
+    rest_step_reach_m: float = 0.35
     # An operator's ankle higher than this share of his leg above his floor (the lowest his ankles have been, rising
     # slowly) bears no weight (on the ball of his foot an ankle rises by at most its distance to the ball, about
     # 0.15 m for a 0.9 m leg): on a stance foot that high he is in the air, and the pelvis height of Eq. 9 is
@@ -546,6 +556,11 @@ class MotionConfig:
         if not 0.0 <= self.path_target_share <= 1.0:
             raise ConfigError(f"MotionConfig.path_target_share must be within [0, 1], got {self.path_target_share}")
         _non_negative("MotionConfig.path_target_max_m", self.path_target_max_m)
+        if self.rest_step_min_m is not None:
+            _non_negative("MotionConfig.rest_step_min_m", self.rest_step_min_m)
+        _positive("MotionConfig.rest_step_shift_mps", self.rest_step_shift_mps)
+        _positive("MotionConfig.rest_step_swing_s", self.rest_step_swing_s)
+        _positive("MotionConfig.rest_step_reach_m", self.rest_step_reach_m)
         for n in ("liftoff_weight_shift_s", "liftoff_after_stand_s", "liftoff_margin_m"):
             _non_negative(f"MotionConfig.{n}", getattr(self, n))
         if self.liftoff_shift_outward_m is not None:
@@ -859,6 +874,7 @@ IN_PLACE_MOTION: dict[str, Any] = {
     "recovery_walk_on_his_way": False,
     "gait_min_way_speed_mps": None,
     "path_target_share": 0.0,
+    "rest_step_min_m": None,  # it stays where it stopped
 }
 IN_PLACE_WHOLE_BODY: dict[str, Any] = {
     "own_step_push_bound": "he_stands",

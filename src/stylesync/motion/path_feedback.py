@@ -67,14 +67,21 @@ class PathReference:
         bounded to ``max_m``: what the landing moves by."""
         return _bounded(deadbeat_gain(self.omega_per_s, step_s) * self.share * self.error_xy, self.max_m)
 
+    def on_path_xy(self, op_point_world: np.ndarray, scale: float) -> np.ndarray | None:
+        """(2,) [m], world frame: a point of the operator's scaled by ``scale`` about his first pelvis ground point and
+        moved onto the character's; None before the first :meth:`update`."""
+        if self._char_origin_xy is None or self._op_origin_xy is None:
+            return None
+        return self._char_origin_xy + scale * (np.asarray(op_point_world, dtype=float)[:2] - self._op_origin_xy)
+
     def target_pull_xy(self, com_target_world: np.ndarray, op_com_world: np.ndarray, scale: float) -> np.ndarray:
         """(2,) [m], world frame: what the targets move by, ``target_share`` of the way from the COM target
         ``com_target_world`` to the operator's COM ``op_com_world`` scaled by ``scale`` about his first pelvis
         ground point onto the character's, at most ``target_max_m``; zero before the first :meth:`update` or when
         off."""
-        if self.target_share <= 0.0 or self._char_origin_xy is None or self._op_origin_xy is None:
+        his = self.on_path_xy(op_com_world, scale)
+        if self.target_share <= 0.0 or his is None:
             return np.zeros(2)
-        his = self._char_origin_xy + scale * (np.asarray(op_com_world, dtype=float)[:2] - self._op_origin_xy)
         return _bounded(self.target_share * (his - np.asarray(com_target_world, dtype=float)[:2]), self.target_max_m)
 
 

@@ -66,6 +66,7 @@ from stylesync.motion.recovery_step import (
     support_outside_m,
 )
 from stylesync.motion.reference import LipmMap, MotionReading, ReferencePose
+from stylesync.motion.rest_step import REST_FOOT_MIN_WEIGHT, WEIGHT_OVER_SOLE_M, rest_step_plan
 from stylesync.motion.stance_fsm import (
     CharacterStanceFsm,
     OperatorStanceFsm,
@@ -97,6 +98,11 @@ _VELOCITY_SMOOTHING = 0.2  # per tick, exponential average of the desired COM ve
 _STANDING_SPEED_MPS = 0.05
 _STANDING_FOR_S = 1.0  # ... and has stood so for this long (not a pause between two jumps or in a dance) [s]
 _STANDING_LEAD_M = 0.005
+# His feet are at rest (steps to where he stands, rest_step.py) below this speed over the ground, scaled [m/s], smoothed
+# over this time [s]: standing, the sensor's noise moves them at most 0.05 m/s; a foot he slides or turns in a dance
+# goes 0.4-1.2 m/s
+_FEET_STILL_MPS = 0.1
+_FEET_SPEED_SMOOTHING_S = 0.1
 _GAIT_AXIS_COS = math.cos(math.radians(GAIT_AXIS_DEG))
 _SIDE_UP = {"left": "LEFT", "right": "RIGHT"}
 # A crouch: his trunk (pelvis to neck) within this of the vertical. Lying, crawling, rolling, it is further [deg]
@@ -233,6 +239,8 @@ class _Tick:
     targets: dict[str, np.ndarray] = field(default_factory=dict)  # ankle targets
     foot_yaw: dict[str, float] = field(default_factory=dict)
     step_exceeded: bool = False
+    he_stands: bool = False  # he has stood still for a while (MotionOptimizer._he_stands)
+    his_feet_still: bool = False  # his feet at rest (MotionOptimizer._his_feet_still)
     swing_landing_xy: np.ndarray | None = None  # where the swing ankle is planned to land (his swing) [m]
     # The operator's capture point and whether it is within the soles he stands on, computed once a tick
     xi_h: np.ndarray | None = None
@@ -243,6 +251,12 @@ def _sole_within_m(state: CharacterState, side: str, gap_m: float) -> bool:
     """Whether the lowest corner of the sole on ``side`` is within ``gap_m`` of the ground (model/sole.py)."""
     ankle = _LINK[f"{side}_ankle"]
     return sole_within_m(state.link_origin_world[ankle], state.link_quat_wxyz[ankle], gap_m)
+
+
+def _within(vector: np.ndarray, max_norm: float) -> np.ndarray:
+    """``vector`` shortened to at most ``max_norm`` long."""
+    norm = float(np.linalg.norm(vector))
+    return vector * (max_norm / norm) if norm > max_norm else vector
 
 
 def _trunk_upright(pelvis_to_neck: np.ndarray) -> bool:
@@ -317,6 +331,14 @@ class MotionOptimizer:
         self._op_ds_s = OPERATOR_DOUBLE_STANCE_S
         self._outside_since_s: float | None = None  # the character's capture point left its double support then [s]
         self._stopping_capture_side: str | None = None  # the swing whose landing _stopping_landing moved last tick
+        # Steps to where he stands (rest_step.py): the foot the weight is on (shifting to it, or standing on it while
+        # the other steps), decided each tick; the COM target's offset that moves the weight there, and that target
+        self._rest_stance: str | None = None
+        self._rest_offset_xy = np.zeros(2)
+        self._rest_com_xy: np.ndarray | None = None
+        self.rest_steps = 0  # steps taken to where he stands
+        self._his_feet_speed_mps = 0.0  # his feet's fastest speed over the ground, scaled, smoothed [m/s]
+        self._his_feet_last: dict[str, np.ndarray] | None = None
         self._sole_bound = sole_corner_points(cfg.capture_bound_sole_share)  # shrunk for capture_bound.py [m]
         self.reading: MotionReading | None = None  # the last tick's reading of the operator, besides the targets
 
@@ -550,12 +572,19 @@ class MotionOptimizer:
             else:
                 self._hold_velocity, self._hold_shift = None, np.zeros(2)
         self._last_xy = np.array([pelvis_xy[:2], com_xy[:2]])
+        if self.cfg.rest_step_min_m is not None:
+            shift = self._rest_shift_xy(tick, state, com_xy)
+            pelvis_xy[:2] += shift
+            com_xy[:2] += shift
         # Opt-in: both targets moved towards his COM on the character's path (path_feedback.py; after the anchor
         # offset's continuity, which is the feet's, not the path's)
         if self.cfg.path_target_share > 0.0:
             pull = self.path.target_pull_xy(com_xy, com_h, scale)
             pelvis_xy[:2] += pull
             com_xy[:2] += pull
+        tick.he_stands = self._he_stands(state, scale, tick.op_state)
+        if self.cfg.rest_step_min_m is not None:
+            tick.his_feet_still = self._his_feet_still(a_hs, scale)
         tau = self.cfg.reference_follows_operator_s
         if tau > 0:
             # The targets advance at the operator's COM velocity (scaled), pulled towards the anchored ones with time
@@ -563,7 +592,7 @@ class MotionOptimizer:
             # at every stance change of a character whose steps are shorter than his, and brakes it); while he stands,
             # once they are on the anchored ones, with reference_follows_standing_s.
             raw = np.array([pelvis_xy[:2], com_xy[:2]])
-            if (self.cfg.reference_follows_standing_s is not None and self._he_stands(state, scale, tick.op_state)
+            if (self.cfg.reference_follows_standing_s is not None and tick.he_stands
                     and self._ref_xy is not None and float(np.abs(self._ref_xy - raw).max()) < _STANDING_LEAD_M):
                 tau = self.cfg.reference_follows_standing_s
             if self.char_fsm.hold_reference and self._hold_velocity is not None:
@@ -614,6 +643,35 @@ class MotionOptimizer:
             xi_c, omega = capture_point(com_c, tick.com_vel_c, self.g)
             self.path.update(state.root_pos_world, p_h, xi_c, self._operator_capture_point(tick), scale, omega)
 
+    def _rest_shift_xy(self, tick: _Tick, state: CharacterState, com_xy: np.ndarray) -> np.ndarray:
+        """(2,) what the targets move by for a step to where he stands [m]: onto the centre of the sole the weight is
+        to be on (:meth:`_rest_step`), the target moving at most ``rest_step_shift_mps``; back again at that rate once
+        no such step is under way."""
+        limit = self.cfg.rest_step_shift_mps * self.dt_s
+        if self._rest_stance is None:
+            self._rest_com_xy = None
+            self._rest_offset_xy = self._rest_offset_xy - _within(self._rest_offset_xy, limit)
+            return self._rest_offset_xy
+        ankle = tick.a_c[self._rest_stance]
+        yaw = rot.twist_angle(state.link_quat_wxyz[_LINK[f"{self._rest_stance}_ankle"]], _UP)
+        centre = ankle[:2] + FOOT_CENTER_AHEAD_OF_ANKLE_M * np.array([math.cos(yaw), math.sin(yaw)])
+        if self._rest_com_xy is None:
+            self._rest_com_xy = com_xy[:2] + self._rest_offset_xy
+        self._rest_com_xy = self._rest_com_xy + _within(centre - self._rest_com_xy, limit)
+        self._rest_offset_xy = self._rest_com_xy - com_xy[:2]
+        return self._rest_offset_xy
+
+    def _his_feet_still(self, his_feet_world: dict[str, np.ndarray], scale: float) -> bool:
+        """Whether his feet (``his_feet_world``, the ankles Eq. 10 is anchored on) are at rest: their fastest speed over
+        the ground, scaled, smoothed over _FEET_SPEED_SMOOTHING_S, below _FEET_STILL_MPS. His COM may be at rest while
+        a foot slides or turns on the ground (a dance, the start of a spin): his feet are not where he stands then."""
+        last, self._his_feet_last = self._his_feet_last, {k: v[:2].copy() for k, v in his_feet_world.items()}
+        if last is not None:
+            speed = max(float(np.linalg.norm(his_feet_world[k][:2] - last[k])) for k in last) * scale / self.dt_s
+            share = min(self.dt_s / _FEET_SPEED_SMOOTHING_S, 1.0)
+            self._his_feet_speed_mps += share * (speed - self._his_feet_speed_mps)
+        return self._his_feet_speed_mps < _FEET_STILL_MPS
+
     def _he_stands(self, state: CharacterState, scale: float, op_state: Stance) -> bool:
         """Whether he has stood on both feet for _STANDING_FOR_S or longer (``op_state`` his stance): his COM's scaled
         speed below _STANDING_SPEED_MPS, now and averaged over his way (operator_way.py), and no foot lifted (a spin
@@ -660,6 +718,12 @@ class MotionOptimizer:
         self._recovery_step(tick, state)
         self._land_overrun_swing(tick, state)
         tick.weights = stance_weights(tick.ch_state, self._ds_left_share(tick.com_c, tick.a_c))
+        if tick.ch_state is Stance.DS and (self._rest_stance is not None or self._rest_offset_xy.any()):
+            # A weight shift for a step to where he stands, or its release after the landing: the COM over one foot
+            # leaves the other no share of the weight, and a foot with none is free to the controller's tasks (it
+            # slides over the ground). Both keep at least a share.
+            low = REST_FOOT_MIN_WEIGHT
+            tick.weights = {side: min(max(w, low), 1.0 - low) for side, w in tick.weights.items()}
         sw = tick.swing = swing_side(tick.ch_state)
         for side in ("left", "right"):
             if side == sw and self.char_fsm.recovery_step:
@@ -881,6 +945,9 @@ class MotionOptimizer:
         stepper = self.recovery
         if stepper.step is not None and not self.char_fsm.recovery_step:
             stepper.end(state.time_s)
+        self._rest_stance = None  # decided again below (_rest_step)
+        if stepper.step is not None and stepper.step.fixed_landing:
+            self._rest_stance = OTHER_SIDE[stepper.step.side]  # the weight stays on the other foot while it steps
         # The operator stands on both feet, or on one while the character, its step for his counted as taken,
         # stands on both and waits for his next change (the held last frame of a clip cut mid-swing): either way
         # the character does not follow a step of his now.
@@ -901,7 +968,42 @@ class MotionOptimizer:
             self._operator_stands_since_s = state.time_s
         if state.time_s - self._operator_stands_since_s < self.cfg.recovery_min_stance_s:
             return  # a double stance shorter than this is a walk's: his next step is the character's
-        self._begin_recovery_step(tick, state)
+        if not self._begin_recovery_step(tick, state) and self.cfg.rest_step_min_m is not None:
+            self._rest_step(tick, state)
+
+    def _rest_step(self, tick: _Tick, state: CharacterState) -> None:
+        """A step to where he stands (rest_step.py), while he and his feet have stood still (``he_stands``,
+        ``his_feet_still``) and the character stands on both feet with its capture point within their support: the
+        weight moved over the foot that stays (:meth:`_rest_shift_xy`, from the next tick on) while the step is
+        planned, and the step begun once the capture point is WEIGHT_OVER_SOLE_M inside that sole."""
+        cfg = self.cfg
+        assert cfg.rest_step_min_m is not None
+        on_ground = soles_on_ground(state)
+        if len(on_ground) < 2 or not (tick.he_stands and tick.his_feet_still):
+            return
+        quats = {s: state.link_quat_wxyz[_LINK[f"{s}_ankle"]] for s in _SIDE_UP}
+        xi, _ = capture_point(tick.com_c, tick.com_vel_c, self.g)
+        if support_outside_m(xi, tick.a_c, quats, on_ground) > 0.0:
+            return
+        goals = {}
+        for side in _SIDE_UP:  # his feet on the character's path
+            goal = self.path.on_path_xy(tick.s.support_ankle_world[side], tick.scale)
+            if goal is None:
+                return
+            goals[side] = goal
+        plan = rest_step_plan(goals, tick.a_c, tick.R_root_d, cfg.rest_step_min_m, cfg.rest_step_reach_m)
+        if plan is None:
+            return
+        side, landing = plan
+        stance = OTHER_SIDE[side]
+        self._rest_stance = stance
+        if sole_outside_m(xi, tick.a_c[stance], quats[stance]) > -WEIGHT_OVER_SOLE_M:
+            return  # the weight is not over the foot that stays yet
+        self.recovery.begin_to(side, state.time_s, tick.a_c[side], landing, cfg.rest_step_swing_s)
+        tick.ch_state = self.char_fsm.begin_recovery_step(side, state.time_s,
+                                                          cfg.rest_step_swing_s + cfg.late_contact_timeout_s)
+        self._swing_t0_s = state.time_s
+        self.rest_steps += 1
 
     def _begin_recovery_step(self, tick: _Tick, state: CharacterState) -> bool:
         """A recovery step from double stance, if the capture point is outside the support by more than the margin
@@ -1193,7 +1295,8 @@ class MotionOptimizer:
         hands = {k: state.root_pos_world + tick.scale * (tick.s.pos[f"WRIST_{v}"] - tick.p_h)
                  for k, v in _SIDE_UP.items()}
         com_d, com_vel_d = tick.com_d, tick.com_vel_d
-        if self.cfg.recovery_step_free_com and self.char_fsm.recovery_step:
+        rest_step = self.recovery.step is not None and self.recovery.step.fixed_landing  # the weight held over
+        if self.cfg.recovery_step_free_com and self.char_fsm.recovery_step and not rest_step:  # ... the other foot
             # The character's own step: its landing is planned on the capture point of a body left to its pendulum
             # (recovery_step.py); a COM target on the operator's stance would pull the body elsewhere while the foot
             # is in the air, and the foot would land where the capture point no longer goes.

@@ -270,6 +270,7 @@ class RecoveryStep:
     landing_world: np.ndarray  # (3,) the planned landing of the swing ankle, re-planned each tick
     duration_s: float  # the swing's time: the nominal one, shortened while the capture point runs out of reach
     taken_over: bool = False  # the step took over a swing already in the air (it only lands it)
+    fixed_landing: bool = False  # a step to a place chosen before it began (rest_step.py): not re-planned
     # (3,) the target's velocity along the swing profile, the landing held where it is this tick (a new array each
     # tick: the reference pose passes it on as it is) [m/s]
     target_vel_world: np.ndarray = field(default_factory=lambda: np.zeros(3))
@@ -343,6 +344,14 @@ class RecoveryStepper:
         ankle = np.array(swing_ankle_world, dtype=float)
         self.step = RecoveryStep(side, time_s, ankle, ankle.copy(), self.cfg.recovery_swing_s, taken_over=True)
         self.count += 1
+        return self.step
+
+    def begin_to(self, side: str, time_s: float, lift_off_world: np.ndarray, landing_world: np.ndarray,
+                 duration_s: float) -> RecoveryStep:
+        """A step of ``side`` from ``lift_off_world`` to ``landing_world`` ((3,) ankles, world frame [m]) over
+        ``duration_s`` [s], its landing fixed (a step to where the operator stands, rest_step.py)."""
+        self.step = RecoveryStep(side, time_s, np.array(lift_off_world, dtype=float),
+                                 np.array(landing_world, dtype=float), duration_s, fixed_landing=True)
         return self.step
 
     def landing_due(self, time_s: float) -> bool:
@@ -457,15 +466,18 @@ class RecoveryStepper:
         step, cfg = self.step, self.cfg
         assert step is not None
         elapsed = time_s - step.start_s
-        over = self._over_stance(com_world, com_vel_world, stance_ankle_world, stance_foot_quat_wxyz)
-        if cfg.recovery_swing_min_s is not None and elapsed < step.duration_s:
-            # Step timing: the step lands no later than when its capture landing leaves the leg's reach (and no
-            # sooner than the shortest swing); the duration only shortens.
-            reach_s = self._reach_time_over(over, stance_ankle_world, heading_world, walk_on)
-            step.duration_s = min(step.duration_s, max(elapsed + reach_s, cfg.recovery_swing_min_s))
-        landing, _ = self._landing_over(over, max(step.duration_s - elapsed, 0.0), stance_ankle_world,
-                                        stance_foot_quat_wxyz, heading_world, step.side, walk_on)
-        step.landing_world = landing
+        if step.fixed_landing:
+            landing = step.landing_world
+        else:
+            over = self._over_stance(com_world, com_vel_world, stance_ankle_world, stance_foot_quat_wxyz)
+            if cfg.recovery_swing_min_s is not None and elapsed < step.duration_s:
+                # Step timing: the step lands no later than when its capture landing leaves the leg's reach (and
+                # no sooner than the shortest swing); the duration only shortens.
+                reach_s = self._reach_time_over(over, stance_ankle_world, heading_world, walk_on)
+                step.duration_s = min(step.duration_s, max(elapsed + reach_s, cfg.recovery_swing_min_s))
+            landing, _ = self._landing_over(over, max(step.duration_s - elapsed, 0.0), stance_ankle_world,
+                                            stance_foot_quat_wxyz, heading_world, step.side, walk_on)
+            step.landing_world = landing
         phase = elapsed / step.duration_s
         along = phase / HORIZONTAL_SHARE
         moved = smooth_step(min(along, 1.0))

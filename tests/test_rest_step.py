@@ -1,0 +1,144 @@
+"""Steps to where the operator stands (motion/rest_step.py): which foot, where it lands, and when none is taken."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from stylesync.config import ConfigError, MotionConfig
+from stylesync.motion.recovery_step import MIN_FOOT_SEPARATION_M
+from stylesync.motion.rest_step import rest_step_plan
+
+HEADING = np.eye(3)  # x forward, y left
+REACH_M = 0.35
+
+
+def _feet(left_x: float, right_x: float, half_width_m: float = 0.1) -> dict[str, np.ndarray]:
+    return {"left": np.array([left_x, half_width_m, 0.05]), "right": np.array([right_x, -half_width_m, 0.05])}
+
+
+def _moved(feet: dict[str, np.ndarray], by_xy) -> dict[str, np.ndarray]:
+    return {s: a[:2] + np.asarray(by_xy, dtype=float) for s, a in feet.items()}
+
+
+def test_no_step_that_brings_a_foot_less_than_the_distance_nearer():
+    feet = _feet(0.0, 0.0)
+    assert rest_step_plan(_moved(feet, [0.06, -0.07]), feet, HEADING, 0.1, REACH_M) is None
+    assert rest_step_plan(_moved(feet, [0.0, 0.11]), feet, HEADING, 0.1, REACH_M) is not None
+
+
+def test_the_foot_behind_steps_past_the_other_to_its_place():
+    """He stands 0.25 m ahead, feet as the character's: the right foot, 0.1 m behind the left, gets nearer its place
+    than the left can (the left's landing is held within the reach of the right ankle)."""
+    feet = _feet(0.1, 0.0)
+    side, landing = rest_step_plan(_moved(feet, [0.25, 0.0]), feet, HEADING, 0.1, REACH_M)
+    assert side == "right"
+    assert landing == pytest.approx([0.25, -0.1, 0.05])
+    # he stands behind: the left foot, ahead, steps back past the right
+    side, landing = rest_step_plan(_moved(feet, [-0.25, 0.0]), feet, HEADING, 0.1, REACH_M)
+    assert side == "left"
+    assert landing == pytest.approx([-0.15, 0.1, 0.05])
+
+
+def test_a_far_place_is_reached_over_several_steps_within_the_reach():
+    feet = _feet(0.0, 0.0)
+    goals = _moved(feet, [1.0, 0.0])
+    sides = []
+    for _ in range(10):
+        plan = rest_step_plan(goals, feet, HEADING, 0.1, REACH_M)
+        if plan is None:
+            break
+        side, landing = plan
+        other = "left" if side == "right" else "right"
+        assert np.hypot(*(landing - feet[other])[:2]) <= REACH_M + 1e-9
+        feet[side] = landing
+        sides.append(side)
+    assert plan is None and len(sides) >= 4
+    assert all(a != b for a, b in zip(sides, sides[1:], strict=False))  # the feet take turns, as in a walk
+    for side in feet:
+        assert np.linalg.norm(feet[side][:2] - goals[side]) < 0.1
+
+
+def test_a_sideways_place_steps_the_foot_on_that_side_first():
+    """He stands 0.3 m to the right: the left foot could not get nearer than the right one's side (it would land on
+    it); the right foot steps out first, as far as the reach from the left allows, then the feet take turns."""
+    feet = _feet(0.0, 0.0)
+    goals = _moved(feet, [0.0, -0.3])
+    side, landing = rest_step_plan(goals, feet, HEADING, 0.1, REACH_M)
+    assert side == "right"
+    assert landing == pytest.approx([0.0, 0.1 - REACH_M, 0.05])
+    sides = []
+    while (plan := rest_step_plan(goals, feet, HEADING, 0.1, REACH_M)) is not None and len(sides) < 10:
+        feet[plan[0]] = plan[1]
+        sides.append(plan[0])
+    assert sides == ["right", "left", "right"]
+    for side in feet:
+        assert np.linalg.norm(feet[side][:2] - goals[side]) < 0.1
+
+
+def test_a_landing_across_the_other_foot_is_moved_off_it():
+    """His feet crossed (his left 0.3 m ahead and 0.05 m right of where the character's right foot stays): the left
+    lands ahead of the right, outwards of it by the feet's least separation."""
+    feet = _feet(0.0, 0.0)
+    goals = {"left": np.array([0.3, -0.15]), "right": feet["right"][:2]}
+    side, landing = rest_step_plan(goals, feet, HEADING, 0.1, REACH_M)
+    assert side == "left"
+    assert landing[1] == pytest.approx(-0.1 + MIN_FOOT_SEPARATION_M)
+    assert 0.2 < landing[0] <= 0.3  # on its way ahead, no more than the reach from where it lifted off
+    assert np.hypot(*(landing - feet["left"])[:2]) <= REACH_M + 1e-9
+
+
+def test_on_by_default_off_in_place_and_validated():
+    from stylesync.config import SessionConfig, in_place
+
+    assert MotionConfig().rest_step_min_m == 0.1
+    assert in_place(SessionConfig()).motion.rest_step_min_m is None
+    for field in ("rest_step_shift_mps", "rest_step_swing_s", "rest_step_reach_m"):
+        with pytest.raises(ConfigError):
+            MotionConfig(**{field: 0.0})
+    with pytest.raises(ConfigError):
+        MotionConfig(rest_step_min_m=-0.1)
+
+
+def _pushed_while_he_stands(rest_step_min_m: float | None, ball_mps: float = 14.0, seconds: float = 8.0):
+    """The push experiment's standing pattern (he stands still; a football hits the character's chest at 2 s), seed 0:
+    the run and the character's COM distance over the ground from where it stood before the push [m], at the end."""
+    import dataclasses
+
+    from stylesync.config import OperatorConfig, SessionConfig
+    from stylesync.experiments import push
+    from stylesync.session import Session
+    from stylesync.sim.disturbance import throw_ball_at_chest
+    from stylesync.sources.builtin_operator import sensed
+    from stylesync.sources.human_model import HumanModel
+
+    op = OperatorConfig(clip="push-stand")
+    cfg = SessionConfig(duration_s=seconds, seed=0, operator=op)
+    cfg = cfg.replace(motion=dataclasses.replace(cfg.motion, rest_step_min_m=rest_step_min_m,
+                                                 rest_step_shift_mps=2.0, rest_step_swing_s=0.4,
+                                                 rest_step_reach_m=0.35))
+    source = sensed(push.performer("stand", HumanModel(op.height_m, op.mass_kg)), op, cfg.clocks, seconds + 1.0, 0,
+                    "push:stand")
+    thrown: list[int] = []
+
+    def hook(state, ref) -> None:
+        if not thrown and state.time_s >= push.THROW_S:
+            thrown.append(throw_ball_at_chest(session.backend, state, ball_mps, push.BALL_START_M))
+
+    session = Session(cfg, source, on_tick=hook)
+    result = session.run()
+    lg = result.log
+    before = int(np.searchsorted(lg.array("t"), push.THROW_S))
+    moved = np.hypot(lg.array("com_x")[-1] - lg.array("com_x")[before], lg.array("com_y")[-1] - lg.array("com_y")[before])
+    return result, session, float(moved)
+
+
+def test_a_character_pushed_off_its_place_while_he_stands_steps_back_to_it():
+    """Traced: a 14 m/s ball moves the standing character back about 9 cm (its own recovery steps catch it); he has
+    not moved. Without steps to where he stands it stays there; with them, one step brings it back within 3 cm."""
+    stays, session, moved = _pushed_while_he_stands(None)
+    assert not stays.fell and session.motion.rest_steps == 0
+    assert moved > 0.07
+    back, session, moved = _pushed_while_he_stands(0.1)
+    assert not back.fell and session.motion.rest_steps >= 1
+    assert moved < 0.03
