@@ -129,7 +129,8 @@ def _pushed_while_he_stands(rest_step_min_m: float | None, ball_mps: float = 14.
     result = session.run()
     lg = result.log
     before = int(np.searchsorted(lg.array("t"), push.THROW_S))
-    moved = np.hypot(lg.array("com_x")[-1] - lg.array("com_x")[before], lg.array("com_y")[-1] - lg.array("com_y")[before])
+    x, y = lg.array("com_x"), lg.array("com_y")
+    moved = np.hypot(x[-1] - x[before], y[-1] - y[before])
     return result, session, float(moved)
 
 

@@ -65,7 +65,7 @@ class PathReference:
     def landing_shift_xy(self, step_s: float) -> np.ndarray:
         """k δ (2,) [m], world frame, k = share / (e^(ω T) - 1) for the last update's ω and ``step_s`` = T [s],
         bounded to ``max_m``: what the landing moves by."""
-        return _bounded(deadbeat_gain(self.omega_per_s, step_s) * self.share * self.error_xy, self.max_m)
+        return bounded_xy(deadbeat_gain(self.omega_per_s, step_s) * self.share * self.error_xy, self.max_m)
 
     def on_path_xy(self, op_point_world: np.ndarray, scale: float) -> np.ndarray | None:
         """(2,) [m], world frame: a point of the operator's scaled by ``scale`` about his first pelvis ground point and
@@ -82,11 +82,11 @@ class PathReference:
         his = self.on_path_xy(op_com_world, scale)
         if self.target_share <= 0.0 or his is None:
             return np.zeros(2)
-        return _bounded(self.target_share * (his - np.asarray(com_target_world, dtype=float)[:2]), self.target_max_m)
+        return bounded_xy(self.target_share * (his - np.asarray(com_target_world, dtype=float)[:2]), self.target_max_m)
 
 
-def _bounded(shift_xy: np.ndarray, max_m: float) -> np.ndarray:
-    """``shift_xy`` (2,) shortened to at most ``max_m`` [m]."""
+def bounded_xy(shift_xy: np.ndarray, max_m: float) -> np.ndarray:
+    """``shift_xy`` (2,) shortened to at most ``max_m`` long [m]."""
     n = float(np.linalg.norm(shift_xy))
     return shift_xy * (max_m / n) if n > max_m else shift_xy
 

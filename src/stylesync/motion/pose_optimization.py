@@ -51,7 +51,7 @@ from stylesync.motion.his_rise import HisRise
 from stylesync.motion.leg_ik import solve_leg
 from stylesync.motion.operator_analysis import UPPER_JOINTS, OperatorAnalysis, analyse_operator, upper_local
 from stylesync.motion.operator_way import OperatorWay
-from stylesync.motion.path_feedback import PathReference
+from stylesync.motion.path_feedback import PathReference, bounded_xy
 from stylesync.motion.recovery_step import (
     RecoveryStepper,
     WalkOn,
@@ -251,12 +251,6 @@ def _sole_within_m(state: CharacterState, side: str, gap_m: float) -> bool:
     """Whether the lowest corner of the sole on ``side`` is within ``gap_m`` of the ground (model/sole.py)."""
     ankle = _LINK[f"{side}_ankle"]
     return sole_within_m(state.link_origin_world[ankle], state.link_quat_wxyz[ankle], gap_m)
-
-
-def _within(vector: np.ndarray, max_norm: float) -> np.ndarray:
-    """``vector`` shortened to at most ``max_norm`` long."""
-    norm = float(np.linalg.norm(vector))
-    return vector * (max_norm / norm) if norm > max_norm else vector
 
 
 def _trunk_upright(pelvis_to_neck: np.ndarray) -> bool:
@@ -650,14 +644,14 @@ class MotionOptimizer:
         limit = self.cfg.rest_step_shift_mps * self.dt_s
         if self._rest_stance is None:
             self._rest_com_xy = None
-            self._rest_offset_xy = self._rest_offset_xy - _within(self._rest_offset_xy, limit)
+            self._rest_offset_xy = self._rest_offset_xy - bounded_xy(self._rest_offset_xy, limit)
             return self._rest_offset_xy
         ankle = tick.a_c[self._rest_stance]
         yaw = rot.twist_angle(state.link_quat_wxyz[_LINK[f"{self._rest_stance}_ankle"]], _UP)
         centre = ankle[:2] + FOOT_CENTER_AHEAD_OF_ANKLE_M * np.array([math.cos(yaw), math.sin(yaw)])
         if self._rest_com_xy is None:
             self._rest_com_xy = com_xy[:2] + self._rest_offset_xy
-        self._rest_com_xy = self._rest_com_xy + _within(centre - self._rest_com_xy, limit)
+        self._rest_com_xy = self._rest_com_xy + bounded_xy(centre - self._rest_com_xy, limit)
         self._rest_offset_xy = self._rest_com_xy - com_xy[:2]
         return self._rest_offset_xy
 
@@ -1295,8 +1289,9 @@ class MotionOptimizer:
         hands = {k: state.root_pos_world + tick.scale * (tick.s.pos[f"WRIST_{v}"] - tick.p_h)
                  for k, v in _SIDE_UP.items()}
         com_d, com_vel_d = tick.com_d, tick.com_vel_d
-        rest_step = self.recovery.step is not None and self.recovery.step.fixed_landing  # the weight held over
-        if self.cfg.recovery_step_free_com and self.char_fsm.recovery_step and not rest_step:  # ... the other foot
+        # (a step to where he stands holds the weight over the other foot: _rest_shift_xy)
+        rest_step = self.recovery.step is not None and self.recovery.step.fixed_landing
+        if self.cfg.recovery_step_free_com and self.char_fsm.recovery_step and not rest_step:
             # The character's own step: its landing is planned on the capture point of a body left to its pendulum
             # (recovery_step.py); a COM target on the operator's stance would pull the body elsewhere while the foot
             # is in the air, and the foot would land where the capture point no longer goes.
