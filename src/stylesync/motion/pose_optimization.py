@@ -332,7 +332,7 @@ class MotionOptimizer:
         self._rest_com_xy: np.ndarray | None = None
         self.rest_steps = 0  # steps taken to where he stands
         self._his_feet_speed_mps = 0.0  # his feet's fastest speed over the ground, scaled, smoothed [m/s]
-        self._his_feet_last: dict[str, np.ndarray] | None = None
+        self._his_feet_last: tuple[float, float, float, float] | None = None  # his feet over the ground, last tick [m]
         self._sole_bound = sole_corner_points(cfg.capture_bound_sole_share)  # shrunk for capture_bound.py [m]
         self.reading: MotionReading | None = None  # the last tick's reading of the operator, besides the targets
 
@@ -566,7 +566,7 @@ class MotionOptimizer:
             else:
                 self._hold_velocity, self._hold_shift = None, np.zeros(2)
         self._last_xy = np.array([pelvis_xy[:2], com_xy[:2]])
-        if self.cfg.rest_step_min_m is not None:
+        if self.cfg.rest_step_min_m is not None and (self._rest_stance is not None or self._rest_offset_xy.any()):
             shift = self._rest_shift_xy(tick, state, com_xy)
             pelvis_xy[:2] += shift
             com_xy[:2] += shift
@@ -659,11 +659,13 @@ class MotionOptimizer:
         """Whether his feet (``his_feet_world``, the ankles Eq. 10 is anchored on) are at rest: their fastest speed over
         the ground, scaled, smoothed over _FEET_SPEED_SMOOTHING_S, below _FEET_STILL_MPS. His COM may be at rest while
         a foot slides or turns on the ground (a dance, the start of a spin): his feet are not where he stands then."""
-        last, self._his_feet_last = self._his_feet_last, {k: v[:2].copy() for k, v in his_feet_world.items()}
+        left, right = his_feet_world["left"], his_feet_world["right"]
+        now = (float(left[0]), float(left[1]), float(right[0]), float(right[1]))
+        last, self._his_feet_last = self._his_feet_last, now
         if last is not None:
-            speed = max(float(np.linalg.norm(his_feet_world[k][:2] - last[k])) for k in last) * scale / self.dt_s
+            moved = max(math.hypot(now[0] - last[0], now[1] - last[1]), math.hypot(now[2] - last[2], now[3] - last[3]))
             share = min(self.dt_s / _FEET_SPEED_SMOOTHING_S, 1.0)
-            self._his_feet_speed_mps += share * (speed - self._his_feet_speed_mps)
+            self._his_feet_speed_mps += share * (moved * scale / self.dt_s - self._his_feet_speed_mps)
         return self._his_feet_speed_mps < _FEET_STILL_MPS
 
     def _he_stands(self, state: CharacterState, scale: float, op_state: Stance) -> bool:
