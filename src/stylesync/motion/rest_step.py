@@ -6,12 +6,11 @@ walked (a walk that ends 0.5-0.8 m short, a lunge of his that it followed by hal
 (path_feedback.py) corrects that distance through the landings of his steps; once he stands there are none, and the
 capture bound keeps the COM target within what the feet support, so no lean of the targets turns into a step either.
 
-When he has stood still (his stance FSM in double stance, his COM at rest) and the character stands on both feet with
-its capture point within their support, each of its feet has a place: his foot's, on the character's path
-(``PathReference.on_path_xy``: scaled about his first pelvis ground point onto the character's), the two at least
-``MIN_FOOT_SEPARATION_M`` apart sideways. A foot lands at its
-place, at most a step's reach (``MotionConfig.rest_step_reach_m``) from where it lifts off and from the other foot,
-and never across it
+When he has stood still (his stance FSM in double stance, his COM and his feet at rest) and the character stands on
+both feet with its capture point within their support, each of its feet has a place: his foot's, on the character's
+path (``PathReference.on_path_xy``: scaled about his first pelvis ground point onto the character's), the two at
+least ``MIN_FOOT_SEPARATION_M`` apart sideways. A foot lands at its place, at most a step's reach
+(``MotionConfig.rest_step_reach_m``) from where it lifts off and from the other foot, and never across that
 (:func:`recovery_step.not_across`); the foot whose landing takes it the most nearer its place steps, if that is at
 least ``MotionConfig.rest_step_min_m``. Before it lifts, the COM target moves over the other foot (a weight shift)
 until the capture point is ``WEIGHT_OVER_SOLE_M`` inside that sole; during the step it stays there; after the landing
