@@ -331,6 +331,8 @@ class MotionOptimizer:
         self._rest_offset_xy = np.zeros(2)
         self._rest_com_xy: np.ndarray | None = None
         self.rest_steps = 0  # steps taken to where he stands
+        # the last such step: its foot, where it lifted off and where it was to land [m]
+        self._rest_last: tuple[str, np.ndarray, np.ndarray] | None = None
         self._his_feet_speed_mps = 0.0  # his feet's fastest speed over the ground, scaled, smoothed [m/s]
         self._his_feet_last: tuple[float, float, float, float] | None = None  # his feet over the ground, last tick [m]
         self._sole_bound = sole_corner_points(cfg.capture_bound_sole_share)  # shrunk for capture_bound.py [m]
@@ -991,11 +993,16 @@ class MotionOptimizer:
         if plan is None:
             return
         side, landing = plan
+        last = self._rest_last
+        if (last is not None and last[0] == side and np.hypot(*(last[1] - tick.a_c[side][:2])) < cfg.rest_step_min_m / 2
+                and np.hypot(*(last[2] - landing[:2])) < cfg.rest_step_min_m / 2):
+            return  # the same step from the same place again: the last did not hold (its foot slid back unloaded)
         stance = OTHER_SIDE[side]
         self._rest_stance = stance
         if sole_outside_m(xi, tick.a_c[stance], quats[stance]) > -WEIGHT_OVER_SOLE_M:
             return  # the weight is not over the foot that stays yet
         self.recovery.begin_to(side, state.time_s, tick.a_c[side], landing, cfg.rest_step_swing_s)
+        self._rest_last = (side, tick.a_c[side][:2].copy(), landing[:2].copy())
         tick.ch_state = self.char_fsm.begin_recovery_step(side, state.time_s,
                                                           cfg.rest_step_swing_s + cfg.late_contact_timeout_s)
         self._swing_t0_s = state.time_s
