@@ -143,3 +143,31 @@ def test_a_character_pushed_off_its_place_while_he_stands_steps_back_to_it():
     back, session, moved = _pushed_while_he_stands(0.1)
     assert not back.fell and session.motion.rest_steps >= 1
     assert moved < 0.03
+
+
+def test_a_step_that_did_not_hold_is_not_taken_again_from_the_same_place(monkeypatch):
+    """Traced: the humanoid3d punch (seed 0) ends about 0.5 m to the side of him, his weight over his right foot. The
+    character's left foot steps out to his wide stance and, unloaded, slides back inwards; the same step was taken six
+    times a second apart. Now no step repeats the last one from the same place to the same landing."""
+    from stylesync.config import OperatorConfig, SessionConfig
+    from stylesync.motion.recovery_step import RecoveryStepper
+    from stylesync.session import Session
+    from stylesync.sources.registry import open_source
+
+    steps: list[tuple[str, np.ndarray, np.ndarray]] = []
+    begin_to = RecoveryStepper.begin_to
+
+    def recorded(self, side, time_s, lift_off_world, landing_world, duration_s):
+        steps.append((side, np.array(lift_off_world[:2]), np.array(landing_world[:2])))
+        return begin_to(self, side, time_s, lift_off_world, landing_world, duration_s)
+
+    monkeypatch.setattr(RecoveryStepper, "begin_to", recorded)
+    opened = open_source("builtin:punch", seed=0, duration_s=12.0)
+    session = Session(SessionConfig(duration_s=12.0, seed=0, operator=OperatorConfig()), opened.source)
+    result = session.run()
+    opened.source.close()
+    assert not result.fell and steps
+    half = MotionConfig().rest_step_min_m / 2
+    for (side_a, lift_a, land_a), (side_b, lift_b, land_b) in zip(steps, steps[1:], strict=False):
+        assert not (side_a == side_b and np.linalg.norm(lift_a - lift_b) < half
+                    and np.linalg.norm(land_a - land_b) < half)
