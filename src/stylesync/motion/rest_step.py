@@ -41,9 +41,10 @@ def rest_step_plan(goals_xy: dict[str, np.ndarray], ankles_world: dict[str, np.n
 
     ``goals_xy``: per foot, his foot's place on the character's path (2,) (world, horizontal) [m]; ``ankles_world``:
     both ankles (3,) [m]; ``heading_world``: (3, 3) the heading frame (x forward, y left), in which a landing across
-    the other foot is moved outwards; ``reach_m``: the largest distance of the landing from the other ankle [m]. Each
-    foot's landing is its place, within the reach of the other foot and off it; the foot whose landing takes it the
-    most nearer its place steps."""
+    the other foot is moved outwards; ``reach_m``: the largest distance of the landing from where the foot is and from
+    the other ankle [m]. Each foot's landing is its place, within those reaches and off the other foot (the places
+    first spread to the feet's least separation sideways); the foot whose landing takes it the most nearer its place
+    steps."""
     goals_xy = _side_by_side(goals_xy, heading_world)
     best: tuple[float, str, np.ndarray] | None = None
     for side in ("left", "right"):
