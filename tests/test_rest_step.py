@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -9,6 +11,7 @@ from stylesync.config import ConfigError, MotionConfig
 from stylesync.motion.recovery_step import MIN_FOOT_SEPARATION_M
 from stylesync.motion.rest_step import rest_step_plan
 
+MOCAP = Path(__file__).resolve().parents[2] / "shared" / "mocap"
 HEADING = np.eye(3)  # x forward, y left
 REACH_M = 0.35
 
@@ -171,3 +174,32 @@ def test_a_step_that_did_not_hold_is_not_taken_again_from_the_same_place(monkeyp
     for (side_a, lift_a, land_a), (side_b, lift_b, land_b) in zip(steps, steps[1:], strict=False):
         assert not (side_a == side_b and np.linalg.norm(lift_a - lift_b) < half
                     and np.linalg.norm(land_a - land_b) < half)
+
+
+@pytest.mark.skipif(not (MOCAP / "cmu-dev" / "08_01.bvh").exists(),
+                    reason="../shared/mocap/cmu-dev/08_01.bvh is not available")
+def test_a_walk_that_ends_ahead_of_the_character_is_closed_up_in_the_rest():
+    """Traced: CMU-dev 08_01 (seed 0), a fast walk that ends at 2.27 s; the development suite's run (its 3 s rest) carried
+    on to 9 s. Without steps to where he stands the character ends 0.75 m from him (its pelvis from his, scaled); with
+    them 0.39 m (his feet, 0.5 m apart mid-stride, are further apart than its reach)."""
+    import dataclasses
+
+    from conftest import suite_run
+
+    from stylesync.config import ControlConfig
+    from stylesync.metrics import imitation as im
+
+    spec = f"bvh:{MOCAP / 'cmu-dev' / '08_01.bvh'}"
+
+    def end_distance_m(rest_step_min_m):
+        cfg = MotionConfig(rest_step_min_m=rest_step_min_m, rest_step_shift_mps=2.0, rest_step_swing_s=0.4,
+                           rest_step_reach_m=0.35)
+        result = suite_run(spec, 0, cfg, ControlConfig(), configure=lambda c: dataclasses.replace(c, duration_s=9.0))
+        assert not result.fell
+        lg = result.log
+        ch = lg.array("ch_joints")
+        ref = im.scale_operator_to_character(lg.array("op_joints"), lg.array("scale"), ch[0, 0])
+        return float(np.linalg.norm((ch[-1, 0] - ref[-1, 0])[:2]))
+
+    assert end_distance_m(None) > 0.65
+    assert end_distance_m(0.1) < 0.45
