@@ -179,9 +179,9 @@ def test_a_step_that_did_not_hold_is_not_taken_again_from_the_same_place(monkeyp
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "08_01.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/08_01.bvh is not available")
 def test_a_walk_that_ends_ahead_of_the_character_is_closed_up_in_the_rest():
-    """Traced: CMU-dev 08_01 (seed 0), a fast walk that ends at 2.27 s; the development suite's run (its 3 s rest) carried
-    on to 9 s. Without steps to where he stands the character ends 0.75 m from him (its pelvis from his, scaled); with
-    them 0.39 m (his feet, 0.5 m apart mid-stride, are further apart than its reach)."""
+    """Traced: CMU-dev 08_01 (seed 0), a fast walk that ends at 2.27 s; the development suite's run (its 3 s rest)
+    carried on to 9 s. Without steps to where he stands the character ends 0.75 m from him (its pelvis from his,
+    scaled); with them 0.39 m (his feet, 0.5 m apart mid-stride, are further apart than its reach)."""
     import dataclasses
 
     from conftest import suite_run
