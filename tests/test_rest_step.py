@@ -96,6 +96,8 @@ def test_on_by_default_off_in_place_and_validated():
 
     assert MotionConfig().rest_step_min_m == 0.1
     assert in_place(SessionConfig()).motion.rest_step_min_m is None
+    with pytest.raises(ConfigError):
+        MotionConfig(rest_step_after_s=-0.1)
     for field in ("rest_step_shift_mps", "rest_step_swing_s", "rest_step_reach_m"):
         with pytest.raises(ConfigError):
             MotionConfig(**{field: 0.0})

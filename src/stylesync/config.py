@@ -446,13 +446,14 @@ class MotionConfig:
     # his as a lag (docs/decisions.md, "Targets on his path"). 0: off [-], [m].
     path_target_share: float = 0.0
     path_target_max_m: float = 0.3
-    # Steps to where he stands (motion/rest_step.py; docs/decisions.md, "Steps to where he stands"): once he and his
-    # feet have stood still, each of the character's feet has his foot's place on its path; the foot that a step
-    # brings the most nearer its place, by rest_step_min_m at least, steps there on its own (at most
-    # rest_step_reach_m from where it lifts off and from the other foot, its swing rest_step_swing_s long), after the
-    # weight has moved over the other foot (the COM target moved there, and back after the landing, at
-    # rest_step_shift_mps). None: the character stays where it stopped [m], [m/s], [s], [m].
+    # Steps to where he stands (motion/rest_step.py; docs/decisions.md, "Steps to where he stands"): once he has stood
+    # still for rest_step_after_s and his feet are still, each of the character's feet has his foot's place on its
+    # path; the foot that a step brings the most nearer its place, by rest_step_min_m at least, steps there on its own
+    # (at most rest_step_reach_m from where it lifts off and from the other foot, its swing rest_step_swing_s long),
+    # after the weight has moved over the other foot (the COM target moved there, and back after the landing, at
+    # rest_step_shift_mps). None: the character stays where it stopped [m], [s], [m/s], [s], [m].
     rest_step_min_m: float | None = 0.1
+    rest_step_after_s: float = 0.5
     rest_step_shift_mps: float = 2.0
     rest_step_swing_s: float = 0.4
     rest_step_reach_m: float = 0.35
@@ -558,6 +559,7 @@ class MotionConfig:
         _non_negative("MotionConfig.path_target_max_m", self.path_target_max_m)
         if self.rest_step_min_m is not None:
             _non_negative("MotionConfig.rest_step_min_m", self.rest_step_min_m)
+        _non_negative("MotionConfig.rest_step_after_s", self.rest_step_after_s)
         _positive("MotionConfig.rest_step_shift_mps", self.rest_step_shift_mps)
         _positive("MotionConfig.rest_step_swing_s", self.rest_step_swing_s)
         _positive("MotionConfig.rest_step_reach_m", self.rest_step_reach_m)

@@ -970,14 +970,17 @@ class MotionOptimizer:
             self._rest_step(tick, state)
 
     def _rest_step(self, tick: _Tick, state: CharacterState) -> None:
-        """A step to where he stands (rest_step.py), while he and his feet have stood still (``he_stands``,
-        ``his_feet_still``) and the character stands on both feet with its capture point within their support: the
+        """A step to where he stands (rest_step.py), while he has stood still for ``rest_step_after_s`` (as
+        :meth:`_he_stands` reads it) and his feet are still (``his_feet_still``), and the character stands on both
+        feet with its capture point within their support: the
         weight moved over the foot that stays (:meth:`_rest_shift_xy`, from the next tick on) while the step is
         planned, and the step begun once the capture point is WEIGHT_OVER_SOLE_M inside that sole."""
         cfg = self.cfg
         assert cfg.rest_step_min_m is not None
         on_ground = soles_on_ground(state)
-        if len(on_ground) < 2 or not (tick.he_stands and tick.his_feet_still):
+        since_s = self._stands_since_s  # (_he_stands)
+        stood = since_s is not None and state.time_s - since_s >= cfg.rest_step_after_s
+        if len(on_ground) < 2 or not (stood and tick.his_feet_still):
             return
         quats = {s: state.link_quat_wxyz[_LINK[f"{s}_ankle"]] for s in _SIDE_UP}
         xi, _ = capture_point(tick.com_c, tick.com_vel_c, self.g)
