@@ -98,6 +98,8 @@ def test_on_by_default_off_in_place_and_validated():
     assert in_place(SessionConfig()).motion.rest_step_min_m is None
     with pytest.raises(ConfigError):
         MotionConfig(rest_step_after_s=-0.1)
+    with pytest.raises(ConfigError):
+        MotionConfig(rest_step_after_s=-0.1)
     for field in ("rest_step_shift_mps", "rest_step_swing_s", "rest_step_reach_m"):
         with pytest.raises(ConfigError):
             MotionConfig(**{field: 0.0})
@@ -119,7 +121,7 @@ def _pushed_while_he_stands(rest_step_min_m: float | None, ball_mps: float = 14.
 
     op = OperatorConfig(clip="push-stand")
     cfg = SessionConfig(duration_s=seconds, seed=0, operator=op)
-    cfg = cfg.replace(motion=dataclasses.replace(cfg.motion, rest_step_min_m=rest_step_min_m,
+    cfg = cfg.replace(motion=dataclasses.replace(cfg.motion, rest_step_min_m=rest_step_min_m, rest_step_after_s=0.5,
                                                  rest_step_shift_mps=2.0, rest_step_swing_s=0.4,
                                                  rest_step_reach_m=0.35))
     source = sensed(push.performer("stand", HumanModel(op.height_m, op.mass_kg)), op, cfg.clocks, seconds + 1.0, 0,
@@ -141,13 +143,13 @@ def _pushed_while_he_stands(rest_step_min_m: float | None, ball_mps: float = 14.
 
 def test_a_character_pushed_off_its_place_while_he_stands_steps_back_to_it():
     """Traced: a 14 m/s ball moves the standing character back about 9 cm (its own recovery steps catch it); he has
-    not moved. Without steps to where he stands it stays there; with them, one step brings it back within 3 cm."""
+    not moved. Without steps to where he stands it stays there; with them, one step brings it back within 1 cm."""
     stays, session, moved = _pushed_while_he_stands(None)
     assert not stays.fell and session.motion.rest_steps == 0
     assert moved > 0.07
     back, session, moved = _pushed_while_he_stands(0.1)
     assert not back.fell and session.motion.rest_steps >= 1
-    assert moved < 0.03
+    assert moved < 0.02
 
 
 def test_a_step_that_did_not_hold_is_not_taken_again_from_the_same_place(monkeypatch):
@@ -183,7 +185,7 @@ def test_a_step_that_did_not_hold_is_not_taken_again_from_the_same_place(monkeyp
 def test_a_walk_that_ends_ahead_of_the_character_is_closed_up_in_the_rest():
     """Traced: CMU-dev 08_01 (seed 0), a fast walk that ends at 2.27 s; the development suite's run (its 3 s rest)
     carried on to 9 s. Without steps to where he stands the character ends 0.75 m from him (its pelvis from his,
-    scaled); with them 0.39 m (his feet, 0.5 m apart mid-stride, are further apart than its reach)."""
+    scaled); with them 0.20 m."""
     import dataclasses
 
     from conftest import suite_run
@@ -194,8 +196,8 @@ def test_a_walk_that_ends_ahead_of_the_character_is_closed_up_in_the_rest():
     spec = f"bvh:{MOCAP / 'cmu-dev' / '08_01.bvh'}"
 
     def end_distance_m(rest_step_min_m):
-        cfg = MotionConfig(rest_step_min_m=rest_step_min_m, rest_step_shift_mps=2.0, rest_step_swing_s=0.4,
-                           rest_step_reach_m=0.35)
+        cfg = MotionConfig(rest_step_min_m=rest_step_min_m, rest_step_after_s=0.5, rest_step_shift_mps=2.0,
+                           rest_step_swing_s=0.4, rest_step_reach_m=0.35)
         result = suite_run(spec, 0, cfg, ControlConfig(), configure=lambda c: dataclasses.replace(c, duration_s=9.0))
         assert not result.fell
         lg = result.log
@@ -204,4 +206,4 @@ def test_a_walk_that_ends_ahead_of_the_character_is_closed_up_in_the_rest():
         return float(np.linalg.norm((ch[-1, 0] - ref[-1, 0])[:2]))
 
     assert end_distance_m(None) > 0.65
-    assert end_distance_m(0.1) < 0.45
+    assert end_distance_m(0.1) < 0.3
