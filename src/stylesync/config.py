@@ -560,9 +560,8 @@ class MotionConfig:
         if self.rest_step_min_m is not None:
             _non_negative("MotionConfig.rest_step_min_m", self.rest_step_min_m)
         _non_negative("MotionConfig.rest_step_after_s", self.rest_step_after_s)
-        _positive("MotionConfig.rest_step_shift_mps", self.rest_step_shift_mps)
-        _positive("MotionConfig.rest_step_swing_s", self.rest_step_swing_s)
-        _positive("MotionConfig.rest_step_reach_m", self.rest_step_reach_m)
+        for n in ("rest_step_shift_mps", "rest_step_swing_s", "rest_step_reach_m"):
+            _positive(f"MotionConfig.{n}", getattr(self, n))
         for n in ("liftoff_weight_shift_s", "liftoff_after_stand_s", "liftoff_margin_m"):
             _non_negative(f"MotionConfig.{n}", getattr(self, n))
         if self.liftoff_shift_outward_m is not None:
