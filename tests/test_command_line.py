@@ -83,7 +83,11 @@ def test_a_recording_asked_to_run_past_its_end_stops_at_its_end_plus_the_rest(tm
     assert cli_main(["run", "--source", f"bvh:{cmu}", "--duration", "80000", "--continue-after-fall",
                      "--out", str(out)]) == 0
     assert "ends (with its rest) at 5.85 s" in capsys.readouterr().err
-    assert json.loads((out / "metrics.json").read_text())["sim_duration_s"] == pytest.approx(5.85, abs=0.01)
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["sim_duration_s"] == pytest.approx(5.85, abs=0.01)
+    # A walk's feet land 0.1-0.2 m apart across his pelvis (scaled); the character's width is measured alike
+    assert 0.08 < metrics["step_width_m"]["operator"] < 0.2
+    assert isinstance(metrics["step_width_m"]["character"], float)
 
 
 def test_a_run_shorter_than_its_operator_worker_start_prints_nothing_but_its_result(tmp_path):

@@ -75,6 +75,20 @@ def test_path_progress_of_a_character_that_goes_part_of_the_way_back_or_aside():
     assert im.path_progress(ref, in_place) == (None, None)
 
 
+def test_step_width_across_the_pelvis_whichever_way_it_faces():
+    n = len(im.JOINT_PAIRS)
+    joint = {o: k for k, o in enumerate(im.OPERATOR_JOINTS)}
+    pos = np.zeros((3, n, 3))
+    for k, yaw in enumerate((0.0, 0.7, -2.5)):  # facing +x, turned left, turned round to the right
+        fwd, left = np.array([np.cos(yaw), np.sin(yaw), 0.0]), np.array([-np.sin(yaw), np.cos(yaw), 0.0])
+        pos[k, joint["HIP_LEFT"]], pos[k, joint["HIP_RIGHT"]] = 0.08 * left + [0, 0, 0.8], -0.08 * left + [0, 0, 0.8]
+        width = (0.14, 0.0, -0.05)[k]  # apart, in line, crossed
+        pos[k, joint["ANKLE_LEFT"]] = 0.3 * fwd + 0.5 * width * left + [0, 0, 0.05]
+        pos[k, joint["ANKLE_RIGHT"]] = -0.3 * fwd - 0.5 * width * left + [0, 0, 0.05]
+    np.testing.assert_allclose(im.step_widths_m(pos, np.array([0, 1, 2])), [0.14, 0.0, -0.05], atol=1e-12)
+    np.testing.assert_allclose(im.step_widths_m(pos, np.array([2])), [-0.05], atol=1e-12)
+
+
 def test_uhc_termination_and_operator_scaling():
     ref = _walker()
     char = ref.copy()

@@ -110,7 +110,7 @@ def run_clip(spec: str, seed: int, duration_s: float, controller: str,
     m = summarize(result)
     keys = ("fell", "fall_time_s", "sim_duration_s", "operator_steps", "character_steps",
             "state_transition_delay_s", "mpjpe_global_mm", "mpjpe_root_mm", "uhc_fall_time_s", "path_progress",
-            "realtime_factor", "fall_reason")
+            "realtime_factor", "fall_reason", "step_width_m")
     return {"clip_end_s": clip_end, **{k: m.get(k) for k in keys}}
 
 
@@ -170,8 +170,17 @@ def category_row(cat: str, version: str, rs: list[dict]) -> str:
              _mean([r["mpjpe_root_mm"] for r in ok if r.get("mpjpe_root_mm") is not None], ".0f"),
              f"{sum(r['character_steps'] for r in ok)}/{sum(r['operator_steps'] for r in ok)}",
              _median([r["path_progress"] for r in ok if r.get("path_progress") is not None], ".2f"),
-             f"{np.median(delays):.3f}" if delays else "-"]
+             f"{np.median(delays):.3f}" if delays else "-", _step_widths(ok)]
     return "| " + " | ".join(cells) + " |"
+
+
+def _step_widths(rs: list[dict]) -> str:
+    """"character / operator": the medians over runs of each run's median step width [m] (summary.py), "-" where
+    no run has one (a version before it was kept, or no step)."""
+    def median_of(who: str) -> str:
+        return _median([r["step_width_m"][who] for r in rs
+                        if r.get("step_width_m") and r["step_width_m"].get(who) is not None], ".3f")
+    return f"{median_of('character')} / {median_of('operator')}"
 
 
 def table(rows: list[dict], versions: list[str]) -> str:
@@ -179,8 +188,8 @@ def table(rows: list[dict], versions: list[str]) -> str:
     lines = ["| category | version | runs | opened | complete (no fall) | through the clip (no fall before its end) | "
              "no UHC termination | mean fall time [s] | falls: pelvis low / other link down / diverged | "
              "MPJPE global [mm] | MPJPE root-rel. [mm] | steps char/op | "
-             "along his path, median | max delay median [s] |",
-             "|" + "---|" * 14]
+             "along his path, median | max delay median [s] | step width char / op, median [m] |",
+             "|" + "---|" * 15]
     for cat in ORDER:
         for v in versions:
             rs = [r for r in rows if r["category"] == cat and r["version"] == v]

@@ -74,6 +74,20 @@ def path_progress(char_root_world: np.ndarray, ref_root_world: np.ndarray,
     return float(dc @ dr) / length**2, abs(float(dc[0] * dr[1] - dc[1] * dr[0])) / length
 
 
+_LEFT_ANKLE, _RIGHT_ANKLE = OPERATOR_JOINTS.index("ANKLE_LEFT"), OPERATOR_JOINTS.index("ANKLE_RIGHT")
+
+
+def step_widths_m(pos: np.ndarray, touchdown_ticks: np.ndarray) -> np.ndarray:
+    """The step width at each of ``touchdown_ticks`` [m]: how far the left ankle lies left of the right one across
+    the pelvis, along the hip line from right to left (:func:`facing_rad`'s), horizontally, in each tick's
+    (T, J, 3) joints in JOINT_PAIRS order. Negative: the feet crossed. A walk's feet land 0.1-0.2 m apart
+    (scaled); feet in line give 0."""
+    d = np.asarray(pos, dtype=float)[np.asarray(touchdown_ticks, dtype=int)]
+    hips = d[:, _LEFT_HIP, :2] - d[:, _RIGHT_HIP, :2]
+    across = hips / np.maximum(np.linalg.norm(hips, axis=1, keepdims=True), 1e-9)
+    return np.einsum("ij,ij->i", d[:, _LEFT_ANKLE, :2] - d[:, _RIGHT_ANKLE, :2], across)
+
+
 def foot_skate_mm(foot_pos: np.ndarray, in_contact: np.ndarray) -> float:
     """Foot skating [mm]: mean horizontal displacement, per tick, of a foot that is in contact at both ends of the
     tick. ``foot_pos`` (T, F, 3), ``in_contact`` (T, F) booleans."""
