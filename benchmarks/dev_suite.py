@@ -65,8 +65,25 @@ if "path_progress" not in m:  # a version before metrics/imitation.path_progress
     dc, dr = ch[-1, :2] - ch[0, :2], scale[-1] * (op[-1, :2] - op[0, :2])
     length = float(np.hypot(dr[0], dr[1]))
     m["path_progress"] = float(dc @ dr) / length**2 if length >= 0.5 else None
+if "step_width_m" not in m:  # a version before metrics/imitation.step_widths_m: the same definition, here
+    import numpy as np
+    lg = result.log
+    ch = lg.array("ch_joints")
+    op = ch[0, 0, :2] + lg.array("scale")[:, None, None] * (lg.array("op_joints")[..., :2]
+                                                            - lg.array("op_joints")[0, 0, :2])
+    def width(pos, states):  # left ankle (5) left of the right (8) along the hip line (right hip 6 to left 3)
+        s = np.asarray(states)
+        ticks = np.where((s[1:] == 1) & (s[:-1] != 1))[0] + 1
+        if not len(ticks):
+            return None
+        hips = pos[ticks, 3, :2] - pos[ticks, 6, :2]
+        across = hips / np.maximum(np.linalg.norm(hips, axis=1, keepdims=True), 1e-9)
+        return round(float(np.median(np.einsum("ij,ij->i", pos[ticks, 5, :2] - pos[ticks, 8, :2], across))), 4)
+    m["step_width_m"] = {"character": width(ch[..., :2], lg.array("char_state")),
+                         "operator": width(op, lg.array("op_state"))}
 keys = ("fell", "fall_time_s", "sim_duration_s", "operator_steps", "character_steps", "state_transition_delay_s",
-        "mpjpe_global_mm", "mpjpe_root_mm", "uhc_fall_time_s", "path_progress", "realtime_factor", "fall_reason")
+        "mpjpe_global_mm", "mpjpe_root_mm", "uhc_fall_time_s", "path_progress", "realtime_factor", "fall_reason",
+        "step_width_m")
 print(json.dumps({"clip_end_s": clip_end, **{k: m.get(k) for k in keys}}))
 '''
 
