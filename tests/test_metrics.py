@@ -133,6 +133,19 @@ def test_unknown_experiment_and_missing_shared_clips_fail_with_one_line(capsys, 
         styles.run(tmp_path / "out", shared=tmp_path / "no-shared")
 
 
+def test_the_styles_experiment_measures_each_style_s_step_width(tmp_path):
+    from stylesync.config import SHARED_DIR
+    from stylesync.experiments import styles
+
+    if not (SHARED_DIR / "mocap" / "deepmimic").is_dir():
+        pytest.skip("../shared/mocap/deepmimic is not available")
+    _, summary = styles.run(tmp_path / "out", duration_s=6.0)
+    for style, m in summary["styles"].items():
+        # his steps land 0.15-0.45 m apart across his pelvis in all three (scaled); the character's are measured alike
+        assert 0.15 < m["operator"]["step_width_m"] < 0.45, style
+        assert isinstance(m["character"]["step_width_m"], float), style
+
+
 def test_transition_delays_count_a_missed_change_and_leave_out_one_the_log_ends_on():
     from stylesync.metrics.summary import transition_delays
 

@@ -28,7 +28,9 @@ import numpy as np  # noqa: E402
 from stylesync.config import SHARED_DIR, OperatorConfig, SessionConfig  # noqa: E402
 from stylesync.errors import StylesyncError  # noqa: E402
 from stylesync.experiments.common import run_session  # noqa: E402
+from stylesync.metrics import imitation as im  # noqa: E402
 from stylesync.metrics.plots import plan_view, save_figure  # noqa: E402
+from stylesync.metrics.summary import touchdowns  # noqa: E402
 from stylesync.session import Session  # noqa: E402
 from stylesync.sources.registry import open_source  # noqa: E402
 
@@ -54,17 +56,24 @@ def _pearson(a: np.ndarray, b: np.ndarray) -> float | None:
 
 
 def style_measures(log, lead_in_s: float, end_s: float) -> dict:
-    """The character's measures over [lead_in_s, end_s] (while it is up), the operator's over his whole clip."""
+    """The character's measures over [lead_in_s, end_s] (while it is up), the operator's over his whole clip; with
+    the median step width of each's steps there (imitation.step_widths_m; his joints scaled; None without a step)."""
     t = log.array("t")
     out: dict = {"window_s": [lead_in_s, end_s]}
     up = (t >= lead_in_s) & (t <= end_s)
+    ch = log.array("ch_joints")
+    joints = {"character": ch,
+              "operator": im.scale_operator_to_character(log.array("op_joints"), log.array("scale"), ch[0, 0])}
     for who, prefix, ankle in (("operator", "op_", "op_ar_z"), ("character", "ch_", "ar_z")):
         w = t >= lead_in_s if who == "operator" else up
         z = log.array(ankle)[w]
         vz = np.gradient(z, t[w]) if w.sum() > 2 else np.zeros(1)
+        steps = [k for k in touchdowns(log.array(f"{'op' if who == 'operator' else 'char'}_state")) if w[k]]
         out[who] = {"N_r_y_swing": float(np.std(log.array(f"{prefix}N_r_y")[w])) if w.any() else 0.0,
                     "stepping_impact_mps": float(max(0.0, -vz.min())),
-                    "ankle_height_range_m": float(np.ptp(z)) if w.any() else 0.0}
+                    "ankle_height_range_m": float(np.ptp(z)) if w.any() else 0.0,
+                    "step_width_m": float(np.median(im.step_widths_m(joints[who], np.array(steps)))) if steps
+                    else None}
     out["correlation"] = {f: _pearson(log.array(f"op_{f}")[up], log.array(f"ch_{f}")[up]) for f in FEATURES}
     return out
 
