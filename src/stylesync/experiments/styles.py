@@ -64,16 +64,16 @@ def style_measures(log, lead_in_s: float, end_s: float) -> dict:
     ch = log.array("ch_joints")
     joints = {"character": ch,
               "operator": im.scale_operator_to_character(log.array("op_joints"), log.array("scale"), ch[0, 0])}
-    for who, prefix, ankle in (("operator", "op_", "op_ar_z"), ("character", "ch_", "ar_z")):
+    for who, prefix, ankle, stance in (("operator", "op_", "op_ar_z", "op_state"),
+                                       ("character", "ch_", "ar_z", "char_state")):
         w = t >= lead_in_s if who == "operator" else up
         z = log.array(ankle)[w]
         vz = np.gradient(z, t[w]) if w.sum() > 2 else np.zeros(1)
-        steps = [k for k in touchdowns(log.array(f"{'op' if who == 'operator' else 'char'}_state")) if w[k]]
+        steps = np.array([k for k in touchdowns(log.array(stance)) if w[k]], dtype=int)
         out[who] = {"N_r_y_swing": float(np.std(log.array(f"{prefix}N_r_y")[w])) if w.any() else 0.0,
                     "stepping_impact_mps": float(max(0.0, -vz.min())),
                     "ankle_height_range_m": float(np.ptp(z)) if w.any() else 0.0,
-                    "step_width_m": float(np.median(im.step_widths_m(joints[who], np.array(steps)))) if steps
-                    else None}
+                    "step_width_m": im.median_step_width_m(joints[who], steps)}
     out["correlation"] = {f: _pearson(log.array(f"op_{f}")[up], log.array(f"ch_{f}")[up]) for f in FEATURES}
     return out
 

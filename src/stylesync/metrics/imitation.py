@@ -88,6 +88,11 @@ def step_widths_m(pos: np.ndarray, touchdown_ticks: np.ndarray) -> np.ndarray:
     return np.einsum("ij,ij->i", d[:, _LEFT_ANKLE, :2] - d[:, _RIGHT_ANKLE, :2], across)
 
 
+def median_step_width_m(pos: np.ndarray, touchdown_ticks: np.ndarray) -> float | None:
+    """The median of :func:`step_widths_m` over ``touchdown_ticks`` [m]; None without a touchdown."""
+    return float(np.median(step_widths_m(pos, touchdown_ticks))) if len(touchdown_ticks) else None
+
+
 def foot_skate_mm(foot_pos: np.ndarray, in_contact: np.ndarray) -> float:
     """Foot skating [mm]: mean horizontal displacement, per tick, of a foot that is in contact at both ends of the
     tick. ``foot_pos`` (T, F, 3), ``in_contact`` (T, F) booleans."""

@@ -102,14 +102,10 @@ def imitation_metrics(result: SessionResult) -> dict:
         "foot_skate_mm": round(im.foot_skate_mm(ch[:, feet], foot_down), 3),
         "jitter_mps2": round(im.jitter_mps2(ch, dt), 3),
         "sync_lag_s": round(im.sync_lag_s(rel_ref.reshape(len(t), -1), rel_ch.reshape(len(t), -1), dt), 4),
-        "step_width_m": {"character": _median_width(ch, touchdowns(lg.array("char_state"))),
-                         "operator": _median_width(ref, touchdowns(lg.array("op_state")))},
+        "step_width_m": {who: None if w is None else round(w, 4) for who, w in (
+            ("character", im.median_step_width_m(ch, touchdowns(lg.array("char_state")))),
+            ("operator", im.median_step_width_m(ref, touchdowns(lg.array("op_state")))))},
     }
-
-
-def _median_width(pos: np.ndarray, ticks: np.ndarray) -> float | None:
-    """The median step width at the touchdowns ``ticks`` [m] (imitation.step_widths_m); None without a step."""
-    return round(float(np.median(im.step_widths_m(pos, ticks))), 4) if len(ticks) else None
 
 
 def _latency(ms: list[float]) -> dict | None:
