@@ -477,6 +477,16 @@ class MotionConfig:
     # 0.4 m up, scaled) was counted fallen while it stood on both feet (docs/decisions.md, "A crouch deeper than the
     # fall height"). None: as deep as he goes [m]
     pelvis_min_height_m: float | None = 0.6
+    # His pelvis for Eq. 9-10 (the pelvis height and the pelvis target over the ground, the swing foot's and the
+    # hands' places relative to it): the midpoint of his hip joints, where the character's root is on its own body
+    # (processing/body_parameters.hip_centre_world); False: his skeleton's pelvis joint, which CMU's BVH files put
+    # 0.1 m above the hip joints (the pelvis target then 0.09 m above where his legs put his, beyond straight legs'
+    # reach) and the CMU-dev files 0.03 m below (docs/decisions.md, "His pelvis at his hip joints").
+    pelvis_from_hip_joints: bool = True
+    # The pelvis target of Eq. 9 this much higher than his, scaled (negative: lower): a character whose stance leg
+    # is as straight as his has no reach left for the step his speed needs, its flat feet having none of the
+    # heel-to-toe roll that lengthens his (docs/decisions.md, "His pelvis at his hip joints") [m]
+    pelvis_height_offset_m: float = -0.07
 
     def __post_init__(self) -> None:
         lo, hi = self.step_outside_capture_point_m

@@ -34,6 +34,7 @@ from stylesync.model.character import (
 from stylesync.motion.leg_ik import solve_leg
 from stylesync.motion.operator_analysis import OperatorAnalysis
 from stylesync.motion.pose_optimization import CHAR_LEG_LENGTH_M, joint_targets, map_upper_body
+from stylesync.processing.body_parameters import hip_centre_world
 from stylesync.processing.operator_processing import OperatorSample
 
 _UP = np.array([0.0, 0.0, 1.0])
@@ -53,16 +54,17 @@ class InitialState:
     joint_vel: np.ndarray  # (n_joints, 3): ball joints child-frame angular velocity [rad/s], hinge rate in column 0
 
 
-def retargeted_pose(s: OperatorSample, analysis: OperatorAnalysis, scale: float | None = None
-                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def retargeted_pose(s: OperatorSample, analysis: OperatorAnalysis, scale: float | None = None,
+                    from_hip_joints: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(root position [m], root quaternion, joint positions) of the character for one operator sample, the pelvis
     over the ground at the operator's, scaled by ``scale`` (default h_C / h_H of this sample, Eq. 9) from the world
-    origin (differences of poses at one scale give velocities)."""
+    origin (differences of poses at one scale give velocities). His pelvis is the midpoint of his hip joints with
+    ``from_hip_joints`` (MotionConfig.pelvis_from_hip_joints), else his skeleton's pelvis joint."""
     if scale is None:
         scale = CHAR_LEG_LENGTH_M / analysis.leg_m  # Eq. 9
     q_root = analysis.root_quat_wxyz
     R_root = rot.matrix_from_quat(q_root)
-    p_h = s.pos["PELVIS"]
+    p_h = hip_centre_world(s.pos) if from_hip_joints else s.pos["PELVIS"]
     ankles = {side: s.pos[f"ANKLE_{side.upper()}"] for side in ("left", "right")}
     ankle_h_z = min(a[2] for a in ankles.values())
     pelvis = np.array([scale * p_h[0], scale * p_h[1], ANKLE_HEIGHT_M + scale * (p_h[2] - ankle_h_z)])  # Eq. 9
@@ -82,9 +84,10 @@ def retargeted_pose(s: OperatorSample, analysis: OperatorAnalysis, scale: float 
     return pelvis, q_root, joint_targets(local, hinge)
 
 
-def initial_state(s0: OperatorSample, a0: OperatorAnalysis, s1: OperatorSample, a1: OperatorAnalysis
-                  ) -> InitialState:
-    """The character's state at ``s0``, with velocities from the forward difference to ``s1`` (later)."""
+def initial_state(s0: OperatorSample, a0: OperatorAnalysis, s1: OperatorSample, a1: OperatorAnalysis,
+                  from_hip_joints: bool = True) -> InitialState:
+    """The character's state at ``s0``, with velocities from the forward difference to ``s1`` (later); his pelvis
+    as :func:`retargeted_pose` takes it."""
     dt = s1.time_s - s0.time_s
     if not dt > 0:
         raise ValueError("initial_state needs a second sample later than the first")
@@ -92,15 +95,16 @@ def initial_state(s0: OperatorSample, a0: OperatorAnalysis, s1: OperatorSample, 
     # operator's leg length (Eq. 1) changes the scale from sample to sample by about 1 %, which alone would add some
     # 0.3 m/s to a forward difference over a 16 Hz frame.
     scale = CHAR_LEG_LENGTH_M / a0.leg_m
-    p0, q0, j0 = retargeted_pose(s0, a0, scale)
-    p1, q1, j1 = retargeted_pose(s1, a1, scale)
+    p0, q0, j0 = retargeted_pose(s0, a0, scale, from_hip_joints)
+    p1, q1, j1 = retargeted_pose(s1, a1, scale, from_hip_joints)
     q1 = rot.align_sign(q1, q0)
     ang_root = rot.rotvec_from_quat(rot.multiply(q1, rot.conjugate(q0))) / dt
     joint_vel = np.zeros((len(JOINTS), 3))
     for k in _BALL:
         joint_vel[k] = rot.rotvec_from_quat(rot.multiply(rot.conjugate(j0[k]), rot.align_sign(j1[k], j0[k]))) / dt
     joint_vel[_HINGE, 0] = (j1[_HINGE, 0] - j0[_HINGE, 0]) / dt
-    origin = np.array([s0.pos["PELVIS"][0] - p0[0], s0.pos["PELVIS"][1] - p0[1], 0.0])  # at the operator's pelvis
+    pelvis = hip_centre_world(s0.pos) if from_hip_joints else s0.pos["PELVIS"]
+    origin = np.array([pelvis[0] - p0[0], pelvis[1] - p0[1], 0.0])  # at the operator's pelvis
     return InitialState(p0 + origin, q0, j0, (p1 - p0) / dt, ang_root, joint_vel)
 
 

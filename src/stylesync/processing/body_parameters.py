@@ -55,6 +55,14 @@ def com_from_joints(pos: dict[str, np.ndarray], fractions: dict[str, float] | No
     return com / sum(fractions.values())
 
 
+def hip_centre_world(pos: dict[str, np.ndarray]) -> np.ndarray:
+    """(3,) the midpoint of the operator's two hip joints [m], world frame: where the character's root is on its own
+    body (its hip joints lie level with its root), whatever his skeleton calls its pelvis (CMU's ``Hips`` root sits
+    about 0.1 m above the hip joints, the CMU-dev ``hip`` 0.03 m below, DeepMimic's and the Kinect's pelvis level with
+    them)."""
+    return 0.5 * (np.asarray(pos["HIP_LEFT"], dtype=float) + np.asarray(pos["HIP_RIGHT"], dtype=float))
+
+
 def leg_length_m(pos: dict[str, np.ndarray], ankle_height_m: float) -> float:
     """Hip-joint height of a straight leg: thigh + shank (Eq. 1) + ankle height [m], mean of both legs."""
     lengths = [link_length(pos[f"HIP_{s}"], pos[f"KNEE_{s}"]) + link_length(pos[f"KNEE_{s}"], pos[f"ANKLE_{s}"])
