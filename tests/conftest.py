@@ -42,26 +42,46 @@ TRACED_BEFORE_PRESS = ControlConfig(whole_body=WholeBodyConfig(press_double_stan
                                                                own_step_push_bound="he_stands"))
 
 
+# Scenarios traced with his skeleton's pelvis joint as his pelvis and the pelvis target at his (scaled), before the
+# retargeting went through his hip joints with the target below his (MotionConfig.pelvis_from_hip_joints,
+# pelvis_height_offset_m; docs/decisions.md, "His pelvis at his hip joints"): the tests that run them carry the
+# pelvis_joint marker.
+PELVIS_JOINT_MOTION = {"pelvis_from_hip_joints": False, "pelvis_height_offset_m": 0.0}
+
+
 def pytest_configure(config):
     config.addinivalue_line("markers", "in_place: a scenario traced with the settings before the character followed "
                                        "its operator's path by default (config.in_place): every MotionConfig, "
                                        "WholeBodyConfig and OperatorConfig made during the test defaults to them")
+    config.addinivalue_line("markers", "pelvis_joint: a scenario traced with his pelvis joint as his pelvis and the "
+                                       "pelvis target at his (PELVIS_JOINT_MOTION): every MotionConfig made during the "
+                                       "test defaults to them")
+
+
+def _set_defaults(monkeypatch, cls: type, values: dict) -> None:
+    """For the test's duration, the defaults of the dataclass ``cls`` for the keys of ``values`` are those values."""
+    init = cls.__init__
+    names = [n for n, p in inspect.signature(init).parameters.items()
+             if n != "self" and p.default is not inspect.Parameter.empty]
+    assert len(names) == len(init.__defaults__) and set(values) <= set(names)
+    monkeypatch.setattr(init, "__defaults__",
+                        tuple(values.get(n, d) for n, d in zip(names, init.__defaults__, strict=True)))
 
 
 @pytest.fixture(autouse=True)
-def _in_place_defaults(request, monkeypatch):
+def _traced_defaults(request, monkeypatch):
     """Under the ``in_place`` marker, the defaults of MotionConfig, WholeBodyConfig and OperatorConfig are those of
-    config.in_place for the test's duration (what a test sets explicitly stays as it sets it)."""
-    if request.node.get_closest_marker("in_place") is None:
-        return
-    for cls, values in ((MotionConfig, IN_PLACE_MOTION), (WholeBodyConfig, IN_PLACE_WHOLE_BODY),
-                        (OperatorConfig, IN_PLACE_OPERATOR)):
-        init = cls.__init__
-        names = [n for n, p in inspect.signature(init).parameters.items()
-                 if n != "self" and p.default is not inspect.Parameter.empty]
-        assert len(names) == len(init.__defaults__) and set(values) <= set(names)
-        monkeypatch.setattr(init, "__defaults__",
-                            tuple(values.get(n, d) for n, d in zip(names, init.__defaults__, strict=True)))
+    config.in_place for the test's duration; under ``pelvis_joint``, MotionConfig's are PELVIS_JOINT_MOTION's too
+    (what a test sets explicitly stays as it sets it)."""
+    motion: dict = {}
+    if request.node.get_closest_marker("pelvis_joint") is not None:
+        motion.update(PELVIS_JOINT_MOTION)
+    if request.node.get_closest_marker("in_place") is not None:
+        motion.update(IN_PLACE_MOTION)
+        _set_defaults(monkeypatch, WholeBodyConfig, IN_PLACE_WHOLE_BODY)
+        _set_defaults(monkeypatch, OperatorConfig, IN_PLACE_OPERATOR)
+    if motion:
+        _set_defaults(monkeypatch, MotionConfig, motion)
 
 
 def _standing(root_quat_wxyz: np.ndarray):

@@ -606,8 +606,12 @@ class MotionOptimizer:
                     norms = np.linalg.norm(lead, axis=1, keepdims=True)
                     self._ref_xy = raw + lead * np.minimum(1.0, lead_max / np.maximum(norms, 1e-12))
             pelvis_xy[:2], com_xy[:2] = self._ref_xy[0], self._ref_xy[1]
+        # ... lowered by the offset as he goes somewhere: in full from pelvis_offset_full_speed_mps of his scaled
+        # COM speed (his smoothed rate), in proportion below it, none while he stands still
+        his_speed = scale * float(np.hypot(self._com_h_rate.rate[0], self._com_h_rate.rate[1]))
+        offset_m = self.cfg.pelvis_height_offset_m * min(his_speed / self.cfg.pelvis_offset_full_speed_mps, 1.0)
         tick.pelvis_d = np.array([pelvis_xy[0], pelvis_xy[1],  # Eq. 9
-                                  ANKLE_HEIGHT_M + scale * (p_h[2] - ankle_h_z) + self.cfg.pelvis_height_offset_m])
+                                  ANKLE_HEIGHT_M + scale * (p_h[2] - ankle_h_z) + offset_m])
         tick.pelvis_vel_z = scale * float(self._pelvis_h_rate(p_h)[2])
         if self._his_rise is not None:
             tick.pelvis_vel_z = self._his_rise.rise_mps(tick.pelvis_vel_z, tick.op_state is Stance.DS)

@@ -1,0 +1,91 @@
+"""His pelvis at his hip joints (MotionConfig.pelvis_from_hip_joints) and the pelvis target's offset below his
+(MotionConfig.pelvis_height_offset_m): the retargeting of Eq. 9-10 does not depend on where a skeleton puts its
+pelvis joint, and a CMU walk's pelvis target comes within the reach of the character's legs."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import suite_run
+
+from stylesync.config import ControlConfig, MotionConfig, OperatorConfig, SessionConfig
+from stylesync.model.character import LINK_NAMES
+from stylesync.motion.initial_state import retargeted_pose
+from stylesync.motion.operator_analysis import analyse_operator
+from stylesync.motion.pose_optimization import CHAR_LEG_LENGTH_M
+from stylesync.processing.body_parameters import hip_centre_world
+from stylesync.processing.operator_processing import OperatorProcessing
+from stylesync.session import Session
+from stylesync.sources.builtin_operator import STAND_CLIP, builtin_operator
+from stylesync.sources.frame import JOINT_INDEX
+from stylesync.sources.registry import open_source
+
+MOCAP = Path(__file__).resolve().parents[2] / "shared" / "mocap"
+_ANKLES = [LINK_NAMES.index(f"{s}_ankle") for s in ("left", "right")]
+
+
+def _sample(frame):
+    processing = OperatorProcessing(SessionConfig().clocks, SessionConfig().filters)
+    processing.push(frame)
+    return processing.step(frame.timestamp_s)
+
+
+def test_the_hip_centre_is_the_midpoint_of_the_hip_joints():
+    pos = {"HIP_LEFT": np.array([0.1, 0.2, 0.9]), "HIP_RIGHT": np.array([0.3, -0.2, 0.7]),
+           "PELVIS": np.array([5.0, 5.0, 5.0])}
+    assert hip_centre_world(pos) == pytest.approx([0.2, 0.0, 0.8])
+
+
+def test_the_retargeted_pose_does_not_depend_on_where_the_skeleton_puts_its_pelvis_joint():
+    frame = open_source("deepmimic:walk", sensor="none", seed=0).source.frames[40]
+    raised = dataclasses.replace(frame, joint_pos_world=frame.joint_pos_world.copy())
+    raised.joint_pos_world[JOINT_INDEX["PELVIS"]] += np.array([0.03, 0.0, 0.10])  # a CMU-like Hips root
+    s, r = _sample(frame), _sample(raised)
+    for a, b in zip(retargeted_pose(s, analyse_operator(s)), retargeted_pose(r, analyse_operator(r)), strict=True):
+        assert np.allclose(a, b, atol=1e-9)
+    # Taken from the pelvis joint, the root goes up with it (scaled by h_C / h_H, Eq. 9)
+    up = retargeted_pose(r, analyse_operator(r), from_hip_joints=False)[0][2]
+    assert up - retargeted_pose(s, analyse_operator(s), from_hip_joints=False)[0][2] > 0.08
+
+
+def test_the_pelvis_target_is_offset_below_his():
+    """Standing, on the first control tick (the same state either way), the pelvis target of Eq. 9 differs by the
+    offset (both below the straight legs' reach, which lowers a higher target: pose_optimization._plan_feet)."""
+    first = {}
+
+    def run(offset_m: float) -> float:
+        cfg = SessionConfig(duration_s=0.02, seed=0, operator=OperatorConfig(clip=STAND_CLIP))
+        cfg = cfg.replace(motion=dataclasses.replace(cfg.motion, pelvis_height_offset_m=offset_m))
+        source, _ = builtin_operator(cfg.operator, cfg.clocks, 1.0, 0)
+        session = Session(cfg, source)
+        session.on_tick = lambda state, ref: first.setdefault(offset_m, float(ref.pelvis_world[2]))
+        session.run()
+        return first[offset_m]
+
+    assert run(-0.14) - run(-0.07) == pytest.approx(-0.07, abs=1e-9)
+
+
+@pytest.mark.skipif(not (MOCAP / "cmu" / "02_01.bvh").is_file(), reason="../shared/mocap/cmu/02_01.bvh is not present")
+def test_a_cmu_walks_pelvis_target_comes_within_the_legs_reach():
+    """CMU's BVH files root their skeleton at a ``Hips`` joint 0.1 m above the hip joints. Taken as his pelvis, the
+    pelvis target of CMU 02_01 (seed 0, its first 2 s) lay above the lower ankle by more than the character's
+    straight leg at the median (measured 0.857 m against 0.831 m): its stance leg could not bend, and its steps were
+    0.42-0.47 m against his 0.5-0.8 m (docs/decisions.md, "His pelvis at his hip joints"). From his hip joints it is
+    below the straight leg by more than the offset."""
+    def median_height(motion: MotionConfig) -> float:
+        heights = []
+
+        def on_tick(state, ref):
+            if state.time_s <= 2.0:
+                ankle_z = min(float(state.link_origin_world[k, 2]) for k in _ANKLES)
+                heights.append(float(ref.pelvis_world[2]) - ankle_z)
+
+        suite_run("bvh:" + str(MOCAP / "cmu" / "02_01.bvh"), 0, motion, ControlConfig(), on_tick=on_tick,
+                  configure=lambda cfg: cfg.replace(duration_s=2.0))
+        return float(np.median(heights))
+
+    assert median_height(MotionConfig(pelvis_from_hip_joints=False, pelvis_height_offset_m=0.0)) > CHAR_LEG_LENGTH_M
+    assert median_height(MotionConfig()) < CHAR_LEG_LENGTH_M - 0.07
