@@ -7,6 +7,7 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
+import pytest
 from conftest import TRACED_BEFORE_PRESS, suite_run
 
 from stylesync.config import MotionConfig, follow_path
@@ -43,6 +44,7 @@ def _followed_walk(bounded: bool) -> tuple[float, int, float, bool]:
     return float(np.mean(speeds)), len(speeds), progress, result.fell
 
 
+@pytest.mark.pelvis_joint
 def test_a_step_landed_before_his_is_not_braked_to_a_stop():
     """Traced on the built-in walk with ``--follow-path`` (seed 0): the character's own steps land after 0.2 s
     against his 0.43 s swing, and on both feet, bounded within its soles, its COM target stood still while he walked

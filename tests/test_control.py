@@ -139,6 +139,7 @@ def test_the_standing_time_constant_is_validated_and_in_place_keeps_none():
         MotionConfig(reference_follows_standing_s=-0.1)
 
 
+@pytest.mark.pelvis_joint
 def test_targets_that_trail_the_settling_feet_leave_a_stance_that_creeps():
     # With the walking time constant while he stands (MotionConfig.reference_follows_standing_s None), the targets
     # trail the anchored ones by up to 1 cm while the feet settle in the first second, and on sensor seed 3 the stance
@@ -149,6 +150,7 @@ def test_targets_that_trail_the_settling_feet_leave_a_stance_that_creeps():
     assert np.abs(feet[-1] - feet[0]).max() > 0.03  # the soles, not the body over them
 
 
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_the_walk_in_place_over_sensor_noise_seeds_mostly_completes_and_follows_the_operators_steps():
     # In place (config.in_place: the defaults before the character followed his path by its landings; by default every
@@ -369,6 +371,7 @@ def test_the_feet_land_and_stay_along_the_body_not_turned_on_their_ankles():
     assert np.mean(drifting > 60.0) > 0.1
 
 
+@pytest.mark.pelvis_joint
 @pytest.mark.parametrize("placed, feet_max_deg", [(True, 60.0), (False, 90.0)])
 def test_the_walk_turns_with_an_operator_who_walks_a_circle(placed, feet_max_deg):
     # The built-in walk bent into a turn at 0.6 rad/s after the lead-in (a circle of about 1.7 m radius; 0.6 * 7 s

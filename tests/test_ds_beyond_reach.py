@@ -53,6 +53,7 @@ def _followed_walk(beyond_reach: bool) -> tuple[float, bool, float | None]:
     return longest, result.fell, result.fall_time_s
 
 
+@pytest.mark.pelvis_joint
 @pytest.mark.skipif(not WALK.exists(), reason="../shared/mocap/cmu-dev/07_05.bvh is not available")
 def test_a_double_stance_beyond_a_steps_reach_steps_at_once():
     """A step of the character's own landed its right foot beside its left at 2.12 s while the body went on at

@@ -123,6 +123,7 @@ def test_a_free_swing_carries_the_kicks_strike_to_the_ball():
     assert not reach[False]["kicked"] and reach[False]["closest_foot_m"] > 0.25
 
 
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_kick_does_not_lift_off_with_the_weight_already_beyond_the_stance_ankle():
     """The scripted kick with the free swing, seed 0: lifting off with its capture point 2.4 cm outside its stance
@@ -138,6 +139,7 @@ def test_a_kick_does_not_lift_off_with_the_weight_already_beyond_the_stance_ankl
     assert out[0.01]["kicked"] and not out[0.01]["fell"]
 
 
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_stance_foot_off_the_ground_is_held_where_it_came_off():
     """The scripted kick, seed 14: while the weight shifts onto the left foot the right one bears no force and comes
@@ -145,13 +147,14 @@ def test_a_stance_foot_off_the_ground_is_held_where_it_came_off():
     for momentum), the lift-off came from there with the weight never over the stance sole, and the kick missed.
     Held where it came off (WholeBodyConfig.press_holds_foot, off by default and in --free-swing), it stays within
     3 cm and the kick moves the ball."""
-    from stylesync.config import WholeBodyConfig
+    from stylesync.config import FREE_SWING_MOTION, MotionConfig, WholeBodyConfig
 
     out = {}
     for hold in (False, True):
         # traced before a double stance's unweighted foot was pressed down (press_double_stance_feet)
         control = ControlConfig(whole_body=WholeBodyConfig(press_holds_foot=hold, press_double_stance_feet=False))
-        result, m, _ = kick.run_one("kick", 14, control=control)
+        # (its MotionConfig made here, under the test's markers: kick.FREE_SWING is made at import)
+        result, m, _ = kick.run_one("kick", 14, motion=MotionConfig(**FREE_SWING_MOTION), control=control)
         t = result.log.array("t")
         shift = (t > kick.KICK_START_S) & (t < kick.KICK_START_S + kick.SHIFT_S + 0.25)  # before any lift-off
         right = np.stack([result.log.array("ar_x"), result.log.array("ar_y")], axis=1)[shift]

@@ -11,15 +11,14 @@ import numpy as np
 import pytest
 from conftest import suite_run
 
-from stylesync.config import ControlConfig, MotionConfig, OperatorConfig, SessionConfig
+from stylesync.config import ControlConfig, MotionConfig, SessionConfig
+from stylesync.errors import ConfigError
 from stylesync.model.character import LINK_NAMES
 from stylesync.motion.initial_state import retargeted_pose
 from stylesync.motion.operator_analysis import analyse_operator
-from stylesync.motion.pose_optimization import CHAR_LEG_LENGTH_M
+from stylesync.motion.pose_optimization import CHAR_LEG_LENGTH_M, pelvis_offset_m
 from stylesync.processing.body_parameters import hip_centre_world
 from stylesync.processing.operator_processing import OperatorProcessing
-from stylesync.session import Session
-from stylesync.sources.builtin_operator import STAND_CLIP, builtin_operator
 from stylesync.sources.frame import JOINT_INDEX
 from stylesync.sources.registry import open_source
 
@@ -51,21 +50,12 @@ def test_the_retargeted_pose_does_not_depend_on_where_the_skeleton_puts_its_pelv
     assert up - retargeted_pose(s, analyse_operator(s), from_hip_joints=False)[0][2] > 0.08
 
 
-def test_the_pelvis_target_is_offset_below_his():
-    """Standing, on the first control tick (the same state either way), the pelvis target of Eq. 9 differs by the
-    offset (both below the straight legs' reach, which lowers a higher target: pose_optimization._plan_feet)."""
-    first = {}
-
-    def run(offset_m: float) -> float:
-        cfg = SessionConfig(duration_s=0.02, seed=0, operator=OperatorConfig(clip=STAND_CLIP))
-        cfg = cfg.replace(motion=dataclasses.replace(cfg.motion, pelvis_height_offset_m=offset_m))
-        source, _ = builtin_operator(cfg.operator, cfg.clocks, 1.0, 0)
-        session = Session(cfg, source)
-        session.on_tick = lambda state, ref: first.setdefault(offset_m, float(ref.pelvis_world[2]))
-        session.run()
-        return first[offset_m]
-
-    assert run(-0.14) - run(-0.07) == pytest.approx(-0.07, abs=1e-9)
+def test_the_pelvis_target_is_offset_below_his_as_he_goes_somewhere():
+    assert pelvis_offset_m(-0.07, 0.0, 0.5) == 0.0  # standing still
+    assert pelvis_offset_m(-0.07, 0.25, 0.5) == pytest.approx(-0.035)
+    assert pelvis_offset_m(-0.07, 1.6, 0.5) == pytest.approx(-0.07)
+    with pytest.raises(ConfigError, match="pelvis_offset_full_speed_mps"):
+        MotionConfig(pelvis_offset_full_speed_mps=0.0)
 
 
 @pytest.mark.skipif(not (MOCAP / "cmu" / "02_01.bvh").is_file(), reason="../shared/mocap/cmu/02_01.bvh is not present")

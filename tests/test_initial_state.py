@@ -58,6 +58,7 @@ def test_initial_velocities_are_the_motion_between_the_two_poses():
     backend.close()
 
 
+@pytest.mark.pelvis_joint
 @needs_cmu_dev
 def test_a_bvh_run_starts_in_the_first_frame_pose_on_the_ground():
     op = OperatorConfig()

@@ -47,6 +47,7 @@ def _run(waits: bool) -> tuple[float, bool, float | None]:
     return worst, result.fell, result.fall_time_s
 
 
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_lift_off_onto_a_sole_the_capture_point_has_passed_waits():
     """The character stood on both feet, its right foot behind on its toes, while the operator, a stride ahead of it

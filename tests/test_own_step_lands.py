@@ -45,6 +45,7 @@ def _hover(gains: tuple[float, float] | None) -> tuple[int, int, bool]:
     return hover[0], due[0], result.fell
 
 
+@pytest.mark.pelvis_joint
 @pytest.mark.skipif(not CLIP.exists(), reason="../shared/mocap/cmu-dev is not present")
 def test_an_own_step_due_to_land_reaches_the_ground():
     hover, due, fell = _hover(None)

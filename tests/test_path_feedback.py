@@ -105,6 +105,7 @@ def test_follow_path_adds_the_pull_and_in_place_sets_the_former_defaults():
     assert follow_path(placed) == cfg
 
 
+@pytest.mark.pelvis_joint
 @pytest.mark.parametrize("seed", [0, 1])
 def test_the_built_in_walk_keeps_to_its_operators_path_longer_than_in_place(seed):
     """Measured (3.5 s of the built-in walk): in place the UHC termination comes at 2.42-2.45 s, the character
@@ -201,6 +202,7 @@ def test_targets_on_his_path_keep_the_stealthy_walk_within_the_uhc_distance():
 _CMU_DEV = Path(__file__).resolve().parents[2] / "shared" / "mocap" / "cmu-dev"
 
 
+@pytest.mark.pelvis_joint
 @pytest.mark.skipif(not (_CMU_DEV / "12_01.bvh").is_file(), reason="../shared/mocap/cmu-dev is not present")
 @pytest.mark.parametrize(("clip", "seed", "fall_s"), [("12_01", 6, 4.30), ("08_08", 1, 2.42), ("10_04", 0, 4.85)])
 def test_a_gait_double_stance_bounded_by_what_a_step_catches_keeps_fast_walks_up(clip, seed, fall_s):

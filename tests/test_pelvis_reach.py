@@ -43,6 +43,7 @@ def _followed_walk(share: float | None) -> tuple[float, float, bool]:
     return float(a[:, 1].max()), float(a[walking, 2].mean()), result.fell
 
 
+@pytest.mark.pelvis_joint
 @pytest.mark.skipif(not WALK.exists(), reason="../shared/mocap/cmu/02_01.bvh is not available")
 def test_a_pelvis_target_within_the_stance_legs_reach_lets_a_followed_walk_keep_its_pace():
     """Eq. 9 puts his pelvis, scaled, 6 cm above what the character's straight legs reach; the stance leg is held

@@ -38,6 +38,7 @@ def _largest_drop_m(**motion) -> float:
     return drop[0]
 
 
+@pytest.mark.pelvis_joint
 def test_his_kick_in_the_air_does_not_drop_the_pelvis_target_of_a_double_stance():
     # At 3.09 s the character stands on both feet while he kicks: from the mean of his ankles the target fell 0.67 m
     assert _largest_drop_m(ds_anchor_ground_height=False, landing_pelvis_descent_mps=None) > 0.6

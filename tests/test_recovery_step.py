@@ -370,6 +370,7 @@ def test_a_recovery_step_lands_when_its_capture_landing_would_leave_the_legs_rea
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "02_03.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/02_03.bvh is not available")
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_run_that_stops_comes_to_rest_on_steps_that_land_before_the_capture_point_leaves_the_reach(monkeypatch):
     """CMU-dev 02_03 (a run; it ends at 1.41 s, then the operator holds his last pose), seed 0, as the development
@@ -418,6 +419,7 @@ def test_a_walk_cut_mid_stride_comes_to_rest_with_its_own_last_step():
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "08_04.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/08_04.bvh is not available")
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_swing_he_stops_on_is_landed_at_once_where_the_capture_point_goes(monkeypatch):
     """CMU-dev 08_04 ends (3.99 s) on the operator's right foot; he lowers the raised left one over 0.5 s as he comes
@@ -451,6 +453,7 @@ def test_a_swing_he_stops_on_is_landed_at_once_where_the_capture_point_goes(monk
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "07_05.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/07_05.bvh is not available")
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_double_stance_whose_capture_point_has_run_out_ends_in_a_step_of_its_own(monkeypatch):
     """CMU-dev 07_05, seed 0: the character lands a recovery step (3.63 s) while the operator is still on one foot,
@@ -520,6 +523,7 @@ def test_a_swing_taken_over_in_the_air_is_lowered_from_where_it_is_to_the_captur
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "08_01.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/08_01.bvh is not available")
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_late_contact_hold_keeps_the_walk_going():
     """CMU 08_01, seed 1: the character's foot often lands after the operator's (late contact, Sec. 5.1). Held
@@ -557,6 +561,7 @@ def test_a_sideways_drift_steps_with_the_foot_that_can_catch_it_not_the_one_that
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "07_01.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/07_01.bvh is not available")
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_recovery_step_lets_the_body_move_as_its_landing_assumes():
     """CMU 07_01, seed 0, in the rest after the clip (2.6 s): the frozen operator's COM is over one of his feet, and
@@ -574,6 +579,7 @@ def test_a_recovery_step_lets_the_body_move_as_its_landing_assumes():
     assert pulled.fell and pulled.fall_time_s is not None and pulled.fall_time_s > 2.6
 
 
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_the_walk_goes_the_operators_way_with_its_swing_aimed_at_his_last_landing():
     """The built-in walk, 8 s, seed 0: each swing goes from where the character's foot lifted off to a landing placed
@@ -595,6 +601,7 @@ def test_the_walk_goes_the_operators_way_with_its_swing_aimed_at_his_last_landin
     assert progress["his_foot_now"] < 0.0
 
 
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_targets_that_follow_the_operator_keep_the_walk_up_with_him():
     """The built-in walk, 7 s: with the feet-anchored targets the character covers about a third of the operator's
@@ -724,6 +731,7 @@ def test_a_rear_foot_on_its_toes_is_read_as_still_standing():
 
 @pytest.mark.skipif(not (MOCAP / "cmu" / "02_01.bvh").exists(),
                     reason="../shared/mocap/cmu/02_01.bvh is not available")
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_recovery_step_that_must_land_lowers_the_body_until_its_foot_reaches_the_ground():
     """CMU 02_01, seed 2, in the rest after the clip: the first recovery step's landing is near the leg's full
@@ -753,6 +761,7 @@ def test_a_step_counted_as_taken_leaves_the_character_waiting_in_double_stance()
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "05_01.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/05_01.bvh is not available")
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_character_waiting_with_its_step_counted_may_still_step_on_its_own():
     """CMU-dev 05_01, seed 2, in the rest after the clip (4.9 s): the operator's held last frame is on one foot,
@@ -810,6 +819,7 @@ def test_a_rear_foot_stays_down_while_the_capture_point_is_behind_the_front_heel
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "02_03.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/02_03.bvh is not available")
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_lighter_pelvis_on_one_foot_lets_a_running_stride_swing_forward():
     """CMU-dev 02_03 (a run), seed 0: with the pelvis orientation at full weight in single stance, the first swing
@@ -855,6 +865,7 @@ def test_a_capture_point_out_of_reach_after_the_wait_is_told_from_one_a_step_the
 
 @pytest.mark.skipif(not (MOCAP / "deepmimic" / "humanoid3d_zombie_walk.txt").exists(),
                     reason="../shared/mocap/deepmimic/humanoid3d_zombie_walk.txt is not available")
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_double_stance_that_would_wait_out_of_reach_steps_at_once():
     """The DeepMimic zombie walk, seed 1: at 3.67 s the operator lifts his right foot; the character, on both feet,
@@ -893,6 +904,7 @@ def test_a_double_stance_that_would_wait_out_of_reach_steps_at_once():
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "10_04.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/10_04.bvh is not available")
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_capture_point_behind_both_feet_steps_back_at_once():
     """CMU-dev 10_04, seed 0: a stopping step landed the character's feet side by side with its COM 9 cm behind them
@@ -936,6 +948,7 @@ def test_the_com_velocity_with_a_leg_carried_leaves_out_only_the_legs_own_motion
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "09_06.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/09_06.bvh is not available")
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_the_swing_foot_of_a_recovery_step_follows_its_target():
     """CMU-dev 09_06 (a run, seed 0) steps on its own from 0.96 s. Through the joint posture alone the swing ankle
@@ -974,6 +987,7 @@ class _Stop(Exception):
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "03_02.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/03_02.bvh is not available")
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_recovery_steps_that_land_where_the_body_will_be_keep_a_walk_on_rough_ground_up():
     """CMU-dev 03_02 (walking over uneven ground, seed 1) fell 2.2 s in with the recovery step's foot driven by the
@@ -991,6 +1005,7 @@ def test_the_pelvis_floor_share_is_checked():
         traced_motion(landing_pelvis_floor_share=-0.1)
 
 
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_landing_foot_out_of_reach_does_not_put_the_pelvis_target_on_the_ground():
     """The kick in place, seed 1 (the development suite's run): from 2.2 s the kicking foot is held for its late
@@ -1055,6 +1070,7 @@ def test_an_operator_swing_is_aimed_within_the_legs_reach():
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "07_11.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/07_11.bvh is not available")
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_swing_that_would_land_out_of_reach_is_landed_by_the_balance():
     """CMU-dev 07_11 (a walk, seed 1): from 1.89 s the character, faster than its operator, stands on its right foot
@@ -1091,6 +1107,7 @@ def test_a_swing_that_would_land_out_of_reach_is_landed_by_the_balance():
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "09_01.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/09_01.bvh is not available")
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_swing_past_its_usual_time_is_landed_before_the_capture_point_runs_out_of_reach():
     """CMU-dev 09_01 (a run), seed 7: the clip ends at 1.20 s with the operator on his right foot, his left foot
@@ -1137,6 +1154,7 @@ def test_a_swing_past_its_usual_time_is_landed_before_the_capture_point_runs_out
     assert result_old.fell and result_old.fall_time_s < 3.0  # measured: 2.25 s
 
 
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_recovery_step_just_short_of_its_crossover_clearance_lands_on_the_capture_points_side():
     """The built-in spin, seed 0: the operator leaps forward and to the right while he turns. At 2.51 s the
@@ -1186,6 +1204,7 @@ def test_a_recovery_step_just_short_of_its_crossover_clearance_lands_on_the_capt
 
 @pytest.mark.skipif(not (MOCAP / "deepmimic" / "humanoid3d_stealthy_walk.txt").exists(),
                     reason="../shared/mocap/deepmimic/humanoid3d_stealthy_walk.txt is not available")
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_the_next_recovery_step_begins_while_both_soles_are_down():
     """The DeepMimic stealthy walk, seed 2: a recovery step's right foot lands at 3.49 s with the capture point 4 cm
@@ -1241,6 +1260,7 @@ def test_the_swing_profiles_velocity_is_its_targets_rate_with_the_landing_held()
         WholeBodyConfig(recovery_foot_target_rate="finite")
 
 
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_recovery_foot_follows_its_swing_profiles_velocity_not_the_landings_replanning():
     """The humanoid3d run, seed 14, as the suite runs it. Each tick a recovery step's landing is planned again on the
@@ -1296,6 +1316,7 @@ def test_the_swing_target_is_back_at_the_ground_by_the_touchdown_share():
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "07_11.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/07_11.bvh is not available")
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_recovery_steps_that_touch_down_on_time_stop_a_walk():
     """CMU-dev 07_11 (a walk, seed 2) stops in the rest after its clip (from 2.58 s) with steps of its own. With the
@@ -1334,6 +1355,7 @@ def test_a_landing_gap_must_be_positive():
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "08_08.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/08_08.bvh is not available")
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_recovery_step_that_reaches_the_ground_on_a_corner_has_landed():
     """CMU-dev 08_08 (a fast walk, seed 3). Counted as landed only once it pressed the ground with 5 N, the recovery
@@ -1377,6 +1399,7 @@ def test_a_recovery_step_that_reaches_the_ground_on_a_corner_has_landed():
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "08_08.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/08_08.bvh is not available")
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_recovery_step_whose_landing_is_due_is_pressed_onto_the_ground():
     """CMU-dev 08_08, seed 1, in the rest after the clip: with the recovery foot's task at its swing weight after the

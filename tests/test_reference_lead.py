@@ -38,6 +38,7 @@ def _run(lead_max_m: float | None) -> tuple[float, bool, float | None]:
     return ahead[0], result.fell, result.fall_time_s
 
 
+@pytest.mark.pelvis_joint
 @pytest.mark.skipif(not CLIP.exists(), reason="../shared/mocap/cmu-dev is not present")
 def test_targets_ahead_of_a_runner_stay_within_reach_of_his_stop():
     ahead, fell, fall_s = _run(None)

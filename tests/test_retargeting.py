@@ -52,6 +52,7 @@ def test_the_airborne_share_must_be_positive():
         MotionConfig(airborne_ankle_height_leg=0.0)
 
 
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_the_spins_leap_does_not_fold_the_stance_leg():
     """The built-in spin, seed 8: from 2.65 s the operator leaps and turns with his body horizontal, his feet 1.4-1.6 m
@@ -140,6 +141,7 @@ def test_the_fraction_between_the_feet_needs_them_in_his_order_where_asked():
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "09_11.bvh").exists(),
                     reason="needs ../shared/mocap/cmu-dev/09_11.bvh (not in the repository)")
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_recovery_step_that_puts_the_other_foot_ahead_does_not_pull_the_body_back_over_the_rear_one():
     # CMU-dev 09_11 (a run, seed 0), traced: in the rest after the clip the character stands on its left foot, his

@@ -6,6 +6,7 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
+import pytest
 
 from stylesync.config import OperatorConfig, SessionConfig
 from stylesync.session import Session
@@ -33,6 +34,7 @@ def _late_contact_drops(within_reach: bool) -> tuple[np.ndarray, bool]:
     return heights[onsets] - heights[onsets + 1], result.fell
 
 
+@pytest.mark.pelvis_joint
 def test_a_late_contact_finds_the_pelvis_target_already_within_the_landing_feet_reach():
     before, fell_before = _late_contact_drops(False)
     after, fell_after = _late_contact_drops(True)

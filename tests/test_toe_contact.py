@@ -177,6 +177,7 @@ def _walk_pelvis(stretch: float | None) -> tuple[bool, float, int]:
     return result.fell, low[0], toes[0]
 
 
+@pytest.mark.pelvis_joint
 @pytest.mark.skipif(not WALK.exists(), reason="../shared/mocap/deepmimic is not present")
 def test_a_rear_foot_on_its_toes_keeps_the_pelvis_up_in_a_long_stride():
     """Traced on this walk: with flat soles the rear leg is straight from 2.77 s to its lift-off at 3.04 s while the

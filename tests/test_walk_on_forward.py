@@ -6,6 +6,7 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
+import pytest
 from conftest import TRACED_BEFORE_PRESS, suite_run
 
 from stylesync import rotations as rot
@@ -42,6 +43,7 @@ def _dance(forward: bool) -> tuple[bool, float | None, int, float]:
     return result.fell, result.fall_time_s, backwards[0], speed[0]
 
 
+@pytest.mark.pelvis_joint
 def test_own_steps_do_not_walk_on_where_he_goes_sideways_or_backwards():
     fell, fall_s, backwards, speed = _dance(False)
     # His way 120-145° from his heading (he travels back and to the side, turning), the character's own steps landed

@@ -146,6 +146,7 @@ def test_opening_a_problems_limits_opens_its_torque_and_hinge_rows_only(standing
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "07_11.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/07_11.bvh is not available")
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_qp_with_no_feasible_point_does_not_throw_the_limbs():
     """CMU-dev 07_11 (a walk, seed 2): at 1.35 s a recovery step begins from a double stance with the feet 0.64 m
@@ -283,6 +284,7 @@ def test_a_joint_past_its_no_load_speed_gets_no_torque_along_its_motion():
     assert limit_joint_speed(limited, vel, 60.0) == 0  # nothing over a higher limit
 
 
+@pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_light_link_does_not_spin_up_within_a_control_tick():
     """The built-in dance_a, seed 2 (the development suite's settings): at 3.45-3.54 s a reference jump's torques,
