@@ -54,8 +54,12 @@ def test_the_pelvis_target_is_offset_below_his_as_he_goes_somewhere():
     assert pelvis_offset_m(-0.07, 0.0, 0.5) == 0.0  # standing still
     assert pelvis_offset_m(-0.07, 0.25, 0.5) == pytest.approx(-0.035)
     assert pelvis_offset_m(-0.07, 1.6, 0.5) == pytest.approx(-0.07)
+    assert pelvis_offset_m(-0.07, 0.9, 1.5, 1.0) == 0.0  # below a start speed, none
+    assert pelvis_offset_m(-0.07, 1.25, 1.5, 1.0) == pytest.approx(-0.035)
     with pytest.raises(ConfigError, match="pelvis_offset_full_speed_mps"):
         MotionConfig(pelvis_offset_full_speed_mps=0.0)
+    with pytest.raises(ConfigError, match="pelvis_offset_full_speed_mps"):
+        MotionConfig(pelvis_offset_start_speed_mps=1.0, pelvis_offset_full_speed_mps=0.8)
 
 
 @pytest.mark.skipif(not (MOCAP / "cmu" / "02_01.bvh").is_file(), reason="../shared/mocap/cmu/02_01.bvh is not present")

@@ -490,6 +490,8 @@ class MotionConfig:
     # ... in full while his scaled COM speed is at least this, in proportion below it (standing, none: a standing
     # character lowered by it drifted 2.2-2.3 cm in 60 s against 1.4 and 0.6 cm) [m/s]
     pelvis_offset_full_speed_mps: float = 0.5
+    # ... and none up to this speed of his (between the two, in proportion) [m/s]
+    pelvis_offset_start_speed_mps: float = 0.0
 
     def __post_init__(self) -> None:
         lo, hi = self.step_outside_capture_point_m
@@ -517,7 +519,10 @@ class MotionConfig:
             _positive("MotionConfig.airborne_ankle_height_leg", self.airborne_ankle_height_leg)
         if self.pelvis_min_height_m is not None:
             _positive("MotionConfig.pelvis_min_height_m", self.pelvis_min_height_m)
-        _positive("MotionConfig.pelvis_offset_full_speed_mps", self.pelvis_offset_full_speed_mps)
+        _non_negative("MotionConfig.pelvis_offset_start_speed_mps", self.pelvis_offset_start_speed_mps)
+        if self.pelvis_offset_full_speed_mps <= self.pelvis_offset_start_speed_mps:
+            raise ConfigError(f"MotionConfig.pelvis_offset_full_speed_mps ({self.pelvis_offset_full_speed_mps}) must "
+                              f"be above pelvis_offset_start_speed_mps ({self.pelvis_offset_start_speed_mps})")
         _non_negative("MotionConfig.recovery_step_margin_m", self.recovery_step_margin_m)
         if self.double_stance_keeps_momentum_m is not None:
             _non_negative("MotionConfig.double_stance_keeps_momentum_m", self.double_stance_keeps_momentum_m)

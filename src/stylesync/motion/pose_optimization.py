@@ -119,11 +119,14 @@ OPERATOR_VELOCITY_SETTLE_S = 0.2  # the operator's filtered COM velocity is take
 HEEL_AHEAD_OF_ANKLE_M = FOOT_CENTER_AHEAD_OF_ANKLE_M - FOOT_LENGTH_M / 2  # < 0: the heel is behind the ankle [m]
 
 
-def pelvis_offset_m(offset_m: float, his_speed_mps: float, full_speed_mps: float) -> float:
+def pelvis_offset_m(offset_m: float, his_speed_mps: float, full_speed_mps: float, start_speed_mps: float = 0.0
+                    ) -> float:
     """The pelvis target's offset from his (MotionConfig.pelvis_height_offset_m) [m] at his scaled horizontal COM
-    speed ``his_speed_mps`` [m/s]: in full from ``full_speed_mps`` on, in proportion below it, none while he stands
-    still."""
-    return offset_m * min(his_speed_mps / full_speed_mps, 1.0)
+    speed ``his_speed_mps`` [m/s]: none up to ``start_speed_mps`` (standing still, none), in full from
+    ``full_speed_mps`` on, in proportion between."""
+    if his_speed_mps <= start_speed_mps:
+        return 0.0
+    return offset_m * min((his_speed_mps - start_speed_mps) / (full_speed_mps - start_speed_mps), 1.0)
 
 
 def _heading_world(tick: _Tick) -> np.ndarray:
@@ -616,7 +619,8 @@ class MotionOptimizer:
         # ... lowered by the offset as he goes somewhere (his smoothed COM rate, scaled)
         his_speed_mps = scale * float(np.hypot(self._com_h_rate.rate[0], self._com_h_rate.rate[1]))
         cfg = self.cfg
-        offset_m = pelvis_offset_m(cfg.pelvis_height_offset_m, his_speed_mps, cfg.pelvis_offset_full_speed_mps)
+        offset_m = pelvis_offset_m(cfg.pelvis_height_offset_m, his_speed_mps, cfg.pelvis_offset_full_speed_mps,
+                                   cfg.pelvis_offset_start_speed_mps)
         tick.pelvis_d = np.array([pelvis_xy[0], pelvis_xy[1],  # Eq. 9
                                   ANKLE_HEIGHT_M + scale * (p_h[2] - ankle_h_z) + offset_m])
         tick.pelvis_vel_z = scale * float(self._pelvis_h_rate(p_h)[2])
