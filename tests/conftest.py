@@ -42,10 +42,10 @@ TRACED_BEFORE_PRESS = ControlConfig(whole_body=WholeBodyConfig(press_double_stan
                                                                own_step_push_bound="he_stands"))
 
 
-# Scenarios traced with his skeleton's pelvis joint as his pelvis and the pelvis target at his (scaled), before the
-# retargeting went through his hip joints with the target below his (MotionConfig.pelvis_from_hip_joints,
+# Scenarios traced with his skeleton's pelvis joint as his pelvis and the pelvis target at his (scaled), the defaults,
+# not through his hip joints with the target below his (`--long-stride`: MotionConfig.pelvis_from_hip_joints,
 # pelvis_height_offset_m; docs/decisions.md, "His pelvis at his hip joints"): the tests that run them carry the
-# pelvis_joint marker.
+# pelvis_joint marker, so that they stay as traced whatever the defaults.
 PELVIS_JOINT_MOTION = {"pelvis_from_hip_joints": False, "pelvis_height_offset_m": 0.0}
 
 

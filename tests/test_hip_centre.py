@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from conftest import suite_run
 
-from stylesync.config import ControlConfig, MotionConfig, SessionConfig
+from stylesync.config import LONG_STRIDE_MOTION, ControlConfig, MotionConfig, SessionConfig
 from stylesync.errors import ConfigError
 from stylesync.model.character import LINK_NAMES
 from stylesync.motion.initial_state import retargeted_pose
@@ -67,8 +67,8 @@ def test_a_cmu_walks_pelvis_target_comes_within_the_legs_reach():
     """CMU's BVH files root their skeleton at a ``Hips`` joint 0.1 m above the hip joints. Taken as his pelvis, the
     pelvis target of CMU 02_01 (seed 0, its first 2 s) lay above the lower ankle by more than the character's
     straight leg at the median (measured 0.857 m against 0.831 m): its stance leg could not bend, and its steps were
-    0.42-0.47 m against his 0.5-0.8 m (docs/decisions.md, "His pelvis at his hip joints"). From his hip joints it is
-    below the straight leg by more than the offset."""
+    0.42-0.47 m against his 0.5-0.8 m (docs/decisions.md, "His pelvis at his hip joints"). From his hip joints and
+    lowered as he goes (`--long-stride`) it is below the straight leg by more than the offset."""
     def median_height(motion: MotionConfig) -> float:
         heights = []
 
@@ -81,5 +81,18 @@ def test_a_cmu_walks_pelvis_target_comes_within_the_legs_reach():
                   configure=lambda cfg: cfg.replace(duration_s=2.0))
         return float(np.median(heights))
 
-    assert median_height(MotionConfig(pelvis_from_hip_joints=False, pelvis_height_offset_m=0.0)) > CHAR_LEG_LENGTH_M
-    assert median_height(MotionConfig()) < CHAR_LEG_LENGTH_M - 0.07
+    assert median_height(MotionConfig()) > CHAR_LEG_LENGTH_M  # the default: his pelvis joint
+    assert median_height(MotionConfig(**LONG_STRIDE_MOTION)) < CHAR_LEG_LENGTH_M - 0.07
+
+
+def test_long_stride_on_the_command_line_sets_both():
+    import argparse
+
+    from stylesync.cli import _motion_options
+
+    names = ("in_place", "follow_path", "free_swing", "no_track_rise")
+    args = argparse.Namespace(**dict.fromkeys(names, False), long_stride=True)
+    motion = _motion_options(SessionConfig(), args).motion
+    assert motion.pelvis_from_hip_joints and motion.pelvis_height_offset_m == -0.07
+    default = _motion_options(SessionConfig(), argparse.Namespace(**dict.fromkeys(names, False), long_stride=False))
+    assert not default.motion.pelvis_from_hip_joints and default.motion.pelvis_height_offset_m == 0.0

@@ -24,6 +24,7 @@ from stylesync.config import (
     follow_path,
     free_swing,
     in_place,
+    long_stride,
     no_track_rise,
 )
 from stylesync.errors import ConfigError, SourceError, StylesyncError
@@ -177,6 +178,7 @@ def _demo(args: argparse.Namespace) -> int:
                                                       "follow_path": args.follow_path,
                                                       "in_place": args.in_place,
                                                       "free_swing": args.free_swing,
+                                                      "long_stride": args.long_stride,
                                                       "track_rise": not args.no_track_rise}, args)
 
 
@@ -189,7 +191,7 @@ def _suite_operator(args: argparse.Namespace) -> OperatorConfig:
 
 def _motion_options(cfg: SessionConfig, args: argparse.Namespace) -> SessionConfig:
     """``cfg`` with the options asked for on the command line (--in-place, --follow-path, --free-swing,
-    --no-track-rise)."""
+    --long-stride, --no-track-rise)."""
     if args.in_place and args.follow_path:
         raise ConfigError("--in-place and --follow-path contradict each other: give one of them")
     if args.in_place:
@@ -198,6 +200,8 @@ def _motion_options(cfg: SessionConfig, args: argparse.Namespace) -> SessionConf
         cfg = follow_path(cfg)
     if args.free_swing:
         cfg = free_swing(cfg)
+    if args.long_stride:
+        cfg = long_stride(cfg)
     if args.no_track_rise:
         cfg = no_track_rise(cfg)
     return cfg
@@ -233,6 +237,7 @@ def _run(args: argparse.Namespace) -> int:
                                                               "follow_path": args.follow_path,
                                                               "in_place": args.in_place,
                                                               "free_swing": args.free_swing,
+                                                              "long_stride": args.long_stride,
                                                               "track_rise": not args.no_track_rise,
                                                               **opened.extras}, args)
 
@@ -364,6 +369,10 @@ def _add_session_args(p: argparse.ArgumentParser, out_default: str, realtime_hel
                    help="a swing foot follows the operator's while both stand balanced on the other foot, lifted "
                         "only with the weight over that ankle (a kick strikes); by default every swing goes to a "
                         "landing placed for balance")
+    p.add_argument("--long-stride", action="store_true",
+                   help="his pelvis taken at his hip joints and the character's lowered 7 cm as he goes: longer "
+                        "steps, a walk that keeps up with him more often; the built-in walk falls out of step "
+                        "(README, status)")
     p.add_argument("--no-track-rise", action="store_true",
                    help="the pelvis height's law damps every vertical speed, a jump's push included (by default it "
                         "tracks half the operator's rise begun and kept on both feet; README, status)")
