@@ -55,7 +55,7 @@ class InitialState:
 
 
 def retargeted_pose(s: OperatorSample, analysis: OperatorAnalysis, scale: float | None = None,
-                    from_hip_joints: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                    from_hip_joints: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(root position [m], root quaternion, joint positions) of the character for one operator sample, the pelvis
     over the ground at the operator's, scaled by ``scale`` (default h_C / h_H of this sample, Eq. 9) from the world
     origin (differences of poses at one scale give velocities). His pelvis is the midpoint of his hip joints with
@@ -85,7 +85,7 @@ def retargeted_pose(s: OperatorSample, analysis: OperatorAnalysis, scale: float 
 
 
 def initial_state(s0: OperatorSample, a0: OperatorAnalysis, s1: OperatorSample, a1: OperatorAnalysis,
-                  from_hip_joints: bool = True) -> InitialState:
+                  from_hip_joints: bool = False) -> InitialState:
     """The character's state at ``s0``, with velocities from the forward difference to ``s1`` (later); his pelvis
     as :func:`retargeted_pose` takes it."""
     dt = s1.time_s - s0.time_s
