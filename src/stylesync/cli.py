@@ -285,6 +285,7 @@ def _bench(args: argparse.Namespace) -> int:
         from stylesync.metrics.dev_suite import (
             FOLLOW_PATH_VERSION,
             IN_PLACE_VERSION,
+            LONG_STRIDE_VERSION,
             ORDER,
             SUITE_CONTROLLERS,
             run_dev_suite,
@@ -296,14 +297,16 @@ def _bench(args: argparse.Namespace) -> int:
             raise ConfigError(f"unknown categories {', '.join(unknown)}; expected some of {', '.join(ORDER)}")
         mocap = shared / "mocap"
         # the follow-path and in-place versions beside stylesync's (the first), before the baselines
-        versions = ((FOLLOW_PATH_VERSION,) if args.follow_path else ()) + ((IN_PLACE_VERSION,) if args.in_place else ())
+        versions = tuple(v for v, given in ((FOLLOW_PATH_VERSION, args.follow_path), (IN_PLACE_VERSION, args.in_place),
+                                            (LONG_STRIDE_VERSION, args.long_stride)) if given)
         controllers = (*SUITE_CONTROLLERS[:1], *versions, *SUITE_CONTROLLERS[1:])
         report = run_dev_suite(Path(args.out), args.seeds, args.duration, mocap if mocap.is_dir() else None, only,
                                controllers=controllers, workers=args.workers, executor=args.executor,
                                first_seed=args.seed, operator=_suite_operator(args))
     else:
         for flag, given in (("--mirror", args.mirror), ("--sensor-noise", args.sensor_noise != 1.0),
-                            ("--follow-path", args.follow_path), ("--in-place", args.in_place)):
+                            ("--follow-path", args.follow_path), ("--in-place", args.in_place),
+                            ("--long-stride", args.long_stride)):
             if given:
                 raise ConfigError(f"{flag} is a dev-suite option: use it with --suite dev")
         report = run_bench(Path(args.out), args.duration, args.seed, shared if shared.is_dir() else None,
@@ -526,6 +529,9 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--in-place", action="store_true",
                        help="dev suite: also the controller with --in-place's settings, in the same run (the "
                             "'in-place' rows, paired with stylesync's)")
+    bench.add_argument("--long-stride", action="store_true",
+                       help="dev suite: also the controller with --long-stride's settings, in the same run (the "
+                            "'long-stride' rows, paired with stylesync's)")
     bench.add_argument("--workers", type=typed.integer(1, 256), default=2,
                        help="runs in parallel (with --executor processes or ray, and for the dev suite)")
     bench.add_argument("--executor", choices=("processes", "ray", "inline"),
