@@ -34,7 +34,7 @@ from stylesync.model.character import (
 from stylesync.motion.leg_ik import solve_leg
 from stylesync.motion.operator_analysis import OperatorAnalysis
 from stylesync.motion.pose_optimization import CHAR_LEG_LENGTH_M, joint_targets, map_upper_body
-from stylesync.processing.body_parameters import hip_centre_world
+from stylesync.processing.body_parameters import operator_pelvis_world
 from stylesync.processing.operator_processing import OperatorSample
 
 _UP = np.array([0.0, 0.0, 1.0])
@@ -64,7 +64,7 @@ def retargeted_pose(s: OperatorSample, analysis: OperatorAnalysis, scale: float 
         scale = CHAR_LEG_LENGTH_M / analysis.leg_m  # Eq. 9
     q_root = analysis.root_quat_wxyz
     R_root = rot.matrix_from_quat(q_root)
-    p_h = hip_centre_world(s.pos) if from_hip_joints else s.pos["PELVIS"]
+    p_h = operator_pelvis_world(s.pos, from_hip_joints)
     ankles = {side: s.pos[f"ANKLE_{side.upper()}"] for side in ("left", "right")}
     ankle_h_z = min(a[2] for a in ankles.values())
     pelvis = np.array([scale * p_h[0], scale * p_h[1], ANKLE_HEIGHT_M + scale * (p_h[2] - ankle_h_z)])  # Eq. 9
@@ -103,7 +103,7 @@ def initial_state(s0: OperatorSample, a0: OperatorAnalysis, s1: OperatorSample, 
     for k in _BALL:
         joint_vel[k] = rot.rotvec_from_quat(rot.multiply(rot.conjugate(j0[k]), rot.align_sign(j1[k], j0[k]))) / dt
     joint_vel[_HINGE, 0] = (j1[_HINGE, 0] - j0[_HINGE, 0]) / dt
-    pelvis = hip_centre_world(s0.pos) if from_hip_joints else s0.pos["PELVIS"]
+    pelvis = operator_pelvis_world(s0.pos, from_hip_joints)
     origin = np.array([pelvis[0] - p0[0], pelvis[1] - p0[1], 0.0])  # at the operator's pelvis
     return InitialState(p0 + origin, q0, j0, (p1 - p0) / dt, ang_root, joint_vel)
 

@@ -74,7 +74,7 @@ from stylesync.motion.stance_fsm import (
     stance_weights,
     swing_side,
 )
-from stylesync.processing.body_parameters import hip_centre_world, leg_length_m
+from stylesync.processing.body_parameters import leg_length_m, operator_pelvis_world
 from stylesync.processing.interpolation import smooth_step
 from stylesync.processing.joint_map import hinge_angle
 from stylesync.processing.operator_processing import OperatorSample
@@ -527,7 +527,7 @@ class MotionOptimizer:
         # (operator_processing.py).
         a_hs = s.support_ankle_world
         a_c = tick.a_c = {k: state.link_origin_world[_LINK[f"{k}_ankle"]].copy() for k in _SIDE_UP}
-        p_h = tick.p_h = hip_centre_world(s.pos) if self.cfg.pelvis_from_hip_joints else s.pos["PELVIS"]
+        p_h = tick.p_h = operator_pelvis_world(s.pos, self.cfg.pelvis_from_hip_joints)
         com_h = tick.com_h = s.com_world
         com_c = tick.com_c = mass.com(state)
         tick.com_vel_c = mass.com_velocity(state)
@@ -616,11 +616,13 @@ class MotionOptimizer:
                     norms = np.linalg.norm(lead, axis=1, keepdims=True)
                     self._ref_xy = raw + lead * np.minimum(1.0, lead_max / np.maximum(norms, 1e-12))
             pelvis_xy[:2], com_xy[:2] = self._ref_xy[0], self._ref_xy[1]
-        # ... lowered by the offset as he goes somewhere (his smoothed COM rate, scaled)
-        his_speed_mps = scale * float(np.hypot(self._com_h_rate.rate[0], self._com_h_rate.rate[1]))
+        # ... lowered by the offset as he goes somewhere (his smoothed COM rate, scaled; none by default)
         cfg = self.cfg
-        offset_m = pelvis_offset_m(cfg.pelvis_height_offset_m, his_speed_mps, cfg.pelvis_offset_full_speed_mps,
-                                   cfg.pelvis_offset_start_speed_mps)
+        offset_m = 0.0
+        if cfg.pelvis_height_offset_m:
+            his_speed_mps = scale * float(np.hypot(self._com_h_rate.rate[0], self._com_h_rate.rate[1]))
+            offset_m = pelvis_offset_m(cfg.pelvis_height_offset_m, his_speed_mps, cfg.pelvis_offset_full_speed_mps,
+                                       cfg.pelvis_offset_start_speed_mps)
         tick.pelvis_d = np.array([pelvis_xy[0], pelvis_xy[1],  # Eq. 9
                                   ANKLE_HEIGHT_M + scale * (p_h[2] - ankle_h_z) + offset_m])
         tick.pelvis_vel_z = scale * float(self._pelvis_h_rate(p_h)[2])

@@ -63,6 +63,12 @@ def hip_centre_world(pos: dict[str, np.ndarray]) -> np.ndarray:
     return 0.5 * (np.asarray(pos["HIP_LEFT"], dtype=float) + np.asarray(pos["HIP_RIGHT"], dtype=float))
 
 
+def operator_pelvis_world(pos: dict[str, np.ndarray], from_hip_joints: bool) -> np.ndarray:
+    """(3,) his pelvis as the retargeting of Eq. 9-10 takes it [m]: :func:`hip_centre_world` with
+    ``from_hip_joints`` (MotionConfig.pelvis_from_hip_joints), else his skeleton's pelvis joint."""
+    return hip_centre_world(pos) if from_hip_joints else pos["PELVIS"]
+
+
 def leg_length_m(pos: dict[str, np.ndarray], ankle_height_m: float) -> float:
     """Hip-joint height of a straight leg: thigh + shank (Eq. 1) + ankle height [m], mean of both legs."""
     lengths = [link_length(pos[f"HIP_{s}"], pos[f"KNEE_{s}"]) + link_length(pos[f"KNEE_{s}"], pos[f"ANKLE_{s}"])
