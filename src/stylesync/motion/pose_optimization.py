@@ -242,6 +242,7 @@ class _Tick:
     ankle_h_z: float = 0.0
     pelvis_d: np.ndarray = field(default_factory=lambda: np.zeros(3))
     pelvis_vel_z: float = 0.0  # the pelvis target's vertical speed [m/s]
+    pelvis_offset_m: float = 0.0  # the pelvis target less his, scaled (MotionConfig.pelvis_height_offset_m) [m]
     com_d: np.ndarray = field(default_factory=lambda: np.zeros(3))
     com_vel_d: np.ndarray = field(default_factory=lambda: np.zeros(3))
     weights: dict[str, float] = field(default_factory=dict)  # stance weights
@@ -623,6 +624,7 @@ class MotionOptimizer:
             his_speed_mps = scale * float(np.hypot(self._com_h_rate.rate[0], self._com_h_rate.rate[1]))
             offset_m = pelvis_offset_m(cfg.pelvis_height_offset_m, his_speed_mps, cfg.pelvis_offset_full_speed_mps,
                                        cfg.pelvis_offset_start_speed_mps)
+        tick.pelvis_offset_m = offset_m
         tick.pelvis_d = np.array([pelvis_xy[0], pelvis_xy[1],  # Eq. 9
                                   ANKLE_HEIGHT_M + scale * (p_h[2] - ankle_h_z) + offset_m])
         tick.pelvis_vel_z = scale * float(self._pelvis_h_rate(p_h)[2])
@@ -1166,6 +1168,9 @@ class MotionOptimizer:
             self._swing_t0_s = state.time_s
             self._liftoff_xy = a_c[side][:2].copy()
         target = tick.pelvis_d + scale * (a_h[side] - tick.p_h)
+        # His foot's height above his ground is his style (Sec. 5.2): a pelvis target lowered from his
+        # (pelvis_height_offset_m) does not lower the swing foot with it.
+        target[2] -= tick.pelvis_offset_m
         if cfg.swing_placement == "capture_point":
             com_c = tick.com_c
             xi_c = com_c + tick.com_vel_c * np.sqrt(max(com_c[2], 0.1) / self.g)
