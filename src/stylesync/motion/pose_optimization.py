@@ -632,6 +632,8 @@ class MotionOptimizer:
             tick.pelvis_vel_z = self._his_rise.rise_mps(tick.pelvis_vel_z, tick.op_state is Stance.DS)
         floor_m = self.cfg.pelvis_min_height_m
         if floor_m is not None and tick.pelvis_d[2] < floor_m and _trunk_upright(s.pos["NECK"] - p_h):
+            # (lowered by the offset only as far as the floor: a crouch of his own below it is not the offset's)
+            tick.pelvis_offset_m = min(0.0, floor_m - (float(tick.pelvis_d[2]) - offset_m))
             tick.pelvis_d[2] = floor_m  # his crouch followed down to the floor, above a fall's height
             tick.pelvis_vel_z = max(tick.pelvis_vel_z, 0.0)
         # The operator's COM height reflects his own mass distribution, not the character's: the vertical is left
