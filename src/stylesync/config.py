@@ -951,8 +951,8 @@ FREE_SWING_MOTION: dict[str, Any] = {
 
 # His pelvis at his hip joints and the pelvis target lowered as he goes (docs/decisions.md, "His pelvis at his hip
 # joints"): `--long-stride`. In-process runs of the suite's clips (every category but acrobatics, seeds 0-15): 128 of
-# 704 without a UHC termination against 100 (the walks 58 of 224 against 30), 684 complete against 687; the
-# built-in walk out of step with him (its largest transition delay 0.19-0.86 s over seeds 0-7).
+# 704 without a UHC termination against 100 (the walks 55 of 224 against 30), 692 complete against 687; the
+# built-in walk out of step with him (its largest transition delay 0.07-0.73 s over seeds 0-7, 0.32 s on the demo's).
 LONG_STRIDE_MOTION: dict[str, Any] = {
     "pelvis_from_hip_joints": True,
     "pelvis_height_offset_m": -0.07,
