@@ -17,10 +17,10 @@ import argparse
 import statistics
 from concurrent.futures import ProcessPoolExecutor
 
-from stylesync.metrics.dev_suite import FOLLOW_PATH_VERSION, run_clip
+from stylesync.metrics.dev_suite import FOLLOW_PATH_VERSION, clip_specs, run_clip
 
-# The looping humanoid3d clips that are not acrobatics (the suite's walk, run, jump, kick and arm categories)
-CLIPS = ("walk", "run", "jump", "kick", "spinkick", "punch", "dance_a", "dance_b", "spin")
+# The looping humanoid3d clips of the suite that are not acrobatics (its walk, run, jump, kick and arm categories)
+CLIPS = tuple(name for _, name, category in clip_specs(None) if category != "acrobatics")
 
 
 def _run(job: tuple[str, int, float, str]) -> tuple[str, int, dict]:
