@@ -37,6 +37,11 @@ from stylesync.sim.backend import PhysicsBackend
 
 _Q_MODEL_WORLD = rot.conjugate(Q_WORLD_MODEL)
 SOCCER_BALL_URDF = "soccerball.urdf"
+# The ground is pybullet_data's plane.urdf, whose collision shape is a box 200 m square (its top face at z = 0). It
+# is kept centred on the multiple of GROUND_TILE_M nearest the character (PyBulletBackend._keep_ground_under): the
+# character always has at least GROUND_TILE_M / 2 of ground around it, wherever a recording puts its operator or a
+# long walk takes it; near the origin the ground never moves [m].
+GROUND_TILE_M = 100.0
 
 
 @contextlib.contextmanager
@@ -96,6 +101,7 @@ class PyBulletBackend(PhysicsBackend):
         self._world = world
         self._fixed_root = fixed_root
         self.plane = c.loadURDF("plane.urdf", [0, 0, 0], useFixedBase=True)
+        self._ground_centre_xy = (0.0, 0.0)
         with _quiet_stdout():  # the URDF importer prints warnings about axis-less spherical joints
             self.body = c.loadURDF(
                 URDF_PATH_IN_PYBULLET_DATA,
@@ -149,6 +155,7 @@ class PyBulletBackend(PhysicsBackend):
         q_link = rot.multiply(np.asarray(root_quat_wxyz, dtype=float), Q_WORLD_MODEL)
         c.resetBasePositionAndOrientation(self.body, list(root_pos_world), rot.xyzw_from_wxyz(q_link).tolist())
         c.resetBaseVelocity(self.body, [0, 0, 0], [0, 0, 0])
+        self._keep_ground_under(root_pos_world)
         for k, j in enumerate(self._joint_idx):
             if self._is_ball[k]:
                 q = rot.IDENTITY_WXYZ if joint_pos is None else rot.normalize(joint_pos[k])
@@ -156,6 +163,15 @@ class PyBulletBackend(PhysicsBackend):
             else:
                 angle = 0.0 if joint_pos is None else float(joint_pos[k, 0])
                 c.resetJointState(self.body, j, angle, 0.0)
+
+    def _keep_ground_under(self, pos_world) -> None:
+        """Centre the ground on the multiple of GROUND_TILE_M nearest ``pos_world`` (horizontally) if it is not
+        there yet: the same surface (z = 0) goes on under the character; no force acts on it."""
+        centre = (GROUND_TILE_M * round(float(pos_world[0]) / GROUND_TILE_M),
+                  GROUND_TILE_M * round(float(pos_world[1]) / GROUND_TILE_M))
+        if centre != self._ground_centre_xy:
+            self._pb.resetBasePositionAndOrientation(self.plane, [centre[0], centre[1], 0.0], [0.0, 0.0, 0.0, 1.0])
+            self._ground_centre_xy = centre
 
     def set_velocities(self, root_lin_vel_world, root_ang_vel_world, joint_vel) -> None:
         """Initial velocities (tests of the kinematics): root [m/s], [rad/s] (world), joints as in
@@ -208,6 +224,7 @@ class PyBulletBackend(PhysicsBackend):
         c = self._pb
         fb = self.read_joint_feedback()
         base_pos, _, lin_vel, _, _ = self._read_raw()
+        self._keep_ground_under(base_pos)
         links = c.getLinkStates(self.body, self._link_idx, computeLinkVelocity=1, computeForwardKinematics=1)
         # One array of each link's COM (3), frame origin (3), orientation xyzw (4), COM velocity (3), angular
         # velocity (3), split into views.
