@@ -241,6 +241,12 @@ class MotionConfig:
     recovery_swing_min_s: float | None = 0.1
     recovery_step_height_m: float = 0.05
     recovery_min_stance_s: float = 0.03
+    # A step from double stance does not stand on a foot that bears less than this share of the two soles' normal
+    # force while the COM moves away from its ankle: lifted, the loaded foot left the body on neither sole (the
+    # humanoid3d jump, seed 1: both soles bore nothing for 0.13 s and it fell; docs/decisions.md, "A step of its
+    # own onto an unloaded foot"). A foot the body moves onto stands, loaded or not: one just landed ahead is about
+    # to bear it (None: by the capture point alone) [-]
+    recovery_stance_min_load_share: float | None = None
     # A recovery step's foot target comes down to the ground at this share of recovery_swing_s (and is then aimed
     # below it until the foot touches): the foot trails its target, and aimed at the ground only at the swing's end
     # it touched down 0.03 s late at the median and 0.1 s late or more on one step in five, while the capture point

@@ -1038,7 +1038,8 @@ class MotionOptimizer:
         (recovery_step.RecoveryStepper.trigger): whether one began."""
         quats = {s: state.link_quat_wxyz[_LINK[f"{s}_ankle"]] for s in _SIDE_UP}
         step = self.recovery.trigger(state.time_s, tick.com_c, tick.com_vel_c, tick.a_c, quats,
-                                     soles_on_ground(state), tick.R_root_d)
+                                     soles_on_ground(state), tick.R_root_d,
+                                     {s: state.foot_contact_force_n[f"{s}_ankle"] for s in _SIDE_UP})
         if step is None:
             return False
         self._outside_since_s = None

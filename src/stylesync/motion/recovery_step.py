@@ -289,12 +289,15 @@ class RecoveryStepper:
 
     def trigger(self, time_s: float, com_world: np.ndarray, com_vel_world: np.ndarray,
                 ankles_world: dict[str, np.ndarray], feet_quat_wxyz: dict[str, np.ndarray],
-                on_ground: list[str], heading_world: np.ndarray | None = None) -> RecoveryStep | None:
+                on_ground: list[str], heading_world: np.ndarray | None = None,
+                loads_n: dict[str, float] | None = None) -> RecoveryStep | None:
         """A new step when the capture point is outside the support polygon of the soles ``on_ground`` by more
         than the margin (and the last recovery step ended at least ``recovery_min_stance_s`` ago). The stance
         foot is the one on the ground whose sole is nearer the capture point; with ``heading_world`` ((3, 3),
         x forward) and both feet on the ground, the foot whose step leaves the predicted capture point least
-        outside the new support (:meth:`capture_residual_m`), the nearer sole on a tie. With one sole on the ground
+        outside the new support (:meth:`capture_residual_m`), the nearer sole on a tie; with ``loads_n`` (each sole's
+        normal force [N]) and ``recovery_stance_min_load_share``, not a sole that bears less than that share of
+        both while the COM moves away from its ankle. With one sole on the ground
         and ``recovery_landing_foot_waits``, none while the foot in the air, landed where it is, would leave the
         capture point predicted a recovery swing ahead no further outside than its step would."""
         cfg = self.cfg
@@ -324,6 +327,15 @@ class RecoveryStepper:
             best = min(residual.values())
             if residual[stance] > best + 1e-3:
                 stance = min(residual, key=lambda s: residual[s])
+        share = cfg.recovery_stance_min_load_share
+        if share is not None and loads_n is not None and len(on_ground) == 2:
+            # A stance foot that bears less than the share of the body, and that the body is not moving onto, would
+            # leave it on neither sole once the other lifts: the loaded foot stands, and the other steps.
+            total = loads_n["left"] + loads_n["right"]
+            towards = float(np.dot(np.asarray(com_vel_world)[:2],
+                                   np.asarray(ankles_world[stance])[:2] - np.asarray(com_world)[:2]))
+            if total > 0.0 and loads_n[stance] < share * total and towards <= 0.0:
+                stance = OTHER_SIDE[stance]
         side = OTHER_SIDE[stance]
         self.step = RecoveryStep(side, time_s, np.array(ankles_world[side], dtype=float),
                                  np.array(ankles_world[side], dtype=float), cfg.recovery_swing_s)
