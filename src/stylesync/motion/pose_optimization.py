@@ -1037,9 +1037,10 @@ class MotionOptimizer:
         """A recovery step from double stance, if the capture point is outside the support by more than the margin
         (recovery_step.RecoveryStepper.trigger): whether one began."""
         quats = {s: state.link_quat_wxyz[_LINK[f"{s}_ankle"]] for s in _SIDE_UP}
+        loads = ({s: state.foot_contact_force_n[f"{s}_ankle"] for s in _SIDE_UP}
+                 if self.cfg.recovery_stance_min_load_share is not None else None)  # read only where they are used
         step = self.recovery.trigger(state.time_s, tick.com_c, tick.com_vel_c, tick.a_c, quats,
-                                     soles_on_ground(state), tick.R_root_d,
-                                     {s: state.foot_contact_force_n[f"{s}_ankle"] for s in _SIDE_UP})
+                                     soles_on_ground(state), tick.R_root_d, loads)
         if step is None:
             return False
         self._outside_since_s = None

@@ -40,7 +40,7 @@ SOCCER_BALL_URDF = "soccerball.urdf"
 # The ground is pybullet_data's plane.urdf, whose collision shape is a box 200 m square (its top face at z = 0). It
 # is kept centred on the multiple of GROUND_TILE_M nearest the character (PyBulletBackend._keep_ground_under): the
 # character always has at least GROUND_TILE_M / 2 of ground around it, wherever a recording puts its operator or a
-# long walk takes it; near the origin the ground never moves [m].
+# long walk takes it; near the origin the ground never moves, and its contacts stay those of the same box [m].
 GROUND_TILE_M = 100.0
 
 
