@@ -130,7 +130,8 @@ def test_a_report_on_a_damaged_folder_is_written_and_says_so(tmp_path, capsys, m
 
 
 def test_follow_path_and_in_place_are_taken_and_recorded(tmp_path, capsys):
-    """``--follow-path`` adds the targets' pull onto his path to the defaults (which follow it by the landings),
+    """``--follow-path`` keeps the targets' pull onto his path at every speed of his (the defaults pull them while he
+    goes slower than the character's gait, and follow his path by the landings),
     ``--in-place`` sets the settings before that; each run's session file records them, and the two together are
     refused with one line."""
     from stylesync.config import FOLLOW_PATH_MOTION, IN_PLACE_MOTION, IN_PLACE_OPERATOR, IN_PLACE_WHOLE_BODY
@@ -143,7 +144,8 @@ def test_follow_path_and_in_place_are_taken_and_recorded(tmp_path, capsys):
     follow, in_place, plain = (header[n]["config"] for n in ("fp", "ip", "plain"))
     for name, value in FOLLOW_PATH_MOTION.items():
         assert follow["motion"][name] == value
-    assert follow["motion"]["path_target_share"] > 0.0 == plain["motion"]["path_target_share"]
+    assert follow["motion"]["path_target_fade_from_mps"] is None
+    assert plain["motion"]["path_target_fade_from_mps"] is not None and plain["motion"]["path_target_share"] > 0.0
     for section, values in ((("motion",), IN_PLACE_MOTION), (("control", "whole_body"), IN_PLACE_WHOLE_BODY),
                             (("operator",), IN_PLACE_OPERATOR)):
         ip, pl = in_place, plain
@@ -151,7 +153,7 @@ def test_follow_path_and_in_place_are_taken_and_recorded(tmp_path, capsys):
             ip, pl = ip[key], pl[key]
         for name, value in values.items():
             assert ip[name] == value
-            assert pl[name] != value or name == "path_target_share", name
+            assert pl[name] != value, name
     assert plain["operator"]["start_with_clip_velocity"] and not in_place["operator"]["start_with_clip_velocity"]
     metrics = {n: json.loads((tmp_path / n / "metrics.json").read_text()) for n in ("ip", "plain")}
     assert metrics["ip"]["in_place"] and not metrics["plain"]["in_place"]

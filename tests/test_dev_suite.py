@@ -101,11 +101,12 @@ def test_the_dev_suite_runs_the_follow_path_and_in_place_settings_beside_the_def
     assert "| kick | follow-path |" in (out / "dev_suite.md").read_text()
     assert "| kick | in-place |" in (out / "dev_suite.md").read_text()
     # The settings reach the run: 3 s of the built-in walk (his first steps from 1.3 s) go further along his path by
-    # default than in place, and further still with the pull (measured: 0.196, 0.545, 0.688)
+    # default than in place, and further still with the pull at every speed of his (by default it fades out as his
+    # way goes from 0.5 to 0.7 m/s; measured: 0.196, 0.596, 0.690)
     in_place, default, follow = (run_clip("builtin:walk", 0, 3.0, v)
                                  for v in (IN_PLACE_VERSION, "stylesync", FOLLOW_PATH_VERSION))
     assert default["path_progress"] > in_place["path_progress"] + 0.25, (in_place, default)
-    assert follow["path_progress"] > default["path_progress"] + 0.1, (default, follow)
+    assert follow["path_progress"] > default["path_progress"] + 0.05, (default, follow)
     # bench options only with the dev suite
     assert cli_main(["bench", "--follow-path", "--out", str(tmp_path / "b")]) == 2
     assert cli_main(["bench", "--in-place", "--out", str(tmp_path / "b")]) == 2

@@ -10,7 +10,12 @@ import numpy as np
 import pytest
 
 from stylesync.config import ConfigError, MotionConfig
-from stylesync.motion.path_feedback import PathReference, deadbeat_gain
+from stylesync.motion.path_feedback import (
+    PathReference,
+    deadbeat_gain,
+    pull_share_after_steps,
+    pull_share_at_speed,
+)
 
 OMEGA = 3.4  # the character's pendulum at a 0.85 m COM height [1/s]
 STEP_S = 0.55  # a walking step: swing and double stance [s]
@@ -93,7 +98,9 @@ def test_follow_path_adds_the_pull_and_in_place_sets_the_former_defaults():
     assert not placed.operator.start_with_clip_velocity and placed.operator.start_speed_max_mps is None
     for name, value in FOLLOW_PATH_MOTION.items():
         assert getattr(cfg.motion, name) == value
-        assert (getattr(default.motion, name) == value) == (name not in ("path_target_share",
+        assert (getattr(default.motion, name) == value) == (name not in ("path_target_fade_from_mps",
+                                                                           "path_target_step_hold_s",
+                                                                           "path_target_along_cos",
                                                                            "landing_reach_ground_gap_m")), name
     for name, value in FOLLOW_PATH_WHOLE_BODY.items():
         assert getattr(cfg.control.whole_body, name) == value == getattr(default.control.whole_body, name)
@@ -155,12 +162,91 @@ def test_the_targets_pull_to_his_com_on_the_characters_path():
     assert off.target_pull_xy(np.zeros(3), np.array([5.0, 0.0, 0.0]), 1.0) == pytest.approx([0.0, 0.0])
 
 
-def test_the_target_pull_is_validated():
-    assert MotionConfig().path_target_share == 0.0
+def test_the_target_pull_is_on_by_default_and_validated():
+    assert MotionConfig().path_target_share == 1.0
     with pytest.raises(ConfigError, match="path_target_share"):
         MotionConfig(path_target_share=1.5)
     with pytest.raises(ConfigError, match="path_target_max_m"):
         MotionConfig(path_target_max_m=-0.1)
+    with pytest.raises(ConfigError, match="path_target_fade_from_mps"):
+        MotionConfig(path_target_fade_from_mps=-0.1)
+    with pytest.raises(ConfigError, match="path_target_fade_to_mps"):
+        MotionConfig(path_target_fade_from_mps=0.7, path_target_fade_to_mps=0.5)
+    with pytest.raises(ConfigError, match="path_target_along_cos"):
+        MotionConfig(path_target_along_cos=1.5)
+    with pytest.raises(ConfigError, match="path_target_along_min_mps"):
+        MotionConfig(path_target_along_min_mps=-0.1)
+
+
+def test_the_pull_fades_out_between_the_two_speeds_of_his_way():
+    """All of the pull while he goes up to 0.5 m/s (scaled), none from 0.7 m/s, linear between; at every speed
+    without the fade."""
+    cfg = MotionConfig()
+    lo, hi = cfg.path_target_fade_from_mps, cfg.path_target_fade_to_mps
+    assert (lo, hi) == (0.5, 0.7)
+    speeds = (0.0, 0.5, 0.55, 0.6, 0.7, 1.4)
+    assert [pull_share_at_speed(v, lo, hi) for v in speeds] == pytest.approx([1.0, 1.0, 0.75, 0.5, 0.0, 0.0])
+    assert [pull_share_at_speed(v, None, hi) for v in speeds] == [1.0] * len(speeds)
+
+
+def test_the_pull_fades_out_once_he_takes_no_step():
+    """All of the pull for 0.5 s after he last stood on one foot, none from 1 s on (and before his first step),
+    linear between; whether he steps or not without the hold."""
+    hold = MotionConfig().path_target_step_hold_s
+    assert hold == 0.5
+    since = (0.0, 0.5, 0.75, 1.0, 3.0, math.inf)
+    assert [pull_share_after_steps(t, hold) for t in since] == pytest.approx([1.0, 1.0, 0.5, 0.0, 0.0, 0.0])
+    assert [pull_share_after_steps(t, None) for t in since] == [1.0] * len(since)
+    with pytest.raises(ConfigError, match="path_target_step_hold_s"):
+        MotionConfig(path_target_step_hold_s=0.0)
+
+
+def test_a_spin_is_not_pulled_along_his_path():
+    """Traced (the humanoid3d spin, sensor seed 7, 12 s): he turns about and travels while he spins, his COM going
+    round as much as along his way; with the targets pulled onto his path whether he goes along it or not
+    (path_target_along_cos None) the pull stood at its 0.3 m bound for seconds, and the character, which follows a spin
+    by turning and stepping where it is, fell at 8.2 s; with the pull kept to the time he goes along his way it
+    completes."""
+    import logging
+
+    from conftest import suite_run
+
+    from stylesync.config import ControlConfig
+    from stylesync.metrics.summary import summarize
+
+    logging.disable(logging.WARNING)
+    try:
+        out = {cos: summarize(suite_run("builtin:spin", 7, MotionConfig(path_target_along_cos=cos), ControlConfig()))
+               for cos in (None, 0.5)}
+    finally:
+        logging.disable(logging.NOTSET)
+    assert out[None]["fell"] and out[None]["fall_time_s"] < 9.0
+    assert not out[0.5]["fell"]
+
+
+def test_a_jump_with_both_feet_is_not_pulled_after_him():
+    """Traced (the humanoid3d jump, sensor seed 4, 12 s): he jumps forwards with both feet and takes no step; with
+    the targets pulled onto his path whether he steps or not (path_target_step_hold_s None; and whether he goes
+    along his way or not, path_target_along_cos None, which alone keeps this run up as well) the pull drew the
+    character's COM target 0.2 m ahead of it, its steps of its own began and sped the body up, step after step, to
+    1.9 m/s, and it fell at 5.94 s; with the pull held to his steps it completes."""
+    import logging
+
+    from conftest import suite_run
+
+    from stylesync.config import ControlConfig
+    from stylesync.metrics.summary import summarize
+
+    logging.disable(logging.WARNING)
+    try:
+        out = {hold: summarize(suite_run("builtin:jump", 4, MotionConfig(path_target_step_hold_s=hold,
+                                                                         path_target_along_cos=None),
+                                         ControlConfig()))
+               for hold in (None, 0.5)}
+    finally:
+        logging.disable(logging.NOTSET)
+    assert out[None]["fell"] and out[None]["fall_time_s"] < 7.0
+    assert not out[0.5]["fell"]
 
 
 _STEALTHY = Path(__file__).resolve().parents[2] / "shared" / "mocap" / "deepmimic" / "humanoid3d_stealthy_walk.txt"

@@ -29,9 +29,10 @@ def _largest_drop_m(**motion) -> float:
         last[:] = [z]
 
     def configure(cfg):  # traced without the pelvis target's floor (pelvis_min_height_m), which bounds the drop too,
-        # and before it came down as his swing went (swing_landing_within_reach)
+        # before it came down as his swing went (swing_landing_within_reach) and before the targets' pull onto his path
         motion_cfg = dataclasses.replace(cfg.motion, **{"pelvis_min_height_m": None,
-                                                        "swing_landing_within_reach": False, **motion})
+                                                        "swing_landing_within_reach": False,
+                                                        "path_target_share": 0.0, **motion})
         return dataclasses.replace(cfg, motion=motion_cfg, duration_s=3.2)
 
     suite_run("builtin:spinkick", 0, MotionConfig(), TRACED_BEFORE_PRESS, on_tick=on_tick, configure=configure)

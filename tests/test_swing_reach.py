@@ -15,9 +15,10 @@ from stylesync.sources.builtin_operator import builtin_operator
 
 def _late_contact_drops(within_reach: bool) -> tuple[np.ndarray, bool]:
     """The built-in walk (6 s, seed 0): the pelvis target's drop [m] on each control tick where a late contact begins
-    to hold the reference, and whether the run fell."""
+    to hold the reference, and whether the run fell. (Traced before the targets' pull onto his path.)"""
     cfg = SessionConfig(duration_s=6.0, operator=OperatorConfig(clip="walk"))
-    cfg = cfg.replace(motion=dataclasses.replace(cfg.motion, swing_landing_within_reach=within_reach))
+    cfg = cfg.replace(motion=dataclasses.replace(cfg.motion, swing_landing_within_reach=within_reach,
+                                                 path_target_share=0.0))
     source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
     session = Session(cfg, source)
     z: list[float] = []

@@ -361,9 +361,9 @@ def _add_session_args(p: argparse.ArgumentParser, out_default: str, realtime_hel
                    help="the operator's mirror image drives the character (his right side its left), as a person "
                         "facing it on a screen expects")
     p.add_argument("--follow-path", action="store_true",
-                   help="keep closer still to the operator's path over the ground: the targets pulled onto it "
-                        "besides the steps placed along it; its own steps between his make the transition delays "
-                        "longer (README, status)")
+                   help="keep closer still to the operator's path over the ground: the targets pulled onto it at "
+                        "every speed of his, not only below the character's gait's top speed; its own steps between "
+                        "his make the transition delays longer (README, status)")
     p.add_argument("--in-place", action="store_true",
                    help="the character's steps planned to stop the body and its targets anchored on its own feet: "
                         "it stays about where it started, trailing an operator who walks off, and a recording "

@@ -450,8 +450,28 @@ class MotionConfig:
     # onto the character's path from where both started, the move at most path_target_max_m. The COM task sets the
     # character's speed over the ground, and targets anchored on its own feet carry every step it falls short of
     # his as a lag (docs/decisions.md, "Targets on his path"). 0: off [-], [m].
-    path_target_share: float = 0.0
+    path_target_share: float = 1.0
     path_target_max_m: float = 0.3
+    # ... all of that pull while his way over the ground (motion/operator_way.py, scaled) is at most
+    # path_target_fade_from_mps fast, none from path_target_fade_to_mps on, in proportion between: the character's
+    # gait at his cadence tops out at about 0.75 m/s (docs/decisions.md, "How fast an operator the character keeps up
+    # with"), and a pull towards a faster operator only makes it outrun its own steps, which a step of its own then
+    # lands early, out of step with his (docs/decisions.md, "The targets on his path below the gait's top speed").
+    # None: the pull at every speed [m/s].
+    path_target_fade_from_mps: float | None = 0.5
+    path_target_fade_to_mps: float = 0.7
+    # ... and all of it for path_target_step_hold_s after he last stood on one foot, none from twice that on, in
+    # proportion between: the character follows his path by its steps, and an operator who takes none (he stands,
+    # jumps with both feet) gives it none to follow with (docs/decisions.md, "The targets on his path below the
+    # gait's top speed"; None: whether he steps or not) [s]
+    path_target_step_hold_s: float | None = 0.5
+    # ... and of that, the share of the last operator_way_time_s in which his COM went along his way over the ground
+    # (operator_way.py's average), at least path_target_along_min_mps fast and within the angle whose cosine is
+    # path_target_along_cos: a dance's sway, a spin's circle or a turn on the spot is followed by turning and
+    # stepping in place, not pulled along (docs/decisions.md, "The targets on his path below the gait's top speed";
+    # None: along his way or not) [-], [m/s]
+    path_target_along_cos: float | None = 0.5
+    path_target_along_min_mps: float = 0.2
     # Steps to where he stands (motion/rest_step.py; docs/decisions.md, "Steps to where he stands"): once he has stood
     # still for rest_step_after_s and his feet are still, each of the character's feet has his foot's place on its
     # path; the foot that a step brings the most nearer its place, by rest_step_min_m at least, steps there on its own
@@ -585,6 +605,17 @@ class MotionConfig:
         if not 0.0 <= self.path_target_share <= 1.0:
             raise ConfigError(f"MotionConfig.path_target_share must be within [0, 1], got {self.path_target_share}")
         _non_negative("MotionConfig.path_target_max_m", self.path_target_max_m)
+        if self.path_target_along_cos is not None and not -1.0 <= self.path_target_along_cos <= 1.0:
+            raise ConfigError(f"MotionConfig.path_target_along_cos must be within [-1, 1], got "
+                              f"{self.path_target_along_cos}")
+        _non_negative("MotionConfig.path_target_along_min_mps", self.path_target_along_min_mps)
+        if self.path_target_step_hold_s is not None:
+            _positive("MotionConfig.path_target_step_hold_s", self.path_target_step_hold_s)
+        if self.path_target_fade_from_mps is not None:
+            _non_negative("MotionConfig.path_target_fade_from_mps", self.path_target_fade_from_mps)
+            if self.path_target_fade_to_mps <= self.path_target_fade_from_mps:
+                raise ConfigError("MotionConfig.path_target_fade_to_mps must exceed path_target_fade_from_mps, got "
+                                  f"{self.path_target_fade_to_mps} <= {self.path_target_fade_from_mps}")
         if self.rest_step_min_m is not None:
             _non_negative("MotionConfig.rest_step_min_m", self.rest_step_min_m)
         _non_negative("MotionConfig.rest_step_after_s", self.rest_step_after_s)
@@ -938,10 +969,14 @@ def _defaults(cls: type, names: dict[str, Any]) -> dict[str, Any]:
 
 # Following the operator's path over the ground closer still, at a cost in falls and in his gait's timing: the
 # defaults of every setting `--in-place` changes (so that it gives the same settings over any base), and besides them
-# the targets pulled onto his path (docs/decisions.md, "Following the operator's path by the landing", "Targets on
-# his path"): `--follow-path`.
+# the targets pulled onto his path at every speed of his, not only below the character's gait's top speed
+# (docs/decisions.md, "Following the operator's path by the landing", "Targets on his path", "The targets on his path
+# below the gait's top speed"): `--follow-path`.
 FOLLOW_PATH_MOTION: dict[str, Any] = _defaults(MotionConfig, IN_PLACE_MOTION) | {
-    "path_target_share": 1.0,  # the targets pulled to his path, at most path_target_max_m (0.3 m) ahead
+    "path_target_share": 1.0,  # the targets pulled to his path, at most path_target_max_m (0.3 m) ahead,
+    "path_target_fade_from_mps": None,  # ... at every speed of his
+    "path_target_step_hold_s": None,  # ... whether he steps or not
+    "path_target_along_cos": None,  # ... and whether he goes along his way or not
     "landing_reach_ground_gap_m": 0.003,  # a foot lying on the ground, pressing or not, lowers no pelvis target
 }
 # ... in the whole-body controller: the push of the character's own steps bounded while he walks too

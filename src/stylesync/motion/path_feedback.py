@@ -15,7 +15,9 @@ step (deadbeat), s > 2 makes it grow with alternating sign. The gain is set as t
 tracking, in its footstep form), k = s / (e^(ωT) - 1), T the operator's usual step (his swing and double stance).
 The correction is bounded: a character far behind catches up over several steps, not one.
 
-The same scaled path also gives the targets a pull (:meth:`PathReference.target_pull_xy`). The pendulum's relation
+The same scaled path also gives the targets a pull (:meth:`PathReference.target_pull_xy`), kept in full while he goes
+no faster than the character's gait carries it at his cadence (:func:`pull_share_at_speed`) and steps
+(:func:`pull_share_after_steps`). The pendulum's relation
 above holds for a body left to its pendulum; the whole-body controller's COM task tracks the COM target instead, and
 the target of Eq. 10 is anchored on the character's own stance foot: within a stance it moves at his speed, and at a
 change of stance it falls back by as much as the character's step was shorter than his. The character's speed over
@@ -83,6 +85,27 @@ class PathReference:
         if self.target_share <= 0.0 or his is None:
             return np.zeros(2)
         return bounded_xy(self.target_share * (his - np.asarray(com_target_world, dtype=float)[:2]), self.target_max_m)
+
+
+def pull_share_at_speed(speed_mps: float, fade_from_mps: float | None, fade_to_mps: float) -> float:
+    """The share of the targets' pull kept when he goes ``speed_mps`` over the ground (scaled) [-]: 1 up to
+    ``fade_from_mps``, 0 from ``fade_to_mps``, linear between; 1 at every speed when ``fade_from_mps`` is None. The
+    character's gait at his cadence has a top speed (its steps' reach at his step time): a pull towards an operator
+    faster than that drives its capture point beyond the reach of a step landed at his timing, and the steps it then
+    takes of its own land early, out of step with his."""
+    if fade_from_mps is None:
+        return 1.0
+    return min(max((fade_to_mps - speed_mps) / (fade_to_mps - fade_from_mps), 0.0), 1.0)
+
+
+def pull_share_after_steps(since_single_stance_s: float, hold_s: float | None) -> float:
+    """The share of the targets' pull kept ``since_single_stance_s`` after he last stood on one foot [-]: 1 for
+    ``hold_s``, then falling linearly to 0 over another ``hold_s``; 1 always when ``hold_s`` is None. The character
+    follows his path by its steps; an operator who takes none (he stands, he jumps with both feet, he sways without
+    lifting a foot) gives it no step to follow with, and a pull then moves the body only by steps of its own."""
+    if hold_s is None:
+        return 1.0
+    return min(max(2.0 - since_single_stance_s / hold_s, 0.0), 1.0)
 
 
 def bounded_xy(shift_xy: np.ndarray, max_m: float) -> np.ndarray:

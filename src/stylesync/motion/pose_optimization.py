@@ -51,7 +51,12 @@ from stylesync.motion.his_rise import HisRise
 from stylesync.motion.leg_ik import solve_leg
 from stylesync.motion.operator_analysis import UPPER_JOINTS, OperatorAnalysis, analyse_operator, upper_local
 from stylesync.motion.operator_way import OperatorWay
-from stylesync.motion.path_feedback import PathReference, bounded_xy
+from stylesync.motion.path_feedback import (
+    PathReference,
+    bounded_xy,
+    pull_share_after_steps,
+    pull_share_at_speed,
+)
 from stylesync.motion.recovery_step import (
     RecoveryStepper,
     WalkOn,
@@ -296,8 +301,11 @@ class MotionOptimizer:
         # His way in his own heading frame (x forwards; its velocity_world holds heading-frame axes), kept up when
         # rear_foot_stepping_way_mps reads it (_rear_foot_bears_weight)
         self._way_heading = OperatorWay(cfg.operator_way_time_s, self.dt_s)
-        # only a gait's speed or a walk-on along his way reads it: otherwise it is not kept up each tick
-        self._tracks_way = cfg.gait_min_way_speed_mps is not None or cfg.recovery_walk_on_his_way
+        # only a gait's speed, a walk-on along his way or the fade of the path's pull reads it: otherwise it is not kept
+        # up each tick
+        self._tracks_way = (cfg.gait_min_way_speed_mps is not None or cfg.recovery_walk_on_his_way
+                            or (cfg.path_target_share > 0.0 and (cfg.path_target_fade_from_mps is not None
+                                                                 or cfg.path_target_along_cos is not None)))
         self.bounds = bounds if bounds is not None else BoundsMonitor()
         self._anchor_stance: Stance | None = None
         self._anchor_offset = np.zeros((2, 2))  # (pelvis, COM) x (x, y) [m]
@@ -329,6 +337,9 @@ class MotionOptimizer:
         self._op_swing_s = OPERATOR_SWING_S  # the operator's swing time, averaged over his swings [s]
         self._op_state: Stance | None = None
         self._op_state_t0_s = 0.0
+        self._his_single_stance_s = -math.inf  # the last tick the operator stood on one foot [s]
+        self._pull_along = 0.0  # how much of the last operator_way_time_s he went along his way [-]
+        self._pull_along_share = min(self.dt_s / cfg.operator_way_time_s, 1.0)
         self._op_last_ds_s = 0.0
         self.recovery = RecoveryStepper(cfg, CHAR_LEG_LENGTH_M, gravity_mps2)
         self._operator_stands_since_s: float | None = None
@@ -494,6 +505,8 @@ class MotionOptimizer:
             self._feet_by_own_step = True
         elif ch_state is not Stance.DS:
             self._feet_by_own_step = False  # a swing of his
+        if op_state is not Stance.DS:
+            self._his_single_stance_s = state.time_s  # the last tick he stood on one foot [s]
         if op_state is not self._op_state:  # the operator's swing time, for the swing's progress
             if self._op_state is Stance.DS:
                 self._op_last_ds_s = state.time_s - self._op_state_t0_s
@@ -583,10 +596,12 @@ class MotionOptimizer:
             shift = self._rest_shift_xy(tick, state, com_xy)
             pelvis_xy[:2] += shift
             com_xy[:2] += shift
-        # Opt-in: both targets moved towards his COM on the character's path (path_feedback.py; after the anchor
-        # offset's continuity, which is the feet's, not the path's)
+        # Both targets moved towards his COM on the character's path (path_feedback.py; after the anchor offset's
+        # continuity, which is the feet's, not the path's), while his way is no faster than the character's gait
         if self.cfg.path_target_share > 0.0:
-            pull = self.path.target_pull_xy(com_xy, com_h, scale)
+            pull = self.path.target_pull_xy(com_xy, com_h, scale) * self._path_pull_kept(state.time_s)
+            if self.cfg.path_target_along_cos is not None:
+                pull = pull * self._path_pull_along(scale)
             pelvis_xy[:2] += pull
             com_xy[:2] += pull
         tick.he_stands = self._he_stands(state, scale, tick.op_state)
@@ -660,6 +675,26 @@ class MotionOptimizer:
         if self.path.enabled:
             xi_c, omega = capture_point(com_c, tick.com_vel_c, self.g)
             self.path.update(state.root_pos_world, p_h, xi_c, self._operator_capture_point(tick), scale, omega)
+
+    def _path_pull_kept(self, time_s: float) -> float:
+        """The share of the targets' pull onto his path kept at ``time_s`` [s]: at his way's speed over the ground
+        (operator_way.py, scaled; as of the last tick), path_feedback.pull_share_at_speed, and as long ago as he last
+        stood on one foot, path_feedback.pull_share_after_steps [-]."""
+        return (pull_share_at_speed(float(np.hypot(*self.way.velocity_world)), self.cfg.path_target_fade_from_mps,
+                                    self.cfg.path_target_fade_to_mps)
+                * pull_share_after_steps(time_s - self._his_single_stance_s, self.cfg.path_target_step_hold_s))
+
+    def _path_pull_along(self, scale: float) -> float:
+        """The share of the targets' pull kept as he goes along his way [-]: how much of the last
+        ``operator_way_time_s`` his (scaled) COM velocity went along his way over the ground, at least
+        ``path_target_along_min_mps`` fast and within the angle whose cosine is ``path_target_along_cos``
+        (operator_way.OperatorWay.goes_along, as of the last tick), averaged over that time. A walk goes along its
+        way; a dance's sway, a spin's circle and a turn on the spot do not, and the character follows those by
+        turning and stepping in place, where a pull towards his path moves the body only by steps of its own."""
+        along = self.way.goes_along(self.cfg.path_target_along_min_mps, scale * self._com_h_rate.rate[:2],
+                                    self.cfg.path_target_along_cos or 0.0)
+        self._pull_along += self._pull_along_share * ((1.0 if along else 0.0) - self._pull_along)
+        return self._pull_along
 
     def _rest_shift_xy(self, tick: _Tick, state: CharacterState, com_xy: np.ndarray) -> np.ndarray:
         """(2,) what the targets move by for a step to where he stands [m]: onto the centre of the sole the weight is
