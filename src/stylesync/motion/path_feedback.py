@@ -16,13 +16,14 @@ tracking, in its footstep form), k = s / (e^(ωT) - 1), T the operator's usual s
 The correction is bounded: a character far behind catches up over several steps, not one.
 
 The same scaled path also gives the targets a pull (:meth:`PathReference.target_pull_xy`), kept in full while he goes
-no faster than the character's gait carries it at his cadence (:func:`pull_share_at_speed`) and steps
-(:func:`pull_share_after_steps`). The pendulum's relation
-above holds for a body left to its pendulum; the whole-body controller's COM task tracks the COM target instead, and
-the target of Eq. 10 is anchored on the character's own stance foot: within a stance it moves at his speed, and at a
-change of stance it falls back by as much as the character's step was shorter than his. The character's speed over
-the ground is then its target's, and no landing undoes a lag that the target carries. Moving the targets a share of
-the way to his COM on the character's path (bounded) puts the restoring term where the speed is set.
+no faster than the character's gait carries it at his cadence (:func:`pull_share_at_speed`), steps
+(:func:`pull_share_after_steps`) and goes along his way (pose_optimization.py, ``_path_pull_along``). The
+pendulum's relation above holds for a body left to its pendulum; the whole-body controller's COM task tracks the COM
+target instead, and the target of Eq. 10 is anchored on the character's own stance foot: within a stance it moves at
+his speed, and at a change of stance it falls back by as much as the character's step was shorter than his. The
+character's speed over the ground is then its target's, and no landing undoes a lag that the target carries. Moving
+the targets a share of the way to his COM on the character's path (bounded) puts the restoring term where the speed
+is set.
 """
 
 from __future__ import annotations

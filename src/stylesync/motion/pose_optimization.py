@@ -597,7 +597,8 @@ class MotionOptimizer:
             pelvis_xy[:2] += shift
             com_xy[:2] += shift
         # Both targets moved towards his COM on the character's path (path_feedback.py; after the anchor offset's
-        # continuity, which is the feet's, not the path's), while his way is no faster than the character's gait
+        # continuity, which is the feet's, not the path's), while he steps along his way no faster than the
+        # character's gait goes
         if self.cfg.path_target_share > 0.0:
             pull = self.path.target_pull_xy(com_xy, com_h, scale) * self._path_pull_kept(state.time_s)
             if self.cfg.path_target_along_cos is not None:
