@@ -30,6 +30,12 @@ def _non_negative(name: str, value: float) -> None:
         raise ConfigError(f"{name} must be >= 0, got {value!r}")
 
 
+def _above(name: str, value: float, lower_name: str, lower: float) -> None:
+    """``value`` (the field ``name``) strictly above ``lower`` (the field ``lower_name``): the upper end of a range."""
+    if not (value > lower):
+        raise ConfigError(f"{name} ({value!r}) must be above {lower_name} ({lower!r})")
+
+
 @dataclass(frozen=True)
 class PidGains:
     """Gains of one joint's PID (Eq. 13), continuous-time: tau = kp e + ki ∫e dt + kd de/dt.
@@ -549,9 +555,8 @@ class MotionConfig:
         if self.pelvis_min_height_m is not None:
             _positive("MotionConfig.pelvis_min_height_m", self.pelvis_min_height_m)
         _non_negative("MotionConfig.pelvis_offset_start_speed_mps", self.pelvis_offset_start_speed_mps)
-        if self.pelvis_offset_full_speed_mps <= self.pelvis_offset_start_speed_mps:
-            raise ConfigError(f"MotionConfig.pelvis_offset_full_speed_mps ({self.pelvis_offset_full_speed_mps}) must "
-                              f"be above pelvis_offset_start_speed_mps ({self.pelvis_offset_start_speed_mps})")
+        _above("MotionConfig.pelvis_offset_full_speed_mps", self.pelvis_offset_full_speed_mps,
+               "pelvis_offset_start_speed_mps", self.pelvis_offset_start_speed_mps)
         _non_negative("MotionConfig.recovery_step_margin_m", self.recovery_step_margin_m)
         if self.double_stance_keeps_momentum_m is not None:
             _non_negative("MotionConfig.double_stance_keeps_momentum_m", self.double_stance_keeps_momentum_m)
@@ -613,9 +618,8 @@ class MotionConfig:
             _positive("MotionConfig.path_target_step_hold_s", self.path_target_step_hold_s)
         if self.path_target_fade_from_mps is not None:
             _non_negative("MotionConfig.path_target_fade_from_mps", self.path_target_fade_from_mps)
-            if self.path_target_fade_to_mps <= self.path_target_fade_from_mps:
-                raise ConfigError("MotionConfig.path_target_fade_to_mps must exceed path_target_fade_from_mps, got "
-                                  f"{self.path_target_fade_to_mps} <= {self.path_target_fade_from_mps}")
+            _above("MotionConfig.path_target_fade_to_mps", self.path_target_fade_to_mps,
+                   "path_target_fade_from_mps", self.path_target_fade_from_mps)
         if self.rest_step_min_m is not None:
             _non_negative("MotionConfig.rest_step_min_m", self.rest_step_min_m)
         _non_negative("MotionConfig.rest_step_after_s", self.rest_step_after_s)

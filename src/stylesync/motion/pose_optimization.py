@@ -301,11 +301,10 @@ class MotionOptimizer:
         # His way in his own heading frame (x forwards; its velocity_world holds heading-frame axes), kept up when
         # rear_foot_stepping_way_mps reads it (_rear_foot_bears_weight)
         self._way_heading = OperatorWay(cfg.operator_way_time_s, self.dt_s)
-        # only a gait's speed, a walk-on along his way or the fade of the path's pull reads it: otherwise it is not kept
-        # up each tick
+        # only a gait's speed, a walk-on along his way or the path's pull reads it: otherwise it is not kept up each
+        # tick
         self._tracks_way = (cfg.gait_min_way_speed_mps is not None or cfg.recovery_walk_on_his_way
-                            or (cfg.path_target_share > 0.0 and (cfg.path_target_fade_from_mps is not None
-                                                                 or cfg.path_target_along_cos is not None)))
+                            or cfg.path_target_share > 0.0)
         self.bounds = bounds if bounds is not None else BoundsMonitor()
         self._anchor_stance: Stance | None = None
         self._anchor_offset = np.zeros((2, 2))  # (pelvis, COM) x (x, y) [m]
@@ -601,8 +600,7 @@ class MotionOptimizer:
         # character's gait goes
         if self.cfg.path_target_share > 0.0:
             pull = self.path.target_pull_xy(com_xy, com_h, scale) * self._path_pull_kept(state.time_s)
-            if self.cfg.path_target_along_cos is not None:
-                pull = pull * self._path_pull_along(scale)
+            pull = pull * self._path_pull_along(scale)
             pelvis_xy[:2] += pull
             com_xy[:2] += pull
         tick.he_stands = self._he_stands(state, scale, tick.op_state)
@@ -691,9 +689,12 @@ class MotionOptimizer:
         ``path_target_along_min_mps`` fast and within the angle whose cosine is ``path_target_along_cos``
         (operator_way.OperatorWay.goes_along, as of the last tick), averaged over that time. A walk goes along its
         way; a dance's sway, a spin's circle and a turn on the spot do not, and the character follows those by
-        turning and stepping in place, where a pull towards his path moves the body only by steps of its own."""
+        turning and stepping in place, where a pull towards his path moves the body only by steps of its own. 1
+        without ``path_target_along_cos``."""
+        if self.cfg.path_target_along_cos is None:
+            return 1.0
         along = self.way.goes_along(self.cfg.path_target_along_min_mps, scale * self._com_h_rate.rate[:2],
-                                    self.cfg.path_target_along_cos or 0.0)
+                                    self.cfg.path_target_along_cos)
         self._pull_along += self._pull_along_share * ((1.0 if along else 0.0) - self._pull_along)
         return self._pull_along
 
