@@ -36,7 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from stylesync import rotations as rot
-from stylesync.config import follow_path, long_stride
+from stylesync.config import follow_path, pelvis_joint
 from stylesync.metrics.dev_suite import clip_specs, suite_config
 from stylesync.model.character import LINK_NAMES
 from stylesync.model.sole import convex_hull_xy, outside_distance_m, sole_corners_world
@@ -101,7 +101,7 @@ def main() -> None:
     ap.add_argument("--yaw", action="store_true", help="also print the headings of the reference's root, the "
                                                         "character's pelvis and its feet [deg]")
     ap.add_argument("--follow-path", action="store_true", help="with --follow-path's settings (config.follow_path)")
-    ap.add_argument("--long-stride", action="store_true", help="with --long-stride's settings (config.long_stride)")
+    ap.add_argument("--pelvis-joint", action="store_true", help="with --pelvis-joint's settings (config.pelvis_joint)")
     ap.add_argument("--heights", action="store_true", help="also print the ankles' heights and, in a step of the "
                                                            "character's own, its ankle target [m]")
     ap.add_argument("--past-fall", action="store_true", help="run on after the first fall (to see what follows it)")
@@ -112,8 +112,8 @@ def main() -> None:
     cfg, clip_end = suite_config(spec, opened, args.seed, args.duration)
     if args.follow_path:
         cfg = follow_path(cfg)
-    if args.long_stride:
-        cfg = long_stride(cfg)
+    if args.pelvis_joint:
+        cfg = pelvis_joint(cfg)
     length = cfg.duration_s
     session = Session(dataclasses.replace(cfg, duration_s=min(length, args.t1)), opened.source)
     session.stop_on_fall = not args.past_fall

@@ -10,6 +10,7 @@ from stylesync.config import (
     IN_PLACE_MOTION,
     IN_PLACE_OPERATOR,
     IN_PLACE_WHOLE_BODY,
+    PELVIS_JOINT_MOTION,
     ControlConfig,
     MotionConfig,
     OperatorConfig,
@@ -42,11 +43,10 @@ TRACED_BEFORE_PRESS = ControlConfig(whole_body=WholeBodyConfig(press_double_stan
                                                                own_step_push_bound="he_stands"))
 
 
-# Scenarios traced with his skeleton's pelvis joint as his pelvis and the pelvis target at his (scaled), the defaults,
-# not through his hip joints with the target below his (`--long-stride`: MotionConfig.pelvis_from_hip_joints,
-# pelvis_height_offset_m; docs/decisions.md, "His pelvis at his hip joints"): the tests that run them carry the
-# pelvis_joint marker, so that they stay as traced whatever the defaults.
-PELVIS_JOINT_MOTION = {"pelvis_from_hip_joints": False, "pelvis_height_offset_m": 0.0}
+# Scenarios traced with his skeleton's pelvis joint as his pelvis and the pelvis target at his (scaled), the
+# defaults before 2026-12-06, not through his hip joints with the target below his (config.PELVIS_JOINT_MOTION;
+# docs/decisions.md, "His pelvis at his hip joints"): the tests that run them carry the pelvis_joint marker (those
+# with the in_place marker, traced before either, have them too), so that they stay as traced whatever the defaults.
 
 
 def pytest_configure(config):
@@ -71,12 +71,13 @@ def _set_defaults(monkeypatch, cls: type, values: dict) -> None:
 @pytest.fixture(autouse=True)
 def _traced_defaults(request, monkeypatch):
     """Under the ``in_place`` marker, the defaults of MotionConfig, WholeBodyConfig and OperatorConfig are those of
-    config.in_place for the test's duration; under ``pelvis_joint``, MotionConfig's are PELVIS_JOINT_MOTION's too
-    (what a test sets explicitly stays as it sets it)."""
+    config.in_place (and PELVIS_JOINT_MOTION's) for the test's duration; under ``pelvis_joint``, MotionConfig's are
+    PELVIS_JOINT_MOTION's too (what a test sets explicitly stays as it sets it)."""
     motion: dict = {}
     if request.node.get_closest_marker("pelvis_joint") is not None:
         motion.update(PELVIS_JOINT_MOTION)
     if request.node.get_closest_marker("in_place") is not None:
+        motion.update(PELVIS_JOINT_MOTION)
         motion.update(IN_PLACE_MOTION)
         _set_defaults(monkeypatch, WholeBodyConfig, IN_PLACE_WHOLE_BODY)
         _set_defaults(monkeypatch, OperatorConfig, IN_PLACE_OPERATOR)

@@ -110,18 +110,19 @@ def test_the_dev_suite_runs_the_follow_path_and_in_place_settings_beside_the_def
     # bench options only with the dev suite
     assert cli_main(["bench", "--follow-path", "--out", str(tmp_path / "b")]) == 2
     assert cli_main(["bench", "--in-place", "--out", str(tmp_path / "b")]) == 2
-    assert cli_main(["bench", "--long-stride", "--out", str(tmp_path / "b")]) == 2
+    assert cli_main(["bench", "--pelvis-joint", "--out", str(tmp_path / "b")]) == 2
 
 
-def test_the_dev_suite_runs_the_long_stride_settings_beside_the_default(tmp_path):
-    from stylesync.metrics.dev_suite import LONG_STRIDE_VERSION, run_clip
+def test_the_dev_suite_runs_the_pelvis_joint_settings_beside_the_default(tmp_path):
+    from stylesync.metrics.dev_suite import PELVIS_JOINT_VERSION, run_clip
 
-    out = tmp_path / "ls"
+    out = tmp_path / "pj"
     assert cli_main(["bench", "--suite", "dev", "--only", "kick", "--seeds", "1", "--duration", "1.0",
-                     "--workers", "1", "--long-stride", "--out", str(out)]) == 0
+                     "--workers", "1", "--pelvis-joint", "--out", str(out)]) == 0
     rows = json.loads((out / "dev_suite.json").read_text())
-    assert {r["version"] for r in rows} == {"stylesync", LONG_STRIDE_VERSION, "plain-pd"}
-    assert "| kick | long-stride |" in (out / "dev_suite.md").read_text()
-    # The settings reach the run: the built-in walk's 3 s differ from the default's (its pelvis lowered as he starts)
-    default, long = (run_clip("builtin:walk", 0, 3.0, v) for v in ("stylesync", LONG_STRIDE_VERSION))
-    assert default["mpjpe_root_mm"] != long["mpjpe_root_mm"]
+    assert {r["version"] for r in rows} == {"stylesync", PELVIS_JOINT_VERSION, "plain-pd"}
+    assert "| kick | pelvis-joint |" in (out / "dev_suite.md").read_text()
+    # The settings reach the run: the built-in walk's 3 s differ from the default's (the pelvis not lowered as he
+    # starts)
+    default, joint = (run_clip("builtin:walk", 0, 3.0, v) for v in ("stylesync", PELVIS_JOINT_VERSION))
+    assert default["mpjpe_root_mm"] != joint["mpjpe_root_mm"]

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 
+import pytest
 from conftest import suite_run
 
 from stylesync.config import ControlConfig, MotionConfig, follow_path
@@ -45,6 +46,7 @@ def _drops_for_resting_feet(gap_m: float | None) -> int:
     return drops[0]
 
 
+@pytest.mark.pelvis_joint
 def test_a_resting_foot_does_not_drop_the_pelvis_target():
     before = _drops_for_resting_feet(None)
     after = _drops_for_resting_feet(ON_GROUND_M)

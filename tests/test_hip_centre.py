@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from conftest import suite_run
 
-from stylesync.config import LONG_STRIDE_MOTION, ControlConfig, MotionConfig, SessionConfig
+from stylesync.config import PELVIS_JOINT_MOTION, ControlConfig, MotionConfig, SessionConfig
 from stylesync.errors import ConfigError
 from stylesync.model.character import LINK_NAMES
 from stylesync.motion.initial_state import retargeted_pose
@@ -68,7 +68,7 @@ def test_a_cmu_walks_pelvis_target_comes_within_the_legs_reach():
     pelvis target of CMU 02_01 (seed 0, its first 2 s) lay above the lower ankle by more than the character's
     straight leg at the median (measured 0.857 m against 0.831 m): its stance leg could not bend, and its steps were
     0.42-0.47 m against his 0.5-0.8 m (docs/decisions.md, "His pelvis at his hip joints"). From his hip joints and
-    lowered as he goes (`--long-stride`) it is below the straight leg by more than the offset."""
+    lowered as he goes (the default) it is below the straight leg by more than the offset."""
     def median_height(motion: MotionConfig) -> float:
         heights = []
 
@@ -81,15 +81,15 @@ def test_a_cmu_walks_pelvis_target_comes_within_the_legs_reach():
                   configure=lambda cfg: cfg.replace(duration_s=2.0))
         return float(np.median(heights))
 
-    assert median_height(MotionConfig()) > CHAR_LEG_LENGTH_M  # the default: his pelvis joint
-    assert median_height(MotionConfig(**LONG_STRIDE_MOTION)) < CHAR_LEG_LENGTH_M - 0.07
+    assert median_height(MotionConfig(**PELVIS_JOINT_MOTION)) > CHAR_LEG_LENGTH_M  # `--pelvis-joint`
+    assert median_height(MotionConfig()) < CHAR_LEG_LENGTH_M - 0.07
 
 
 def test_the_lowered_pelvis_leaves_his_swing_foot_height():
     """His swing foot's height above his ground is his style (Sec. 5.2): the pelvis target lowered by
-    `--long-stride` does not lower the swing foot's target with it. Measured on the DeepMimic walk (seed 0, 4 s), the
-    swing ankle's height at the 90th percentile of the character's single stances (its own steps left out): 0.258 m
-    by default, 0.264 m with `--long-stride`; 0.202 m with the swing target lowered with the pelvis."""
+    default does not lower the swing foot's target with it. Measured on the DeepMimic walk (seed 0, 4 s), the swing
+    ankle's height at the 90th percentile of the character's single stances (its own steps left out): 0.258 m with
+    `--pelvis-joint`, 0.264 m by default; 0.202 m with the swing target lowered with the pelvis."""
     from stylesync.motion.stance_fsm import Stance
 
     def swing_height_m(motion: MotionConfig) -> float:
@@ -104,17 +104,17 @@ def test_the_lowered_pelvis_leaves_his_swing_foot_height():
                   configure=lambda cfg: cfg.replace(duration_s=4.0))
         return float(np.percentile(heights, 90))
 
-    assert swing_height_m(MotionConfig(**LONG_STRIDE_MOTION)) > swing_height_m(MotionConfig()) - 0.02
+    assert swing_height_m(MotionConfig()) > swing_height_m(MotionConfig(**PELVIS_JOINT_MOTION)) - 0.02
 
 
-def test_long_stride_on_the_command_line_sets_both():
+def test_pelvis_joint_on_the_command_line_sets_both():
     import argparse
 
     from stylesync.cli import _motion_options
 
     names = ("in_place", "follow_path", "free_swing", "no_track_rise")
-    args = argparse.Namespace(**dict.fromkeys(names, False), long_stride=True)
+    args = argparse.Namespace(**dict.fromkeys(names, False), pelvis_joint=True)
     motion = _motion_options(SessionConfig(), args).motion
-    assert motion.pelvis_from_hip_joints and motion.pelvis_height_offset_m == -0.07
-    default = _motion_options(SessionConfig(), argparse.Namespace(**dict.fromkeys(names, False), long_stride=False))
-    assert not default.motion.pelvis_from_hip_joints and default.motion.pelvis_height_offset_m == 0.0
+    assert not motion.pelvis_from_hip_joints and motion.pelvis_height_offset_m == 0.0
+    default = _motion_options(SessionConfig(), argparse.Namespace(**dict.fromkeys(names, False), pelvis_joint=False))
+    assert default.motion.pelvis_from_hip_joints and default.motion.pelvis_height_offset_m == -0.07

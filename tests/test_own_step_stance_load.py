@@ -6,6 +6,7 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
+import pytest
 from conftest import suite_run
 
 from stylesync.config import MotionConfig
@@ -45,6 +46,7 @@ def test_an_unloaded_stance_foot_the_body_moves_onto_stays_the_stance():
     assert _stance(ON, com, vel, {"left": 30.0, "right": 400.0}) == "left"
 
 
+@pytest.mark.pelvis_joint
 def test_the_jump_in_place_stands_where_its_step_lifted_its_loaded_foot():
     """The humanoid3d jump (seed 1, the suite's settings), traced: at 8.74 s, in double stance with 421 N on its
     right foot and 64 N on its left, the body moving away from the left, a step of its own lifted the right foot; both

@@ -201,6 +201,7 @@ def test_the_pull_fades_out_once_he_takes_no_step():
         MotionConfig(path_target_step_hold_s=0.0)
 
 
+@pytest.mark.pelvis_joint
 def test_a_spin_is_not_pulled_along_his_path():
     """Traced (the humanoid3d spin, sensor seed 7, 12 s): he turns about and travels while he spins, his COM going
     round as much as along his way; with the targets pulled onto his path whether he goes along it or not
@@ -224,6 +225,7 @@ def test_a_spin_is_not_pulled_along_his_path():
     assert not out[0.5]["fell"]
 
 
+@pytest.mark.pelvis_joint
 def test_a_jump_with_both_feet_is_not_pulled_after_him():
     """Traced (the humanoid3d jump, sensor seed 4, 12 s): he jumps forwards with both feet and takes no step; with
     the targets pulled onto his path whether he steps or not (path_target_step_hold_s None; and whether he goes

@@ -24,8 +24,8 @@ from stylesync.config import (
     follow_path,
     free_swing,
     in_place,
-    long_stride,
     no_track_rise,
+    pelvis_joint,
 )
 from stylesync.errors import ConfigError, SourceError, StylesyncError
 from stylesync.files import write_atomically
@@ -178,7 +178,7 @@ def _demo(args: argparse.Namespace) -> int:
                                                       "follow_path": args.follow_path,
                                                       "in_place": args.in_place,
                                                       "free_swing": args.free_swing,
-                                                      "long_stride": args.long_stride,
+                                                      "pelvis_joint": args.pelvis_joint,
                                                       "track_rise": not args.no_track_rise}, args)
 
 
@@ -191,7 +191,7 @@ def _suite_operator(args: argparse.Namespace) -> OperatorConfig:
 
 def _motion_options(cfg: SessionConfig, args: argparse.Namespace) -> SessionConfig:
     """``cfg`` with the options asked for on the command line (--in-place, --follow-path, --free-swing,
-    --long-stride, --no-track-rise)."""
+    --pelvis-joint, --no-track-rise)."""
     if args.in_place and args.follow_path:
         raise ConfigError("--in-place and --follow-path contradict each other: give one of them")
     if args.in_place:
@@ -200,8 +200,8 @@ def _motion_options(cfg: SessionConfig, args: argparse.Namespace) -> SessionConf
         cfg = follow_path(cfg)
     if args.free_swing:
         cfg = free_swing(cfg)
-    if args.long_stride:
-        cfg = long_stride(cfg)
+    if args.pelvis_joint:
+        cfg = pelvis_joint(cfg)
     if args.no_track_rise:
         cfg = no_track_rise(cfg)
     return cfg
@@ -237,7 +237,7 @@ def _run(args: argparse.Namespace) -> int:
                                                               "follow_path": args.follow_path,
                                                               "in_place": args.in_place,
                                                               "free_swing": args.free_swing,
-                                                              "long_stride": args.long_stride,
+                                                              "pelvis_joint": args.pelvis_joint,
                                                               "track_rise": not args.no_track_rise,
                                                               **opened.extras}, args)
 
@@ -285,8 +285,8 @@ def _bench(args: argparse.Namespace) -> int:
         from stylesync.metrics.dev_suite import (
             FOLLOW_PATH_VERSION,
             IN_PLACE_VERSION,
-            LONG_STRIDE_VERSION,
             ORDER,
+            PELVIS_JOINT_VERSION,
             SUITE_CONTROLLERS,
             run_dev_suite,
         )
@@ -298,7 +298,7 @@ def _bench(args: argparse.Namespace) -> int:
         mocap = shared / "mocap"
         # the follow-path and in-place versions beside stylesync's (the first), before the baselines
         versions = tuple(v for v, given in ((FOLLOW_PATH_VERSION, args.follow_path), (IN_PLACE_VERSION, args.in_place),
-                                            (LONG_STRIDE_VERSION, args.long_stride)) if given)
+                                            (PELVIS_JOINT_VERSION, args.pelvis_joint)) if given)
         controllers = (*SUITE_CONTROLLERS[:1], *versions, *SUITE_CONTROLLERS[1:])
         report = run_dev_suite(Path(args.out), args.seeds, args.duration, mocap if mocap.is_dir() else None, only,
                                controllers=controllers, workers=args.workers, executor=args.executor,
@@ -306,7 +306,7 @@ def _bench(args: argparse.Namespace) -> int:
     else:
         for flag, given in (("--mirror", args.mirror), ("--sensor-noise", args.sensor_noise != 1.0),
                             ("--follow-path", args.follow_path), ("--in-place", args.in_place),
-                            ("--long-stride", args.long_stride)):
+                            ("--pelvis-joint", args.pelvis_joint)):
             if given:
                 raise ConfigError(f"{flag} is a dev-suite option: use it with --suite dev")
         report = run_bench(Path(args.out), args.duration, args.seed, shared if shared.is_dir() else None,
@@ -372,10 +372,10 @@ def _add_session_args(p: argparse.ArgumentParser, out_default: str, realtime_hel
                    help="a swing foot follows the operator's while both stand balanced on the other foot, lifted "
                         "only with the weight over that ankle (a kick strikes); by default every swing goes to a "
                         "landing placed for balance")
-    p.add_argument("--long-stride", action="store_true",
-                   help="his pelvis taken at his hip joints and the character's lowered 7 cm as he goes: longer "
-                        "steps, a walk that keeps up with him more often; the built-in walk falls out of step "
-                        "(README, status)")
+    p.add_argument("--pelvis-joint", action="store_true",
+                   help="his skeleton's pelvis joint as his pelvis and the character's pelvis at his height (the "
+                        "settings before 2026-12-06); by default his pelvis is the midpoint of his hip joints and the "
+                        "character's is lowered 7 cm as he goes, for longer steps (README, status)")
     p.add_argument("--no-track-rise", action="store_true",
                    help="the pelvis height's law damps every vertical speed, a jump's push included (by default it "
                         "tracks half the operator's rise begun and kept on both feet; README, status)")
@@ -529,9 +529,9 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--in-place", action="store_true",
                        help="dev suite: also the controller with --in-place's settings, in the same run (the "
                             "'in-place' rows, paired with stylesync's)")
-    bench.add_argument("--long-stride", action="store_true",
-                       help="dev suite: also the controller with --long-stride's settings, in the same run (the "
-                            "'long-stride' rows, paired with stylesync's)")
+    bench.add_argument("--pelvis-joint", action="store_true",
+                       help="dev suite: also the controller with --pelvis-joint's settings, in the same run (the "
+                            "'pelvis-joint' rows, paired with stylesync's)")
     bench.add_argument("--workers", type=typed.integer(1, 256), default=2,
                        help="runs in parallel (with --executor processes or ray, and for the dev suite)")
     bench.add_argument("--executor", choices=("processes", "ray", "inline"),

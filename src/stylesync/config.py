@@ -511,17 +511,16 @@ class MotionConfig:
     pelvis_min_height_m: float | None = 0.6
     # His pelvis for Eq. 9-10 (the pelvis height and the pelvis target over the ground, the swing foot's and the
     # hands' places relative to it): the midpoint of his hip joints, where the character's root is on its own body
-    # (processing/body_parameters.hip_centre_world); False: his skeleton's pelvis joint, which CMU's BVH files put
-    # 0.1 m above the hip joints (the pelvis target then 0.09 m above where his legs put his, beyond straight legs'
-    # reach) and the CMU-dev files 0.03 m below (docs/decisions.md, "His pelvis at his hip joints"). Off by default
-    # (`--long-stride`, LONG_STRIDE_MOTION, turns it on): the built-in walk's trace is chaotic, and with the hip
-    # joints' noise in place of the pelvis joint's its largest transition delay on seed 0 was 0.43 s against 0.08 s.
-    pelvis_from_hip_joints: bool = False
+    # (processing/body_parameters.hip_centre_world), whichever place his skeleton gives its pelvis joint; False: that
+    # joint, which CMU's BVH files put 0.1 m above the hip joints (the pelvis target then 0.09 m above where his legs
+    # put his, beyond straight legs' reach) and the CMU-dev files 0.03 m below (docs/decisions.md, "His pelvis at his
+    # hip joints"; `--pelvis-joint`, PELVIS_JOINT_MOTION, the settings before 2026-12-06).
+    pelvis_from_hip_joints: bool = True
     # The pelvis target of Eq. 9 this much higher than his, scaled (negative: lower): a character whose stance leg
     # is as straight as his has no reach left for the step his speed needs, its flat feet having none of the
-    # heel-to-toe roll that lengthens his (docs/decisions.md, "His pelvis at his hip joints"; -0.07 with
-    # `--long-stride`, 0 by default: the built-in walk then falls out of step with him) [m]
-    pelvis_height_offset_m: float = 0.0
+    # heel-to-toe roll that lengthens his (docs/decisions.md, "His pelvis at his hip joints"; 0 with
+    # `--pelvis-joint`) [m]
+    pelvis_height_offset_m: float = -0.07
     # ... in full while his scaled COM speed is at least this, in proportion below it (standing, none: a standing
     # character lowered by it drifted 2.2-2.3 cm in 60 s against 1.4 and 0.6 cm) [m/s]
     pelvis_offset_full_speed_mps: float = 0.5
@@ -994,19 +993,17 @@ FREE_SWING_MOTION: dict[str, Any] = {
 }
 
 
-# His pelvis at his hip joints and the pelvis target lowered as he goes (docs/decisions.md, "His pelvis at his hip
-# joints"): `--long-stride`. In-process runs of the suite's clips (every category but acrobatics, seeds 0-15): 128 of
-# 704 without a UHC termination against 100 (the walks 55 of 224 against 30), 692 complete against 687; the
-# built-in walk out of step with him (its largest transition delay 0.07-0.73 s over seeds 0-7, 0.32 s on the demo's).
-LONG_STRIDE_MOTION: dict[str, Any] = {
-    "pelvis_from_hip_joints": True,
-    "pelvis_height_offset_m": -0.07,
+# His skeleton's pelvis joint as his pelvis and the pelvis target at his, scaled: the settings before 2026-12-06
+# (docs/decisions.md, "His pelvis at his hip joints", "His pelvis at his hip joints by default"): `--pelvis-joint`.
+PELVIS_JOINT_MOTION: dict[str, Any] = {
+    "pelvis_from_hip_joints": False,
+    "pelvis_height_offset_m": 0.0,
 }
 
 
-def long_stride(cfg: SessionConfig) -> SessionConfig:
-    """``cfg`` with LONG_STRIDE_MOTION."""
-    return with_settings(cfg, motion=LONG_STRIDE_MOTION)
+def pelvis_joint(cfg: SessionConfig) -> SessionConfig:
+    """``cfg`` with PELVIS_JOINT_MOTION."""
+    return with_settings(cfg, motion=PELVIS_JOINT_MOTION)
 
 
 def free_swing(cfg: SessionConfig) -> SessionConfig:

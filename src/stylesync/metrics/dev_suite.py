@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from stylesync.config import OperatorConfig, SessionConfig, follow_path, in_place, long_stride
+from stylesync.config import OperatorConfig, SessionConfig, follow_path, in_place, pelvis_joint
 from stylesync.errors import StylesyncError
 from stylesync.metrics.bench import CONTROLLERS
 from stylesync.metrics.paired_outcomes import paired_table
@@ -54,10 +54,10 @@ SUITE_CONTROLLERS = ("stylesync", "plain-pd")
 FOLLOW_PATH_VERSION = "follow-path"
 # ... and with `--in-place`'s (config.in_place): `stylesync bench --suite dev --in-place`
 IN_PLACE_VERSION = "in-place"
-# ... and with `--long-stride`'s (config.long_stride): `stylesync bench --suite dev --long-stride`
-LONG_STRIDE_VERSION = "long-stride"
+# ... and with `--pelvis-joint`'s (config.pelvis_joint): `stylesync bench --suite dev --pelvis-joint`
+PELVIS_JOINT_VERSION = "pelvis-joint"
 # The stylesync controller's versions with a set of settings, and the function that sets them
-VERSION_SETTINGS = {FOLLOW_PATH_VERSION: follow_path, IN_PLACE_VERSION: in_place, LONG_STRIDE_VERSION: long_stride}
+VERSION_SETTINGS = {FOLLOW_PATH_VERSION: follow_path, IN_PLACE_VERSION: in_place, PELVIS_JOINT_VERSION: pelvis_joint}
 
 
 def clip_specs(mocap: Path | None) -> list[tuple[str, str, str]]:
