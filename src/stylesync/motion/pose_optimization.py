@@ -444,6 +444,9 @@ class MotionOptimizer:
         ``recovery_landing_gap_m`` of the ground (it has landed, if on a corner)."""
         contact = state.feet_pressing()
         gap, step = self.cfg.recovery_landing_gap_m, self.recovery.step
+        if (self.cfg.own_step_scuff_before_due and step is not None and self.char_fsm.recovery_step
+                and contact[step.side] and not self.recovery.landing_due(state.time_s)):
+            contact[step.side] = False
         if gap is None or step is None or not self.char_fsm.recovery_step or contact[step.side]:
             return contact
         if self.recovery.landing_due(state.time_s) and _sole_within_m(state, step.side, gap):
