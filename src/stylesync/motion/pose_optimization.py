@@ -441,7 +441,8 @@ class MotionOptimizer:
     def _feet_down(self, state: CharacterState) -> dict[str, bool]:
         """Per side, whether the foot is on the ground: it presses it (``CharacterState.feet_pressing``), or it is a
         recovery step's foot past its horizontal travel whose sole's lowest corner is within
-        ``recovery_landing_gap_m`` of the ground (it has landed, if on a corner)."""
+        ``recovery_landing_gap_m`` of the ground (it has landed, if on a corner); with ``own_step_scuff_before_due``
+        a recovery step's foot that presses the ground before its landing is due is not on it (a scuff)."""
         contact = state.feet_pressing()
         gap, step = self.cfg.recovery_landing_gap_m, self.recovery.step
         if (self.cfg.own_step_scuff_before_due and step is not None and self.char_fsm.recovery_step
