@@ -272,12 +272,12 @@ class MotionConfig:
     # only) [m]
     recovery_landing_gap_m: float | None = 0.003
     # A step of the character's own whose foot touches the ground before its landing is due (before it has covered
-    # its way over the ground, recovery_step.HORIZONTAL_SHARE of its swing time) has scuffed it, not landed: the step
-    # goes on. Traced on CMU-dev 05_01 (seed 8): a swing taken over 0.03 s after his lift-off, its foot 1-2 cm up,
-    # touched 0.12 s after it, 0.55 m short of its landing, and ended there; the next step of its own, from a foot
-    # that far behind the capture point, could not catch the body, and a chain of them ran it to 2.4 m/s and down
-    # (docs/decisions.md, "An own step's foot that scuffs the ground"). Off by default: the demo walk's largest
-    # transition delay (seed 0) 0.232 s with it.
+    # its way over the ground, recovery_step.HORIZONTAL_SHARE of its swing time), more than a foot's length short of
+    # the landing, has scuffed it, not landed: the step goes on. Traced on CMU-dev 05_01 (seed 8): a swing taken over
+    # 0.03 s after his lift-off, its foot 1-2 cm up, touched 0.12 s after it, 0.55 m short of its landing, and ended
+    # there; the next step of its own, from a foot that far behind the capture point, could not catch the body, and a
+    # chain of them ran it to 2.4 m/s and down (docs/decisions.md, "An own step's foot that scuffs the ground"). Off
+    # by default: over the suite's seeds 0-11 as many runs fall as without it (the spinning kick for the walks).
     own_step_scuff_before_due: bool = False
     # A recovery step lands its ankle at most this share of the leg's length from the stance ankle (the pelvis lowered
     # as the leg needs, recovery_landing_reach): at 0.6 the steps that stop a walk landed short of the capture point,

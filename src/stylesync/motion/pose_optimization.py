@@ -442,12 +442,16 @@ class MotionOptimizer:
         """Per side, whether the foot is on the ground: it presses it (``CharacterState.feet_pressing``), or it is a
         recovery step's foot past its horizontal travel whose sole's lowest corner is within
         ``recovery_landing_gap_m`` of the ground (it has landed, if on a corner); with ``own_step_scuff_before_due``
-        a recovery step's foot that presses the ground before its landing is due is not on it (a scuff)."""
+        a recovery step's foot that presses the ground before its landing is due, more than a foot's length short of
+        it, is not on it (a scuff)."""
         contact = state.feet_pressing()
         gap, step = self.cfg.recovery_landing_gap_m, self.recovery.step
         if (self.cfg.own_step_scuff_before_due and step is not None and self.char_fsm.recovery_step
                 and contact[step.side] and not self.recovery.landing_due(state.time_s)):
-            contact[step.side] = False
+            ankle = state.link_origin_world[_LINK[f"{step.side}_ankle"]]
+            short_m = math.hypot(float(step.landing_world[0] - ankle[0]), float(step.landing_world[1] - ankle[1]))
+            if short_m > FOOT_LENGTH_M:  # more than a foot's length short of its landing
+                contact[step.side] = False
         if gap is None or step is None or not self.char_fsm.recovery_step or contact[step.side]:
             return contact
         if self.recovery.landing_due(state.time_s) and _sole_within_m(state, step.side, gap):
