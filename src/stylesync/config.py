@@ -30,6 +30,12 @@ def _non_negative(name: str, value: float) -> None:
         raise ConfigError(f"{name} must be >= 0, got {value!r}")
 
 
+def _within(name: str, value: float, lower: float, upper: float) -> None:
+    """``value`` (the field ``name``) within the closed range [``lower``, ``upper``]."""
+    if not (lower <= value <= upper):
+        raise ConfigError(f"{name} must be within [{lower:g}, {upper:g}], got {value}")
+
+
 def _above(name: str, value: float, lower_name: str, lower: float) -> None:
     """``value`` (the field ``name``) strictly above ``lower`` (the field ``lower_name``): the upper end of a range."""
     if not (value > lower):
@@ -569,9 +575,7 @@ class MotionConfig:
             _non_negative("MotionConfig.double_stance_keeps_momentum_m", self.double_stance_keeps_momentum_m)
         if self.recovery_cross_clear_m is not None:
             _non_negative("MotionConfig.recovery_cross_clear_m", self.recovery_cross_clear_m)
-        if not 0.0 <= self.capture_bound_sole_share <= 1.0:
-            raise ConfigError(f"MotionConfig.capture_bound_sole_share must be within [0, 1], got "
-                              f"{self.capture_bound_sole_share}")
+        _within("MotionConfig.capture_bound_sole_share", self.capture_bound_sole_share, 0.0, 1.0)
         _positive("MotionConfig.recovery_swing_s", self.recovery_swing_s)
         if self.gait_capture_step_s is not None:
             _positive("MotionConfig.gait_capture_step_s", self.gait_capture_step_s)
@@ -597,9 +601,7 @@ class MotionConfig:
             _positive("MotionConfig.landing_pelvis_descent_mps", self.landing_pelvis_descent_mps)
         if self.landing_reach_ground_gap_m is not None:
             _positive("MotionConfig.landing_reach_ground_gap_m", self.landing_reach_ground_gap_m)
-        if not 0.0 <= self.landing_pelvis_floor_share <= 1.0:
-            raise ConfigError(f"MotionConfig.landing_pelvis_floor_share must be within [0, 1], got "
-                              f"{self.landing_pelvis_floor_share}")
+        _within("MotionConfig.landing_pelvis_floor_share", self.landing_pelvis_floor_share, 0.0, 1.0)
         _non_negative("MotionConfig.recovery_min_stance_s", self.recovery_min_stance_s)
         _positive("MotionConfig.recovery_step_reach_share", self.recovery_step_reach_share)
         _positive("MotionConfig.recovery_swing_overrun", self.recovery_swing_overrun)
@@ -614,12 +616,10 @@ class MotionConfig:
             _non_negative("MotionConfig.reference_follows_standing_s", self.reference_follows_standing_s)
         _non_negative("MotionConfig.path_feedback_share", self.path_feedback_share)
         _non_negative("MotionConfig.path_feedback_max_m", self.path_feedback_max_m)
-        if not 0.0 <= self.path_target_share <= 1.0:
-            raise ConfigError(f"MotionConfig.path_target_share must be within [0, 1], got {self.path_target_share}")
+        _within("MotionConfig.path_target_share", self.path_target_share, 0.0, 1.0)
         _non_negative("MotionConfig.path_target_max_m", self.path_target_max_m)
-        if self.path_target_along_cos is not None and not -1.0 <= self.path_target_along_cos <= 1.0:
-            raise ConfigError(f"MotionConfig.path_target_along_cos must be within [-1, 1], got "
-                              f"{self.path_target_along_cos}")
+        if self.path_target_along_cos is not None:
+            _within("MotionConfig.path_target_along_cos", self.path_target_along_cos, -1.0, 1.0)
         _non_negative("MotionConfig.path_target_along_min_mps", self.path_target_along_min_mps)
         if self.path_target_step_hold_s is not None:
             _positive("MotionConfig.path_target_step_hold_s", self.path_target_step_hold_s)
