@@ -47,6 +47,9 @@ TRACED_BEFORE_PRESS = ControlConfig(whole_body=WholeBodyConfig(press_double_stan
 # defaults before 2026-12-06, not through his hip joints with the target below his (config.PELVIS_JOINT_MOTION;
 # docs/decisions.md, "His pelvis at his hip joints"): the tests that run them carry the pelvis_joint marker (those
 # with the in_place marker, traced before either, have them too), so that they stay as traced whatever the defaults.
+# Scenarios traced while every swing the balance took over was lowered from where its foot was, on the ground or not
+# (MotionConfig.recovery_takeover_low_foot_m None, the default before 2026-12-06; docs/decisions.md, "A swing taken
+# over on the ground"): the tests that run them carry the lowered_takeover marker.
 
 
 def pytest_configure(config):
@@ -56,6 +59,9 @@ def pytest_configure(config):
     config.addinivalue_line("markers", "pelvis_joint: a scenario traced with his pelvis joint as his pelvis and the "
                                        "pelvis target at his (PELVIS_JOINT_MOTION): every MotionConfig made during the "
                                        "test defaults to them")
+    config.addinivalue_line("markers", "lowered_takeover: a scenario traced while every taken-over swing was lowered "
+                                       "from where its foot was (recovery_takeover_low_foot_m None): every "
+                                       "MotionConfig made during the test defaults to that")
 
 
 def _set_defaults(monkeypatch, cls: type, values: dict) -> None:
@@ -72,7 +78,8 @@ def _set_defaults(monkeypatch, cls: type, values: dict) -> None:
 def _traced_defaults(request, monkeypatch):
     """Under the ``in_place`` marker, the defaults of MotionConfig, WholeBodyConfig and OperatorConfig are those of
     config.in_place (and PELVIS_JOINT_MOTION's) for the test's duration; under ``pelvis_joint``, MotionConfig's are
-    PELVIS_JOINT_MOTION's too (what a test sets explicitly stays as it sets it)."""
+    PELVIS_JOINT_MOTION's too; under ``lowered_takeover``, its recovery_takeover_low_foot_m is None (what a test sets
+    explicitly stays as it sets it)."""
     motion: dict = {}
     if request.node.get_closest_marker("pelvis_joint") is not None:
         motion.update(PELVIS_JOINT_MOTION)
@@ -81,6 +88,8 @@ def _traced_defaults(request, monkeypatch):
         motion.update(IN_PLACE_MOTION)
         _set_defaults(monkeypatch, WholeBodyConfig, IN_PLACE_WHOLE_BODY)
         _set_defaults(monkeypatch, OperatorConfig, IN_PLACE_OPERATOR)
+    if request.node.get_closest_marker("lowered_takeover") is not None:
+        motion["recovery_takeover_low_foot_m"] = None
     if motion:
         _set_defaults(monkeypatch, MotionConfig, motion)
 

@@ -142,6 +142,7 @@ def test_the_share_is_checked():
         MotionConfig(capture_bound_sole_share=1.2)
 
 
+@pytest.mark.lowered_takeover
 @pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_lunge_the_character_cannot_stop_from_is_not_asked_for():
@@ -218,6 +219,7 @@ def test_a_capture_point_in_the_landing_catch_region_is_caught_by_the_landing_wh
 ZOMBIE = Path(__file__).resolve().parents[2] / "shared" / "mocap" / "deepmimic" / "humanoid3d_zombie_walk.txt"
 
 
+@pytest.mark.lowered_takeover
 @pytest.mark.pelvis_joint
 @pytest.mark.skipif(not ZOMBIE.exists(), reason="../shared/mocap/deepmimic/humanoid3d_zombie_walk.txt is not available")
 @pytest.mark.in_place

@@ -48,6 +48,7 @@ def _run(waits: bool) -> tuple[float, bool, float | None]:
     return worst, result.fell, result.fall_time_s
 
 
+@pytest.mark.lowered_takeover
 @pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_lift_off_onto_a_sole_the_capture_point_has_passed_waits():

@@ -90,6 +90,7 @@ needs_cmu_dev = pytest.mark.skipif(not (MOCAP / "cmu-dev").is_dir(),
                                    reason="../shared/mocap/cmu-dev (Poser/DAZ CMU clips) is not present")
 
 
+@pytest.mark.lowered_takeover
 @pytest.mark.pelvis_joint
 @needs_cmu_dev
 @pytest.mark.parametrize("push_bound", ["off", "he_stands"])

@@ -35,8 +35,9 @@ def test_a_scuffed_own_step_goes_on_to_its_landing():
                            configure=lambda cfg: cfg.replace(duration_s=6.0))
         return result.fell, begun
 
-    fell_off, steps_off = run(MotionConfig(own_step_scuff_before_due=False))
-    fell_on, _ = run(MotionConfig(own_step_scuff_before_due=True))
+    # (as traced: a taken-over swing lowered from where its foot is, wherever that is)
+    fell_off, steps_off = run(MotionConfig(own_step_scuff_before_due=False, recovery_takeover_low_foot_m=None))
+    fell_on, _ = run(MotionConfig(own_step_scuff_before_due=True, recovery_takeover_low_foot_m=None))
     assert fell_off and not fell_on
     # without it, the left foot's step taken over at 2.83 s ends within 0.1 s and the same foot steps again at once
     left = [t for t, side in steps_off if side == "left" and 2.8 < t < 3.0]

@@ -201,6 +201,7 @@ def test_the_pull_fades_out_once_he_takes_no_step():
         MotionConfig(path_target_step_hold_s=0.0)
 
 
+@pytest.mark.lowered_takeover
 @pytest.mark.pelvis_joint
 def test_a_spin_is_not_pulled_along_his_path():
     """Traced (the humanoid3d spin, sensor seed 7, 12 s): he turns about and travels while he spins, his COM going
@@ -290,6 +291,7 @@ def test_targets_on_his_path_keep_the_stealthy_walk_within_the_uhc_distance():
 _CMU_DEV = Path(__file__).resolve().parents[2] / "shared" / "mocap" / "cmu-dev"
 
 
+@pytest.mark.lowered_takeover
 @pytest.mark.pelvis_joint
 @pytest.mark.skipif(not (_CMU_DEV / "12_01.bvh").is_file(), reason="../shared/mocap/cmu-dev is not present")
 @pytest.mark.parametrize(("clip", "seed", "fall_s"), [("12_01", 6, 4.30), ("08_08", 1, 2.42), ("10_04", 0, 4.85)])

@@ -453,6 +453,7 @@ def test_a_swing_he_stops_on_is_landed_at_once_where_the_capture_point_goes(monk
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "07_05.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/07_05.bvh is not available")
+@pytest.mark.lowered_takeover
 @pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_double_stance_whose_capture_point_has_run_out_ends_in_a_step_of_its_own(monkeypatch):
@@ -865,6 +866,7 @@ def test_a_capture_point_out_of_reach_after_the_wait_is_told_from_one_a_step_the
 
 @pytest.mark.skipif(not (MOCAP / "deepmimic" / "humanoid3d_zombie_walk.txt").exists(),
                     reason="../shared/mocap/deepmimic/humanoid3d_zombie_walk.txt is not available")
+@pytest.mark.lowered_takeover
 @pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_double_stance_that_would_wait_out_of_reach_steps_at_once():
@@ -987,6 +989,7 @@ class _Stop(Exception):
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "03_02.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/03_02.bvh is not available")
+@pytest.mark.lowered_takeover
 @pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_recovery_steps_that_land_where_the_body_will_be_keep_a_walk_on_rough_ground_up():
@@ -1070,6 +1073,7 @@ def test_an_operator_swing_is_aimed_within_the_legs_reach():
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "07_11.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/07_11.bvh is not available")
+@pytest.mark.lowered_takeover
 @pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_swing_that_would_land_out_of_reach_is_landed_by_the_balance():
@@ -1107,6 +1111,7 @@ def test_a_swing_that_would_land_out_of_reach_is_landed_by_the_balance():
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "09_01.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/09_01.bvh is not available")
+@pytest.mark.lowered_takeover
 @pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_swing_past_its_usual_time_is_landed_before_the_capture_point_runs_out_of_reach():
@@ -1204,6 +1209,7 @@ def test_a_recovery_step_just_short_of_its_crossover_clearance_lands_on_the_capt
 
 @pytest.mark.skipif(not (MOCAP / "deepmimic" / "humanoid3d_stealthy_walk.txt").exists(),
                     reason="../shared/mocap/deepmimic/humanoid3d_stealthy_walk.txt is not available")
+@pytest.mark.lowered_takeover
 @pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_the_next_recovery_step_begins_while_both_soles_are_down():
@@ -1260,6 +1266,7 @@ def test_the_swing_profiles_velocity_is_its_targets_rate_with_the_landing_held()
         WholeBodyConfig(recovery_foot_target_rate="finite")
 
 
+@pytest.mark.lowered_takeover
 @pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_recovery_foot_follows_its_swing_profiles_velocity_not_the_landings_replanning():
@@ -1399,6 +1406,7 @@ def test_a_recovery_step_that_reaches_the_ground_on_a_corner_has_landed():
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "08_08.bvh").exists(),
                     reason="../shared/mocap/cmu-dev/08_08.bvh is not available")
+@pytest.mark.lowered_takeover
 @pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_recovery_step_whose_landing_is_due_is_pressed_onto_the_ground():

@@ -141,6 +141,7 @@ def test_the_fraction_between_the_feet_needs_them_in_his_order_where_asked():
 
 @pytest.mark.skipif(not (MOCAP / "cmu-dev" / "09_11.bvh").exists(),
                     reason="needs ../shared/mocap/cmu-dev/09_11.bvh (not in the repository)")
+@pytest.mark.lowered_takeover
 @pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_recovery_step_that_puts_the_other_foot_ahead_does_not_pull_the_body_back_over_the_rear_one():

@@ -32,6 +32,7 @@ def _target(stepper: RecoveryStepper, t: float, ankle: np.ndarray) -> np.ndarray
     return stepper.swing_target(t, COM, VEL, STANCE, IDENTITY, np.eye(3), None, ankle)
 
 
+@pytest.mark.lowered_takeover
 def test_a_taken_over_swing_that_trails_its_target_stays_up_until_its_foot_has_come_its_share_of_the_way():
     step_height = MotionConfig().recovery_step_height_m
     # Lowered along the target's travel (None), the target reaches the ground's height while the foot, trailing,

@@ -43,6 +43,7 @@ def _dance(forward: bool) -> tuple[bool, float | None, int, float]:
     return result.fell, result.fall_time_s, backwards[0], speed[0]
 
 
+@pytest.mark.lowered_takeover
 @pytest.mark.pelvis_joint
 def test_own_steps_do_not_walk_on_where_he_goes_sideways_or_backwards():
     fell, fall_s, backwards, speed = _dance(False)

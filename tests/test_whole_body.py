@@ -284,6 +284,7 @@ def test_a_joint_past_its_no_load_speed_gets_no_torque_along_its_motion():
     assert limit_joint_speed(limited, vel, 60.0) == 0  # nothing over a higher limit
 
 
+@pytest.mark.lowered_takeover
 @pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_light_link_does_not_spin_up_within_a_control_tick():

@@ -271,6 +271,13 @@ class MotionConfig:
     # stance foot, short of the landing, and a step of the other foot followed (docs/decisions.md, "A taken-over
     # swing that comes down short"). None: lowered along the target's travel [-]
     recovery_takeover_clearance_share: float | None = None
+    # A swing taken over with its ankle less than this above its height on the ground (taken over at his lift-off,
+    # before the foot has risen: the reach rule in a fast walk, a clip's held last frame) is a step from the ground,
+    # its foot up by recovery_step_height_m and down, not a foot in the air lowered from where it is: lowered from the
+    # ground, the foot slid 0.9 m along it to its landing, loaded, touched down beside the stance foot, and the own
+    # steps after it ran the body away (docs/decisions.md, "A swing taken over on the ground"). None: every taken-over
+    # swing is lowered from where its foot is [m]
+    recovery_takeover_low_foot_m: float | None = 0.05
     # ... and it has landed once its horizontal travel is over and the lowest corner of its sole is within this of
     # the ground, not only once it presses with CONTACT_FORCE_N: a foot that came down on a corner, tilted, rested
     # there with less than that while the stance leg, straight, held the pelvis above its target, and the body ran
@@ -594,6 +601,8 @@ class MotionConfig:
         if clearance is not None and not 0.0 <= clearance < 1.0:
             raise ConfigError(f"MotionConfig.recovery_takeover_clearance_share must be within [0, 1), "
                               f"got {self.recovery_takeover_clearance_share}")
+        if self.recovery_takeover_low_foot_m is not None:
+            _non_negative("MotionConfig.recovery_takeover_low_foot_m", self.recovery_takeover_low_foot_m)
         if self.pelvis_stance_reach_share is not None and not 0.0 < self.pelvis_stance_reach_share <= 1.0:
             raise ConfigError(f"MotionConfig.pelvis_stance_reach_share must be within (0, 1] or None, got "
                               f"{self.pelvis_stance_reach_share}")

@@ -352,9 +352,13 @@ class RecoveryStepper:
 
     def take_over(self, side: str, time_s: float, swing_ankle_world: np.ndarray) -> RecoveryStep:
         """Turn the swing of ``side``, in the air since the operator lifted it, into a recovery step that lands it
-        (step timing adaptation: the balance decides when the step ends)."""
+        (step timing adaptation: the balance decides when the step ends). A foot still within
+        ``recovery_takeover_low_foot_m`` of the ground (taken over at its lift-off) is stepped as a step from the
+        ground, up by ``recovery_step_height_m`` and down, not lowered from where it is."""
         ankle = np.array(swing_ankle_world, dtype=float)
-        self.step = RecoveryStep(side, time_s, ankle, ankle.copy(), self.cfg.recovery_swing_s, taken_over=True)
+        low_m = self.cfg.recovery_takeover_low_foot_m
+        in_air = low_m is None or float(ankle[2]) >= ANKLE_HEIGHT_M + low_m
+        self.step = RecoveryStep(side, time_s, ankle, ankle.copy(), self.cfg.recovery_swing_s, taken_over=in_air)
         self.count += 1
         return self.step
 
