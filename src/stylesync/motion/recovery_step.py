@@ -269,7 +269,9 @@ class RecoveryStep:
     lift_off_world: np.ndarray  # (3,) swing ankle at lift-off (or where it was when the step took a swing over)
     landing_world: np.ndarray  # (3,) the planned landing of the swing ankle, re-planned each tick
     duration_s: float  # the swing's time: the nominal one, shortened while the capture point runs out of reach
-    taken_over: bool = False  # the step took over a swing already in the air (it only lands it)
+    # the step took over a swing already in the air (it only lands it); one taken over with its foot still on the
+    # ground (MotionConfig.recovery_takeover_low_foot_m) is stepped as a step of its own from the ground is
+    taken_over: bool = False
     fixed_landing: bool = False  # a step to a place chosen before it began (rest_step.py): not re-planned
     # (3,) the target's velocity along the swing profile, the landing held where it is this tick (a new array each
     # tick: the reference pose passes it on as it is) [m/s]
