@@ -35,7 +35,7 @@ def _heights(low_m: float | None, foot_up_m: float) -> tuple[bool, list[float]]:
     for k in range(10):
         t = 1.0 + 0.1 * k * step.duration_s
         heights.append(float(stepper.swing_target(t, COM, VEL, STANCE, IDENTITY, np.eye(3))[2]) - ANKLE_HEIGHT_M)
-    return step.taken_over, heights
+    return step.lowered, heights
 
 
 def test_a_swing_taken_over_on_the_ground_rises_a_step_height():

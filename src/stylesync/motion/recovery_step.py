@@ -269,9 +269,10 @@ class RecoveryStep:
     lift_off_world: np.ndarray  # (3,) swing ankle at lift-off (or where it was when the step took a swing over)
     landing_world: np.ndarray  # (3,) the planned landing of the swing ankle, re-planned each tick
     duration_s: float  # the swing's time: the nominal one, shortened while the capture point runs out of reach
-    # the step took over a swing already in the air (it only lands it); one taken over with its foot still on the
-    # ground (MotionConfig.recovery_takeover_low_foot_m) is stepped as a step of its own from the ground is
-    taken_over: bool = False
+    taken_over: bool = False  # the step took over a swing of the operator's (it only lands it)
+    # its foot, in the air, is lowered from where it is: a taken-over swing's, unless the foot was still on the ground
+    # (MotionConfig.recovery_takeover_low_foot_m), which steps up and down as a step of its own does
+    lowered: bool = False
     fixed_landing: bool = False  # a step to a place chosen before it began (rest_step.py): not re-planned
     # (3,) the target's velocity along the swing profile, the landing held where it is this tick (a new array each
     # tick: the reference pose passes it on as it is) [m/s]
@@ -360,7 +361,8 @@ class RecoveryStepper:
         ankle = np.array(swing_ankle_world, dtype=float)
         low_m = self.cfg.recovery_takeover_low_foot_m
         in_air = low_m is None or float(ankle[2]) >= ANKLE_HEIGHT_M + low_m
-        self.step = RecoveryStep(side, time_s, ankle, ankle.copy(), self.cfg.recovery_swing_s, taken_over=in_air)
+        self.step = RecoveryStep(side, time_s, ankle, ankle.copy(), self.cfg.recovery_swing_s, taken_over=True,
+                                 lowered=in_air)
         self.count += 1
         return self.step
 
@@ -503,7 +505,7 @@ class RecoveryStepper:
         moved_rate = smooth_step_slope(along) / (HORIZONTAL_SHARE * step.duration_s)
         target = step.lift_off_world + moved * (landing - step.lift_off_world)
         vel = moved_rate * (landing - step.lift_off_world)
-        if phase < 1.0 and step.taken_over:
+        if phase < 1.0 and step.lowered:
             # Already in the air: lowered from where it is to the ground by the time it is over the landing ...
             target[2] = step.lift_off_world[2] + moved * (ANKLE_HEIGHT_M - step.lift_off_world[2])
             vel[2] = moved_rate * (ANKLE_HEIGHT_M - step.lift_off_world[2])
