@@ -1252,7 +1252,8 @@ def test_the_swing_profiles_velocity_is_its_targets_rate_with_the_landing_held()
     swing_s, h = stepper.cfg.recovery_swing_s, 1e-5
     for taken_over in (False, True):
         lift_off = ANKLES["right"] + (np.array([0.0, 0.0, 0.08]) if taken_over else 0.0)
-        stepper.step = RecoveryStep("right", 1.0, lift_off.copy(), lift_off.copy(), swing_s, taken_over=taken_over)
+        stepper.step = RecoveryStep("right", 1.0, lift_off.copy(), lift_off.copy(), swing_s, taken_over=taken_over,
+                                    lowered=taken_over)
         rates = []
         for phase in (0.1, 0.3, 0.5, 0.7, 0.85, 0.95):
             t = 1.0 + phase * swing_s
