@@ -605,12 +605,14 @@ class MotionOptimizer:
             com_xy[:2] += shift
         # Both targets moved towards his COM on the character's path (path_feedback.py; after the anchor offset's
         # continuity, which is the feet's, not the path's), while he steps along his way no faster than the
-        # character's gait goes
+        # character's gait goes (the pull is not computed while none of it is kept)
         if self.cfg.path_target_share > 0.0:
-            pull = self.path.target_pull_xy(com_xy, com_h, scale) * self._path_pull_kept(state.time_s)
-            pull = pull * self._path_pull_along(scale)
-            pelvis_xy[:2] += pull
-            com_xy[:2] += pull
+            kept = self._path_pull_kept(state.time_s)
+            along = self._path_pull_along(scale)
+            if kept != 0.0 and along != 0.0:
+                pull = self.path.target_pull_xy(com_xy, com_h, scale) * kept * along
+                pelvis_xy[:2] += pull
+                com_xy[:2] += pull
         tick.he_stands = self._he_stands(state, scale, tick.op_state)
         if self.cfg.rest_step_min_m is not None:
             tick.his_feet_still = self._his_feet_still(a_hs, scale)
