@@ -79,3 +79,79 @@ def test_joint_map_local_rotations_are_each_pairs_relative_rotation():
         # q_parent ⊗ local = q_child
         np.testing.assert_allclose(rot.multiply(q_parent, q), world[child], atol=1e-12)
     np.testing.assert_allclose(rot.batch_slerp(out, out[::-1], 1.0), rot.batch_align_sign(out[::-1], out), atol=1e-12)
+
+
+def test_heading_is_the_turn_about_the_vertical_of_a_trunk_bent_over():
+    # A pelvis turned by psi about the vertical, then pitched by theta: its heading is psi at every pitch up to the
+    # twist's tilt (past the vertical too); the heading of its forward axis turns half a turn as that axis passes
+    # the vertical. Beyond that tilt (a body upside down) the forward axis's heading again.
+    for psi in np.radians([-179.0, -120.0, -30.0, 0.0, 45.0, 135.0, 180.0]):
+        for theta_deg in (0.0, 30.0, 60.0, 80.0, 89.0, 91.0, 99.0, 120.0):
+            q = rot.multiply(rot.quat_from_yaw(psi),
+                             rot.quat_from_axis_angle(np.array([0.0, 1.0, 0.0]), np.radians(theta_deg)))
+            wrapped = np.angle(np.exp(1j * (rot.heading_from_quat(q) - psi)))
+            upright = theta_deg < rot.HEADING_TWIST_MAX_TILT_DEG
+            assert abs(wrapped) < 1e-9 if upright else abs(abs(wrapped) - np.pi) < 1e-9
+            forward = np.angle(np.exp(1j * (rot.yaw_from_quat(q) - psi)))
+            assert abs(forward) < 1e-9 if theta_deg < 90.0 else abs(abs(forward) - np.pi) < 1e-9
+    assert rot.heading_from_quat(-rot.quat_from_yaw(0.7)) == rot.heading_from_quat(rot.quat_from_yaw(0.7))
+
+
+def test_heading_is_the_forward_axis_yaw_bit_for_bit_while_upright_and_continuous_beyond():
+    rng = np.random.default_rng(11)
+    q = rng.normal(size=(4000, 4))
+    q /= np.linalg.norm(q, axis=1, keepdims=True)
+    batch = rot.batch_heading_from_quat(q)
+    upright = 0
+    for i in range(len(q)):
+        single = rot.heading_from_quat(q[i])
+        assert abs(np.angle(np.exp(1j * (batch[i] - single)))) < 1e-12
+        r = rot.matrix_from_quat(q[i])
+        if np.hypot(r[0, 0], r[1, 0]) >= np.cos(np.radians(rot.HEADING_FORWARD_PITCH_DEG)):
+            assert single == rot.yaw_from_quat(q[i])  # the Euler yaw as it was
+            upright += 1
+    assert upright > 500
+    # Along a pitch from upright to 99 degrees (bent over past the vertical) at a turn psi with a roll: no jump of
+    # more than a degree a step
+    for psi in (0.3, 2.9):
+        for phi_deg in (0.0, 20.0):
+            last = None
+            for theta_deg in np.arange(0.0, 99.0, 0.5):
+                q = rot.multiply(rot.multiply(rot.quat_from_yaw(psi), rot.quat_from_axis_angle(
+                    np.array([0.0, 1.0, 0.0]), np.radians(theta_deg))),
+                    rot.quat_from_axis_angle(np.array([1.0, 0.0, 0.0]), np.radians(phi_deg)))
+                h = rot.heading_from_quat(q)
+                if last is not None:
+                    assert abs(np.angle(np.exp(1j * (h - last)))) < np.radians(1.0)
+                last = h
+
+
+def test_the_spins_heading_turns_as_fast_as_he_does():
+    # The humanoid3d spin (pybullet_data): his trunk bends over as he turns (the pelvis's forward axis within 5
+    # degrees of straight down at times, its tilt up to 95 degrees), and the clip turns at most 372 deg/s (6.2
+    # degrees a sample at 60 Hz). His heading (the style feature H, which the character's root follows, Sec. 5.4)
+    # moves at most 14.4 degrees a sample (where the pelvis is tilted 90 degrees its turn about the vertical itself
+    # moves that fast); the forward axis's heading jumps by up to 83 degrees.
+    from stylesync.config import ClockConfig, OperatorConfig
+    from stylesync.motion.style_features import StyleExtractor
+    from stylesync.sources.builtin_operator import builtin_operator
+
+    _, performer = builtin_operator(OperatorConfig(clip="spin", start_ramp_s=0.0), ClockConfig(), 6.0, 0)
+    dt_s = 1.0 / 60.0
+    heading, forward = [], []
+    for t in np.arange(1.0, 5.4, dt_s):
+        f = performer.frame_at(float(t))
+        sides = {"left": "LEFT", "right": "RIGHT"}
+        feats = StyleExtractor()({k: f.pos(f"HIP_{v}") for k, v in sides.items()},
+                                 {k: f.pos(f"KNEE_{v}") for k, v in sides.items()},
+                                 {k: f.pos(f"ANKLE_{v}") for k, v in sides.items()},
+                                 {k: f.quat(f"KNEE_{v}") for k, v in sides.items()},
+                                 {k: f.quat(f"ANKLE_{v}") for k, v in sides.items()},
+                                 f.pos("PELVIS"), f.quat("PELVIS"))
+        heading.append(feats.H)
+        forward.append(rot.yaw_from_quat(f.quat("PELVIS")))
+    step_deg = np.degrees(np.abs(np.diff(np.unwrap(heading))))
+    jump_deg = np.degrees(np.abs(np.diff(np.unwrap(forward))))
+    assert step_deg.max() < 15.0
+    assert jump_deg.max() > 45.0  # the forward axis's heading is not one
+    assert np.degrees(abs(np.unwrap(heading)[-1] - np.unwrap(heading)[0])) > 600.0  # two turns, as the clip's

@@ -77,6 +77,16 @@ def multiply(a: Array, b: Array) -> Array:
 
 
 _CONJUGATE_SIGNS = np.array([1.0, -1.0, -1.0, -1.0])
+_WORLD_UP = np.array([0.0, 0.0, 1.0])
+# heading_from_quat: the body x axis's heading up to this pitch, the twist about the vertical from the second on [deg]
+HEADING_FORWARD_PITCH_DEG = 45.0
+HEADING_TWIST_PITCH_DEG = 75.0
+_HEADING_FORWARD_LENGTH = math.cos(math.radians(HEADING_FORWARD_PITCH_DEG))
+_HEADING_TWIST_LENGTH = math.cos(math.radians(HEADING_TWIST_PITCH_DEG))
+# ... and the x axis's heading wherever q's tilt (its swing from the vertical) exceeds HEADING_TWIST_MAX_TILT_DEG: a
+# body upside down has no twist of its own (w² + z² = cos²(tilt / 2))
+HEADING_TWIST_MAX_TILT_DEG = 100.0
+_HEADING_TWIST_MIN_COS2 = math.cos(math.radians(HEADING_TWIST_MAX_TILT_DEG / 2.0)) ** 2
 
 
 def conjugate(q: Array) -> Array:
@@ -171,6 +181,49 @@ def yaw_from_quat(q: Array) -> float:
     """Heading [rad] about world z of the body x axis of q."""
     w, x, y, z = np.asarray(q, dtype=float).tolist()
     return math.atan2(2 * (x * y + w * z), 1 - 2 * (y * y + z * z))
+
+
+def heading_from_quat(q: Array) -> float:
+    """Heading [rad] of q about world z, in (-π, π].
+
+    While the body x axis is within HEADING_FORWARD_PITCH_DEG of the horizontal, or q is tilted beyond
+    HEADING_TWIST_MAX_TILT_DEG from the upright (a body upside down has no turn about the vertical of its own): the
+    heading of the x axis, as :func:`yaw_from_quat` (the yaw of q's z-y-x Euler angles). As the x axis nears the
+    vertical (a trunk bent over in a spin or a kick), its horizontal part shrinks and turns with the tilt, not with
+    the turn, half a turn as it passes the vertical; from HEADING_TWIST_PITCH_DEG on: the turn of q about the
+    vertical (its twist, :func:`twist_angle`), which stays defined there. Between the two: the direction of the
+    blend of their unit vectors, the x axis's in proportion to its horizontal length and to its agreement with the
+    twist (none where it points back, past the vertical)."""
+    w, x, y, z = np.asarray(q, dtype=float).tolist()
+    fx, fy = 1 - 2 * (y * y + z * z), 2 * (x * y + w * z)  # the body x axis's horizontal part
+    length = math.hypot(fx, fy)
+    if length >= _HEADING_FORWARD_LENGTH or w * w + z * z < _HEADING_TWIST_MIN_COS2:
+        return math.atan2(fy, fx)
+    twist = twist_angle(q, _WORLD_UP)
+    share = min((length - _HEADING_TWIST_LENGTH) / (_HEADING_FORWARD_LENGTH - _HEADING_TWIST_LENGTH), 1.0)
+    if share <= 0.0:
+        return twist
+    tx, ty = math.cos(twist), math.sin(twist)
+    ux, uy = fx / length, fy / length
+    share *= max(ux * tx + uy * ty, 0.0)  # none of an x axis that points back (past the vertical)
+    return math.atan2(share * uy + (1.0 - share) * ty, share * ux + (1.0 - share) * tx)
+
+
+def batch_heading_from_quat(q: Array) -> Array:
+    """:func:`heading_from_quat` of each row of ``q`` (n, 4) [rad]."""
+    w, x, y, z = np.asarray(q, dtype=float).T
+    fx, fy = 1 - 2 * (y * y + z * z), 2 * (x * y + w * z)
+    length = np.hypot(fx, fy)
+    sign = np.where(w < 0, -1.0, 1.0)
+    twist = np.where((np.abs(w) < 1e-12) & (np.abs(z) < 1e-12), 0.0, 2.0 * np.arctan2(sign * z, sign * w))
+    share = np.clip((length - _HEADING_TWIST_LENGTH) / (_HEADING_FORWARD_LENGTH - _HEADING_TWIST_LENGTH), 0.0, 1.0)
+    tx, ty = np.cos(twist), np.sin(twist)
+    unit = np.maximum(length, 1e-300)
+    ux, uy = fx / unit, fy / unit
+    share = share * np.maximum(ux * tx + uy * ty, 0.0)
+    blend = np.arctan2(share * uy + (1.0 - share) * ty, share * ux + (1.0 - share) * tx)
+    forward = (length >= _HEADING_FORWARD_LENGTH) | (w * w + z * z < _HEADING_TWIST_MIN_COS2)
+    return np.where(forward, np.arctan2(fy, fx), np.where(share <= 0.0, twist, blend))
 
 
 def quat_from_yaw(yaw_rad: float) -> Array:

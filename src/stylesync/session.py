@@ -197,7 +197,7 @@ class Session:
 
     def _stand_at(self, pelvis_world: np.ndarray, pelvis_quat_wxyz: np.ndarray) -> None:
         """Character standing at the operator's pelvis position (horizontally) and heading."""
-        yaw = rot.yaw_from_quat(pelvis_quat_wxyz)
+        yaw = rot.heading_from_quat(pelvis_quat_wxyz)
         self.backend.reset(np.array([pelvis_world[0], pelvis_world[1], STANDING_ROOT_HEIGHT_M + 0.003]),
                            rot.quat_from_yaw(yaw))
 

@@ -4,7 +4,8 @@
 * N: unit normal of the leg motion plane, ``(knee - hip) × (ankle - knee)``, pointing left for a knee bent
   forward; undefined for a straight leg, where the previous normal (or the pelvis's left axis) is kept;
 * P_c: vector from the COM to each ankle [m];
-* H: heading of the root, the yaw of the pelvis [rad].
+* H: heading of the root, the yaw of the pelvis [rad]; with a trunk bent over (a spin, a kick), its turn about the
+  vertical (rotations.heading_from_quat): the heading of its forward axis turns with the tilt there, not the turn.
 The same extractor serves the operator and the character, so their features can be compared.
 """
 
@@ -73,7 +74,7 @@ class StyleExtractor:
             N[s] = leg_plane_normal(hip[s], knee[s], ankle[s], left_axis)
             P[s] = np.asarray(ankle[s]) - np.asarray(com)
         return StyleFeatures(T["left"], T["right"], N["left"], N["right"], P["left"], P["right"],
-                             rot.yaw_from_quat(pelvis_quat))
+                             rot.heading_from_quat(pelvis_quat))
 
 
 def style_rows(hip: np.ndarray, knee: np.ndarray, ankle: np.ndarray, shank_quat: np.ndarray, foot_quat: np.ndarray,
@@ -101,8 +102,7 @@ def style_rows(hip: np.ndarray, knee: np.ndarray, ankle: np.ndarray, shank_quat:
     unit = np.where((np.einsum("nsk,nk->ns", unit, left) >= 0)[:, :, None], unit, -unit)
     normals = np.where(straight[:, :, None], left[:, None, :], unit)
     out[:, 2:5], out[:, 5:8] = normals[:, 0], normals[:, 1]
-    # P_c: COM to each ankle; H: the pelvis's yaw (rotations.yaw_from_quat).
+    # P_c: COM to each ankle; H: the pelvis's heading (rotations.heading_from_quat).
     out[:, 8:11], out[:, 11:14] = ankle[:, 0] - com, ankle[:, 1] - com
-    pw, px, py, pz = pelvis_quat.T
-    out[:, 14] = np.arctan2(2 * (px * py + pw * pz), 1 - 2 * (py * py + pz * pz))
+    out[:, 14] = rot.batch_heading_from_quat(pelvis_quat)
     return out
