@@ -189,7 +189,7 @@ def heading_from_quat(q: Array) -> float:
     While the body x axis is within HEADING_FORWARD_PITCH_DEG of the horizontal, or q is tilted beyond
     HEADING_TWIST_MAX_TILT_DEG from the upright (a body upside down has no turn about the vertical of its own): the
     heading of the x axis, as :func:`yaw_from_quat` (the yaw of q's z-y-x Euler angles). As the x axis nears the
-    vertical (a trunk bent over in a spin or a kick), its horizontal part shrinks and turns with the tilt, not with
+    vertical (a trunk bent over in a spin), its horizontal part shrinks and turns with the tilt, not with
     the turn, half a turn as it passes the vertical; from HEADING_TWIST_PITCH_DEG on: the turn of q about the
     vertical (its twist, :func:`twist_angle`), which stays defined there. Between the two: the direction of the
     blend of their unit vectors, the x axis's in proportion to its horizontal length and to its agreement with the

@@ -4,7 +4,7 @@
 * N: unit normal of the leg motion plane, ``(knee - hip) × (ankle - knee)``, pointing left for a knee bent
   forward; undefined for a straight leg, where the previous normal (or the pelvis's left axis) is kept;
 * P_c: vector from the COM to each ankle [m];
-* H: heading of the root, the yaw of the pelvis [rad]; with a trunk bent over (a spin, a kick), its turn about the
+* H: heading of the root, the yaw of the pelvis [rad]; with the trunk bent over (a spin), its turn about the
   vertical (rotations.heading_from_quat): the heading of its forward axis turns with the tilt there, not the turn.
 The same extractor serves the operator and the character, so their features can be compared.
 """
