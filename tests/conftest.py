@@ -50,6 +50,9 @@ TRACED_BEFORE_PRESS = ControlConfig(whole_body=WholeBodyConfig(press_double_stan
 # Scenarios traced while every swing the balance took over was lowered from where its foot was, on the ground or not
 # (MotionConfig.recovery_takeover_low_foot_m None, the default before 2026-12-06; docs/decisions.md, "A swing taken
 # over on the ground"): the tests that run them carry the lowered_takeover marker.
+# Scenarios traced while the operator's heading was his pelvis's forward axis's in every pose (rotations.yaw_from_quat,
+# before 2026-12-06; docs/decisions.md, "The operator's heading where his trunk bends over"): the tests that run them
+# carry the forward_heading marker.
 
 
 def pytest_configure(config):
@@ -62,6 +65,8 @@ def pytest_configure(config):
     config.addinivalue_line("markers", "lowered_takeover: a scenario traced while every taken-over swing was lowered "
                                        "from where its foot was (recovery_takeover_low_foot_m None): every "
                                        "MotionConfig made during the test defaults to that")
+    config.addinivalue_line("markers", "forward_heading: a scenario traced while the operator's heading was his "
+                                       "pelvis's forward axis's in every pose (rotations.yaw_from_quat)")
 
 
 def _set_defaults(monkeypatch, cls: type, values: dict) -> None:
@@ -79,7 +84,7 @@ def _traced_defaults(request, monkeypatch):
     """Under the ``in_place`` marker, the defaults of MotionConfig, WholeBodyConfig and OperatorConfig are those of
     config.in_place (and PELVIS_JOINT_MOTION's) for the test's duration; under ``pelvis_joint``, MotionConfig's are
     PELVIS_JOINT_MOTION's too; under ``lowered_takeover``, its recovery_takeover_low_foot_m is None (what a test sets
-    explicitly stays as it sets it)."""
+    explicitly stays as it sets it); under ``forward_heading``, the operator's heading is rotations.yaw_from_quat."""
     motion: dict = {}
     if request.node.get_closest_marker("pelvis_joint") is not None:
         motion.update(PELVIS_JOINT_MOTION)
@@ -92,6 +97,16 @@ def _traced_defaults(request, monkeypatch):
         motion["recovery_takeover_low_foot_m"] = None
     if motion:
         _set_defaults(monkeypatch, MotionConfig, motion)
+    if request.node.get_closest_marker("forward_heading") is not None:
+        # (the operator side's worker is forked from this process: it computes the heading so too)
+        monkeypatch.setattr(rot, "heading_from_quat", rot.yaw_from_quat)
+        monkeypatch.setattr(rot, "batch_heading_from_quat", _forward_headings)
+
+
+def _forward_headings(q: np.ndarray) -> np.ndarray:
+    """rotations.yaw_from_quat of each row of ``q`` (n, 4) [rad]."""
+    w, x, y, z = np.asarray(q, dtype=float).T
+    return np.arctan2(2 * (x * y + w * z), 1 - 2 * (y * y + z * z))
 
 
 def _standing(root_quat_wxyz: np.ndarray):

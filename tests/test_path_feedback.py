@@ -203,6 +203,7 @@ def test_the_pull_fades_out_once_he_takes_no_step():
 
 @pytest.mark.lowered_takeover
 @pytest.mark.pelvis_joint
+@pytest.mark.forward_heading
 def test_a_spin_is_not_pulled_along_his_path():
     """Traced (the humanoid3d spin, sensor seed 7, 12 s): he turns about and travels while he spins, his COM going
     round as much as along his way; with the targets pulled onto his path whether he goes along it or not

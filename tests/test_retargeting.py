@@ -54,6 +54,7 @@ def test_the_airborne_share_must_be_positive():
 
 @pytest.mark.pelvis_joint
 @pytest.mark.in_place
+@pytest.mark.forward_heading
 def test_the_spins_leap_does_not_fold_the_stance_leg():
     """The built-in spin, seed 8: from 2.65 s the operator leaps and turns with his body horizontal, his feet 1.4-1.6 m
     up (above his head) while the stance FSM still reads his lower foot, the left, as his stance. Measured from that
