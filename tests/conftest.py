@@ -105,8 +105,7 @@ def _traced_defaults(request, monkeypatch):
 
 def _forward_headings(q: np.ndarray) -> np.ndarray:
     """rotations.yaw_from_quat of each row of ``q`` (n, 4) [rad]."""
-    w, x, y, z = np.asarray(q, dtype=float).T
-    return np.arctan2(2 * (x * y + w * z), 1 - 2 * (y * y + z * z))
+    return np.array([rot.yaw_from_quat(row) for row in np.asarray(q, dtype=float)])
 
 
 def _standing(root_quat_wxyz: np.ndarray):
