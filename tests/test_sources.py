@@ -63,6 +63,90 @@ def test_builtin_walk_starts_from_standing_and_reaches_the_clip_speed():
     assert speed(t_after) == pytest.approx(v_clip, rel=1e-6)
 
 
+def _ankles_and_heading(performer, times):
+    """His ankles (T, 2, 3) [m] and pelvis heading (T,) [rad] at ``times`` [s]."""
+    from stylesync import rotations as rot
+
+    frames = [performer.frame_at(t) for t in times]
+    ankles = np.array([[f.pos("ANKLE_LEFT"), f.pos("ANKLE_RIGHT")] for f in frames])
+    heading = np.unwrap([rot.yaw_from_quat(f.quat("PELVIS")) for f in frames])
+    return ankles, heading
+
+
+def _down_foot_slide_m(ankles, up_m=0.03):
+    """The farthest an ankle moves over the ground [m] while it stays within ``up_m`` of its lowest height."""
+    low = ankles[:, :, 2].min(axis=0)
+    worst = 0.0
+    for k in range(ankles.shape[1]):
+        start = None
+        for i in range(len(ankles)):
+            if ankles[i, k, 2] - low[k] >= up_m:
+                start = None
+                continue
+            start = i if start is None else start
+            worst = max(worst, float(np.linalg.norm(ankles[i, k, :2] - ankles[start, k, :2])))
+    return worst
+
+
+def test_the_rate_ramp_starts_a_loop_from_its_own_pose_with_no_foot_sliding():
+    """``OperatorConfig.start_ramp="rate"``: the walk starts in the clip's pose with both feet down, the clip's time
+    grows as u_0 + τ² / (2 T), and a foot on the ground moves no more than in the clip played at its own pace (the
+    heel-to-toe roll); the blend slides the walk's left foot 0.1 m further than that at a few centimetres' height."""
+    from stylesync.config import ClockConfig, OperatorConfig
+    from stylesync.sources.builtin_operator import ClipPerformer, builtin_operator
+    from stylesync.sources.human_model import HumanModel
+
+    times = np.arange(0.0, 3.5, 1.0 / 60.0)
+    op = OperatorConfig()
+    own = ClipPerformer(DeepMimicClip.builtin("walk"), HumanModel(op.height_m, op.mass_kg))
+    clip_slide = _down_foot_slide_m(_ankles_and_heading(own, times)[0])
+    slides = {}
+    for ramp in ("rate", "blend"):
+        op = OperatorConfig(start_ramp=ramp)
+        _, performer = builtin_operator(op, ClockConfig(), 1.0, 0)
+        ankles, _ = _ankles_and_heading(performer, times)
+        slides[ramp] = _down_foot_slide_m(ankles)
+        if ramp == "rate":
+            assert performer.rate_ramp
+            assert (ankles[0, :, 2] - ankles[:, :, 2].min(axis=0)).max() <= 0.05  # he stands on both feet
+            ramp_s, u0 = op.start_ramp_s, performer.start_phase_s
+            assert performer.clip_time_s(0.5) == u0
+            assert performer.clip_time_s(1.0 + 0.5 * ramp_s) == pytest.approx(u0 + ramp_s / 8)
+            assert performer.clip_time_s(1.0 + 2.0 * ramp_s) == pytest.approx(u0 + 1.5 * ramp_s)
+    assert slides["rate"] <= clip_slide + 0.01
+    assert slides["blend"] > clip_slide + 0.1
+
+
+def test_the_rate_ramp_turns_a_turning_clip_along_its_own_path():
+    """The blend turns the dancer the shorter way about his heading in one frame; the rate ramp turns him no faster
+    than the clip itself does; a run, whose feet are never both down, is blended in with either setting."""
+    from stylesync import rotations as rot
+    from stylesync.config import ClockConfig, OperatorConfig
+    from stylesync.sources.builtin_operator import builtin_operator
+
+    times = np.arange(0.0, 4.0, 1.0 / 120.0)
+    clip = DeepMimicClip.builtin("dance_a")
+    clip_yaw = np.unwrap([rot.yaw_from_quat(clip.pose_at(t).local_quats["PELVIS"]) for t in times])
+    clip_step = float(np.abs(np.diff(clip_yaw)).max())
+    turns = {}
+    for ramp in ("rate", "blend"):
+        _, performer = builtin_operator(OperatorConfig(clip="dance_a", start_ramp=ramp), ClockConfig(), 1.0, 0)
+        _, heading = _ankles_and_heading(performer, times)
+        turns[ramp] = float(np.abs(np.diff(heading)).max())
+    assert turns["rate"] <= clip_step + 1e-9
+    assert turns["blend"] > np.radians(90.0)
+    _, run = builtin_operator(OperatorConfig(clip="run", start_ramp="rate"), ClockConfig(), 1.0, 0)
+    assert not run.rate_ramp
+
+
+def test_an_unknown_start_ramp_is_a_clear_configuration_error():
+    from stylesync.config import OperatorConfig
+    from stylesync.errors import ConfigError
+
+    with pytest.raises(ConfigError, match="start_ramp"):
+        OperatorConfig(start_ramp="jump")
+
+
 def test_a_faster_operator_plays_the_clip_faster_after_the_lead_in():
     """``OperatorConfig.playback_speed``: the same lead-in, then the clip's time runs that many times faster (the
     sync experiment's speed sweep); a speed of zero or less is a clear configuration error."""

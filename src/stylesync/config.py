@@ -870,7 +870,12 @@ class OperatorConfig:
     orientation_noise_rad: float = 0.02  # joint orientation noise (1 sigma) [rad]
     timestamp_jitter_s: float = 0.004  # sample-time jitter (1 sigma) [s]
     standing_lead_in_s: float = 1.0  # operator stands in the first frame's pose before the clip plays [s]
-    start_ramp_s: float = 1.5  # a looping clip's strides grow from standing to full over this time [s]
+    # A looping clip's start after the lead-in (sources/builtin_operator.py): "blend", a neutral stand blended into
+    # the clip (his feet slide, and a turning clip turns him the shorter way at once); "rate", his pose the clip's own
+    # at the phase where his feet are lowest and the clip's time running at a rate that grows from 0 to 1 (no slide,
+    # no turn but the clip's; measured, not the default: docs/decisions.md, "A built-in clip's start at a growing rate")
+    start_ramp: str = "blend"
+    start_ramp_s: float = 1.5  # ... over this time [s]
     # The clip played this many times faster after the lead-in (the operator walks faster: cadence and speed) [-]
     playback_speed: float = 1.0
     # The clip's path bent into a turn at this rate after the lead-in (+: counter-clockwise seen from above;
@@ -908,6 +913,8 @@ class OperatorConfig:
         _non_negative("OperatorConfig.timestamp_jitter_s", self.timestamp_jitter_s)
         _non_negative("OperatorConfig.standing_lead_in_s", self.standing_lead_in_s)
         _non_negative("OperatorConfig.start_ramp_s", self.start_ramp_s)
+        if self.start_ramp not in ("rate", "blend"):
+            raise ConfigError(f"OperatorConfig.start_ramp {self.start_ramp!r}: expected 'rate' or 'blend'")
         _positive("OperatorConfig.playback_speed", self.playback_speed)
         if not math.isfinite(self.turn_rate_rad_s):
             raise ConfigError(f"OperatorConfig.turn_rate_rad_s must be finite, got {self.turn_rate_rad_s}")

@@ -127,7 +127,7 @@ def open_source(spec: str, clocks: ClockConfig | None = None, operator: Operator
         is_path = arg.endswith(".txt") or "/" in arg
         clip = DeepMimicClip.load(arg) if is_path else DeepMimicClip.builtin(arg)
         human = HumanModel(op.height_m, op.mass_kg)
-        performer = ClipPerformer(clip, human, op.standing_lead_in_s, start_ramp_s=op.start_ramp_s)
+        performer = ClipPerformer(clip, human, op.standing_lead_in_s, start_ramp_s=op.start_ramp_s, ramp=op.start_ramp)
         total = (duration_s if duration_s is not None else
                  (clip.duration_s if not clip.loop else 12.0) + op.standing_lead_in_s)
         if sensor == "kinect":
