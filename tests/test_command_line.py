@@ -70,6 +70,16 @@ def test_an_export_into_a_missing_folder_creates_it(tmp_path, capsys):
     assert bvh.is_file() and bvh.read_text().startswith("HIERARCHY")
 
 
+def test_the_demo_takes_the_start_ramp_and_records_it(tmp_path, capsys):
+    import json
+
+    assert cli_main(["demo", "--duration", "0.3", "--start-ramp", "rate", "--out", str(tmp_path / "o")]) == 0
+    assert json.loads((tmp_path / "o" / "metrics.json").read_text())["start_ramp"] == "rate"
+    assert _exit_code(["demo", "--start-ramp", "slide", "--out", str(tmp_path / "p")]) == 2
+    err = capsys.readouterr().err
+    assert "--start-ramp" in err and "Traceback" not in err
+
+
 def test_a_recording_asked_to_run_past_its_end_stops_at_its_end_plus_the_rest(tmp_path, capsys):
     import json
     from pathlib import Path

@@ -166,13 +166,15 @@ def _replay_viewer(args: argparse.Namespace, session) -> None:
 def _demo(args: argparse.Namespace) -> int:
     from stylesync.sources.builtin_operator import builtin_operator
 
-    operator = OperatorConfig(clip=args.clip, turn_rate_rad_s=args.turn_rate, mirror=args.mirror)
+    operator = OperatorConfig(clip=args.clip, turn_rate_rad_s=args.turn_rate, mirror=args.mirror,
+                              start_ramp=args.start_ramp)
     cfg = SessionConfig(duration_s=args.duration, seed=args.seed, gui=args.gui,
                         realtime=args.realtime or args.viewer != "none", operator=operator,
                         control=ControlConfig(lipm_time_sync=not args.no_lipm))
     cfg = _motion_options(cfg, args)
     source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
     return _run_session(cfg, source, Path(args.out), {"clip": args.clip, "turn_rate_rad_s": args.turn_rate,
+                                                      "start_ramp": args.start_ramp,
                                                       "lipm_time_sync": not args.no_lipm,
                                                       "mirror": args.mirror,
                                                       "follow_path": args.follow_path,
@@ -480,6 +482,9 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument("--seed", type=typed.seed, default=0)
     demo.add_argument("--turn-rate", type=typed.turn_rate_rad_s, default=0.0,
                       help="the clip's path bent into a turn at this rate after the lead-in [rad/s] (+: to the left)")
+    demo.add_argument("--start-ramp", choices=("blend", "rate"), default=OperatorConfig().start_ramp,
+                      help="a looping clip's start: blended in from a stand (default), or its own poses at a rate "
+                           "growing from 0 (no foot slides, no turn but the clip's)")
     _add_session_args(demo, "out/demo", "pace to the wall clock")
     demo.set_defaults(func=_demo)
     run = sub.add_parser("run", help="drive the character from an operator source")
