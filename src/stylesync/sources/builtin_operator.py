@@ -69,7 +69,8 @@ class ClipPerformer:
             phase_s, higher_m = self._lowest_feet_phase_s()
             if higher_m <= RATE_RAMP_MAX_FOOT_UP_M:
                 self.start_phase_s, self.rate_ramp = phase_s, True
-        if self.start_ramp_s > 0 and not self.rate_ramp:  # ∫_0^s (p_clip(s') - p_clip(0)) ds' on a fine grid, for the ramped pelvis path
+        if self.start_ramp_s > 0 and not self.rate_ramp:
+            # ∫_0^s (p_clip(s') - p_clip(0)) ds' on a fine grid, for the blend's pelvis path
             self._ramp_t = np.linspace(0.0, self.start_ramp_s, int(self.start_ramp_s * _RAMP_GRID_HZ) + 2)
             self._clip_root_0 = self._clip_root(0.0)
             p = np.array([self._clip_root(t) for t in self._ramp_t]) - self._clip_root_0
