@@ -14,8 +14,8 @@ stand. Two starts (``OperatorConfig.start_ramp``):
 * ``"rate"``: he stands for the lead-in in the clip's own pose at the phase where his feet are nearest the
   ground (a clip with no pose on both feet, a run, starts as with ``"blend"``), and the clip's time then runs at a
   rate that grows from 0 to 1 over ``start_ramp_s`` (clip time u = u_0 + τ² / (2 T) for τ < T, u_0 + τ - T / 2
-  after). Every pose he takes is one of the clip's, so a foot
-  that stands in the clip stands in the start too, and his heading turns along the clip's own path.
+  after). Every pose he takes is one of the clip's, so a foot that stands in the clip stands in the start too, and
+  his heading turns along the clip's own path.
 * ``"blend"`` (the default): he stands in a neutral pose and the clip's joint rotations are blended in from it over
   ``start_ramp_s`` (slerp, the shorter arc), the pelvis's velocity scaled by the same weight. His feet slide in
   that blend (the built-in walk's left foot 0.26 m forwards at 6 cm height, no step), and a clip that turns
