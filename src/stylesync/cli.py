@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 from stylesync import cli_args as typed
 from stylesync.config import (
     SHARED_DIR,
+    START_RAMPS,
     VIEWER_DRAW_HZ,
     ClockConfig,
     ControlConfig,
@@ -482,7 +483,7 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument("--seed", type=typed.seed, default=0)
     demo.add_argument("--turn-rate", type=typed.turn_rate_rad_s, default=0.0,
                       help="the clip's path bent into a turn at this rate after the lead-in [rad/s] (+: to the left)")
-    demo.add_argument("--start-ramp", choices=("blend", "rate"), default=OperatorConfig().start_ramp,
+    demo.add_argument("--start-ramp", choices=START_RAMPS, default=OperatorConfig().start_ramp,
                       help="a looping clip's start: blended in from a stand (default), or its own poses at a rate "
                            "growing from 0 (no foot slides, no turn but the clip's)")
     _add_session_args(demo, "out/demo", "pace to the wall clock")

@@ -859,6 +859,9 @@ class ControlConfig:
 FOLLOW_PATH_START_SPEED_MAX_MPS = 1.0
 
 
+START_RAMPS = ("blend", "rate")  # how a looping built-in clip starts after the lead-in (OperatorConfig.start_ramp)
+
+
 @dataclass(frozen=True)
 class OperatorConfig:
     """The built-in operator: a recorded clip played by a human-scale skeleton through a Kinect-like sensor."""
@@ -874,7 +877,7 @@ class OperatorConfig:
     # the clip (his feet slide, and a turning clip turns him the shorter way at once); "rate", his pose the clip's own
     # at the phase where his feet are lowest and the clip's time running at a rate that grows from 0 to 1 (no slide,
     # no turn but the clip's; measured, not the default: docs/decisions.md, "A built-in clip's start at a growing rate")
-    start_ramp: str = "blend"
+    start_ramp: str = "blend"  # one of START_RAMPS
     start_ramp_s: float = 1.5  # ... over this time [s]
     # The clip played this many times faster after the lead-in (the operator walks faster: cadence and speed) [-]
     playback_speed: float = 1.0
@@ -913,8 +916,9 @@ class OperatorConfig:
         _non_negative("OperatorConfig.timestamp_jitter_s", self.timestamp_jitter_s)
         _non_negative("OperatorConfig.standing_lead_in_s", self.standing_lead_in_s)
         _non_negative("OperatorConfig.start_ramp_s", self.start_ramp_s)
-        if self.start_ramp not in ("rate", "blend"):
-            raise ConfigError(f"OperatorConfig.start_ramp {self.start_ramp!r}: expected 'rate' or 'blend'")
+        if self.start_ramp not in START_RAMPS:
+            raise ConfigError(f"OperatorConfig.start_ramp {self.start_ramp!r}: expected one of "
+                              f"{', '.join(START_RAMPS)}")
         _positive("OperatorConfig.playback_speed", self.playback_speed)
         if not math.isfinite(self.turn_rate_rad_s):
             raise ConfigError(f"OperatorConfig.turn_rate_rad_s must be finite, got {self.turn_rate_rad_s}")

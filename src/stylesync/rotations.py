@@ -227,7 +227,7 @@ def batch_heading_from_quat(q: Array) -> Array:
 
 
 def quat_from_yaw(yaw_rad: float) -> Array:
-    return quat_from_axis_angle(np.array([0.0, 0.0, 1.0]), yaw_rad)
+    return quat_from_axis_angle(_WORLD_UP, yaw_rad)
 
 
 def swing_twist(q: Array, axis: Array) -> tuple[Array, Array]:

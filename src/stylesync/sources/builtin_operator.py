@@ -31,7 +31,7 @@ from collections.abc import Callable
 import numpy as np
 
 from stylesync import rotations as rot
-from stylesync.config import ClockConfig, OperatorConfig
+from stylesync.config import START_RAMPS, ClockConfig, OperatorConfig
 from stylesync.sources.base import RecordedSource
 from stylesync.sources.deepmimic_clip import CLIP_CHARACTER_LEG_LENGTH_M, DeepMimicClip
 from stylesync.sources.frame import OperatorFrame
@@ -39,7 +39,6 @@ from stylesync.sources.human_model import HumanModel
 from stylesync.sources.sensor_model import SensorModel
 from stylesync.sources.turning_path import TurningPath
 
-START_RAMPS = ("rate", "blend")  # how a looping clip starts after the lead-in (see the module)
 # The rate ramp starts a looping clip only where it has a pose with both ankles within this of their lowest (a stance
 # on both feet; heel and toe roll within it): a run's feet are never both down, and it is blended in [m]
 RATE_RAMP_MAX_FOOT_UP_M = 0.05
@@ -128,10 +127,10 @@ class ClipPerformer:
         return np.array([root[0], root[1], self.human.hip_height_m]), {"PELVIS": rot.quat_from_yaw(yaw)}
 
     def frame_at(self, t_s: float) -> OperatorFrame:
-        stand_root, stand_quats = self._stand_root, self._stand_quats
         if self.clip is not None and self.rate_ramp:
             pose = self.clip.pose_at(self.clip_time_s(t_s))
             return self.human.frame_from_pose(t_s, pose.root_pos_world * self.leg_ratio, pose.local_quats)
+        stand_root, stand_quats = self._stand_root, self._stand_quats
         if self.clip is None or t_s < self.lead_in_s - self.blend_s:
             return self.human.frame_from_pose(t_s, stand_root, stand_quats)
         u_s = self.speed * (t_s - self.lead_in_s)  # the clip's time [s]
