@@ -19,7 +19,8 @@ import numpy as np
 from stylesync.config import ClockConfig, OperatorConfig
 from stylesync.errors import SourceError
 from stylesync.sources.base import OperatorSource, RecordedSource
-from stylesync.sources.frame import JOINT_INDEX, OperatorFrame
+from stylesync.sources.frame import OperatorFrame
+from stylesync.sources.held_pose import put_feet_down
 from stylesync.sources.sensor_model import SensorModel
 
 SENSORS = ("kinect", "none")
@@ -54,20 +55,8 @@ class _LeadIn:
         f.timestamp_s = t_s
         if clip_t > self.performer.duration_s:
             x = min((clip_t - self.performer.duration_s) / FEET_DOWN_S, 1.0)
-            _put_feet_down(f, 0.5 - 0.5 * float(np.cos(np.pi * x)))  # from 0 to 1 with zero slope at both ends
+            put_feet_down(f, 0.5 - 0.5 * float(np.cos(np.pi * x)))  # from 0 to 1 with zero slope at both ends
         return f
-
-
-def _put_feet_down(f: OperatorFrame, fraction: float) -> None:
-    """In place: the operator holding a pose comes to rest on both feet. The higher foot (ankle, toe, and the knee
-    by half) is lowered by ``fraction`` of its height over the lower one, where it is over the ground: a clip that
-    ends mid-stride would otherwise leave the character standing on one leg for as long as the pose is held."""
-    z = {side: f.pos(f"ANKLE_{side}")[2] for side in ("LEFT", "RIGHT")}
-    low = min(z.values())
-    for side, ankle_z in z.items():
-        drop = fraction * (ankle_z - low)
-        for joint, share in (("ANKLE", 1.0), ("FOOT", 1.0), ("KNEE", 0.5)):
-            f.joint_pos_world[JOINT_INDEX[f"{joint}_{side}"], 2] -= share * drop
 
 
 def _recorded(performer, label: str, sensor: str, clocks: ClockConfig, op: OperatorConfig, seed: int,
