@@ -13,11 +13,11 @@ from conftest import suite_run
 
 from stylesync.config import PELVIS_JOINT_MOTION, ControlConfig, MotionConfig, SessionConfig
 from stylesync.errors import ConfigError
-from stylesync.model.character import LINK_NAMES
+from stylesync.model.character import LINK_NAMES, OPERATOR_JOINTS
 from stylesync.motion.initial_state import retargeted_pose
 from stylesync.motion.operator_analysis import analyse_operator
 from stylesync.motion.pose_optimization import CHAR_LEG_LENGTH_M, pelvis_offset_m
-from stylesync.processing.body_parameters import hip_centre_world
+from stylesync.processing.body_parameters import hip_centre_world, paired_operator_joints
 from stylesync.processing.operator_processing import OperatorProcessing
 from stylesync.sources.frame import JOINT_INDEX
 from stylesync.sources.registry import open_source
@@ -36,6 +36,18 @@ def test_the_hip_centre_is_the_midpoint_of_the_hip_joints():
     pos = {"HIP_LEFT": np.array([0.1, 0.2, 0.9]), "HIP_RIGHT": np.array([0.3, -0.2, 0.7]),
            "PELVIS": np.array([5.0, 5.0, 5.0])}
     assert hip_centre_world(pos) == pytest.approx([0.2, 0.0, 0.8])
+
+
+def test_the_metrics_compare_the_characters_root_with_his_hip_centre():
+    # The imitation metrics' joint 0 is where the character's root is on its body, whatever joint his skeleton
+    # calls its pelvis: a CMU-like Hips root 0.1 m above the hips changes no paired joint.
+    frame = open_source("deepmimic:walk", sensor="none", seed=0).source.frames[40]
+    pos = {n: frame.pos(n).copy() for n in OPERATOR_JOINTS}
+    raised = dict(pos, PELVIS=pos["PELVIS"] + np.array([0.03, 0.0, 0.10]))
+    a, b = paired_operator_joints(pos, OPERATOR_JOINTS), paired_operator_joints(raised, OPERATOR_JOINTS)
+    assert np.array_equal(a, b)
+    assert a[OPERATOR_JOINTS.index("PELVIS")] == pytest.approx(hip_centre_world(pos))
+    assert a[OPERATOR_JOINTS.index("NECK")] == pytest.approx(pos["NECK"])
 
 
 def test_the_retargeted_pose_does_not_depend_on_where_the_skeleton_puts_its_pelvis_joint():

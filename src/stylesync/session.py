@@ -40,6 +40,7 @@ from stylesync.motion.stance_fsm import Stance
 from stylesync.motion.style_features import ROW_NAMES as _FEATURES
 from stylesync.motion.style_features import style_rows
 from stylesync.prefetch import OperatorInline, OperatorPrefetch
+from stylesync.processing.body_parameters import paired_operator_joints
 from stylesync.processing.joint_map import tracked_arrays
 from stylesync.processing.operator_processing import OperatorProcessing, OperatorSample
 from stylesync.sim.backend import PhysicsBackend
@@ -478,7 +479,7 @@ def _add_after_run_columns(lg: TickLog) -> None:
                 lg.columns[f"{prefix}_{axis}"] = arr[:, k].tolist()
     op_pos = lg.columns.pop("_op_pos", [])
     if op_pos:
-        lg.columns["op_joints"] = [np.array([pos[n] for n in OPERATOR_JOINTS]) for pos in op_pos]
+        lg.columns["op_joints"] = [paired_operator_joints(pos, OPERATOR_JOINTS) for pos in op_pos]
     features = lg.columns.pop("_op_features", [])
     if features:
         arr = np.asarray([f.as_row() for f in features], dtype=float)

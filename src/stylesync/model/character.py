@@ -141,7 +141,8 @@ def canonical_quat_from_model(q_model_wxyz: np.ndarray) -> np.ndarray:
     return np.asarray(q_model_wxyz, dtype=float) @ _CANONICAL_FROM_MODEL_T
 
 
-# Character links whose frame origin is the joint of the same name on the operator (canonical joints).
+# Character links whose frame origin is the joint of the same name on the operator (canonical joints); his "PELVIS"
+# is read at his hip joints' midpoint where they are compared (processing/body_parameters.paired_operator_joints).
 JOINT_PAIRS: tuple[tuple[str, str], ...] = (
     ("root", "PELVIS"), ("chest", "SPINE_CHEST"), ("neck", "NECK"),
     ("left_hip", "HIP_LEFT"), ("left_knee", "KNEE_LEFT"), ("left_ankle", "ANKLE_LEFT"),

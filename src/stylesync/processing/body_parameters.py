@@ -63,6 +63,14 @@ def hip_centre_world(pos: dict[str, np.ndarray]) -> np.ndarray:
     return 0.5 * (np.asarray(pos["HIP_LEFT"], dtype=float) + np.asarray(pos["HIP_RIGHT"], dtype=float))
 
 
+def paired_operator_joints(pos: dict[str, np.ndarray], names: tuple[str, ...]) -> np.ndarray:
+    """(len(names), 3) his joints ``names`` [m], world frame, with his pelvis (``"PELVIS"``) read at his hip joints'
+    midpoint (:func:`hip_centre_world`): the points of his body that the character's links of the same place are
+    compared with (the imitation metrics). The character's root is level with its hip joints, and a skeleton puts
+    its pelvis joint anywhere from 0.03 m below them (CMU-dev) to 0.1 m above (CMU's ``Hips``)."""
+    return np.array([hip_centre_world(pos) if n == "PELVIS" else pos[n] for n in names])
+
+
 def operator_pelvis_world(pos: dict[str, np.ndarray], from_hip_joints: bool) -> np.ndarray:
     """(3,) his pelvis as the retargeting of Eq. 9-10 takes it [m]: :func:`hip_centre_world` with
     ``from_hip_joints`` (MotionConfig.pelvis_from_hip_joints), else his skeleton's pelvis joint."""
