@@ -4,8 +4,9 @@ A clip often ends mid-stride (or, on uneven ground, with a foot on a step). Held
 on one leg for the whole rest; so the higher foot comes down to the lower one's height. Its hip stays where it is and
 the knee is placed by the two-link solution in the leg's own plane (the plane of hip, knee and ankle), so that the
 thigh and the shank keep their lengths: his leg length (Eq. 1), and with it the scale of Eq. 9, stays what it was
-during the clip. A foot the leg cannot bring that low (a hip too high over it) comes down as far as the straight
-leg reaches.
+during the clip. A trailing foot behind a leg that would have to stretch to reach the ground below it is brought in
+towards the hip as it comes down. The segments' orientations are left as they were: the legs are retargeted from
+the joints' positions (motion/pose_optimization.py), the feet's headings from the feet, which are moved, not turned.
 """
 
 from __future__ import annotations
@@ -27,6 +28,8 @@ def _knee_in_leg_plane(hip: np.ndarray, knee: np.ndarray, ankle: np.ndarray, thi
     leg) is bent towards ``toes_dir`` (ankle to toes)."""
     d = ankle - hip
     dist = float(np.linalg.norm(d))
+    if dist < 1e-9:  # an ankle at the hip (a body folded up): no plane to solve in
+        return knee
     axis = d / dist
     along = (thigh_m * thigh_m - shank_m * shank_m + dist * dist) / (2.0 * dist)
     off = math.sqrt(max(thigh_m * thigh_m - along * along, 0.0))
