@@ -50,8 +50,9 @@ def _hover(gains: tuple[float, float] | None) -> tuple[int, int, bool]:
 def test_an_own_step_due_to_land_reaches_the_ground():
     hover, due, fell = _hover(None)
     # With the soft gains the hip stayed 0.05-0.13 m above its target, the leg straight, the foot 0.1-0.2 m up while
-    # the body ran past its landing, and the character fell at 3.5 s
-    assert fell and hover >= 20 and hover >= 0.3 * due, (hover, due, fell)
+    # the body ran past its landing, and the character fell at 3.5 s (the foot more than HOVER_M up on 18 of the 55
+    # ticks its landing was due since the rest's held pose keeps his leg's lengths, sources/held_pose.py)
+    assert fell and due >= 20 and hover >= 0.3 * due, (hover, due, fell)
     hover, due, fell = _hover((100.0, 20.0))
     assert not fell and hover <= 0.1 * due, (hover, due, fell)
 

@@ -1119,8 +1119,9 @@ def test_a_swing_past_its_usual_time_is_landed_before_the_capture_point_runs_out
     raised and then lowered slowly (the held last frame). His usual swing time is past from about 1.27 s, and his
     landing is predicted for now: the capture point is not yet beyond a recovery step's reach from the stance ankle,
     so the swing waited until 1.385 s, with the capture point 0.49 m outside the stance sole, and the run fell in the
-    rest at 2.25 s (measured). Predicted a recovery swing ahead (``recovery_overdue_swing_horizon``), the swing is
-    taken over at 1.323 s, 0.38 m outside, and the run comes to rest."""
+    rest at 2.25 s (measured while the held pose stretched his raised leg; since it keeps its lengths it does not).
+    Predicted a recovery swing ahead (``recovery_overdue_swing_horizon``), the swing is taken over at 1.323 s, 0.38 m
+    outside, and the run comes to rest."""
     spec = f"bvh:{MOCAP / 'cmu-dev' / '09_01.bvh'}"
 
     def run(flag: bool):
@@ -1141,8 +1142,9 @@ def test_a_swing_past_its_usual_time_is_landed_before_the_capture_point_runs_out
             return on_tick
 
         # traced before the joints' no-load speed (with it, the late swing's run also comes to rest), before Eq.
-        # 10's fraction from the rear foot to the front one after the character's own step (with it, too) and before
-        # a recovery step's timing adapted to its reach (with it, too)
+        # 10's fraction from the rear foot to the front one after the character's own step (with it, too), before
+        # a recovery step's timing adapted to its reach (with it, too) and before the held pose kept his leg's
+        # lengths (sources/held_pose.py; with it, too: the fall is no longer asserted)
         control = ControlConfig(whole_body=WholeBodyConfig(joint_speed_limit_rad_s=None,
                                                            recovery_foot_target_rate="differenced",
                                                            press_double_stance_feet=False))
@@ -1155,8 +1157,7 @@ def test_a_swing_past_its_usual_time_is_landed_before_the_capture_point_runs_out
     taken_old, result_old = run(False)
     assert 1.30 <= taken[0][0] <= 1.35 and taken[0][1] < 0.42  # measured: 1.323 s, 0.376 m
     assert taken_old[0][0] >= 1.37 and taken_old[0][1] > 0.45  # measured: 1.385 s, 0.490 m
-    assert not result.fell
-    assert result_old.fell and result_old.fall_time_s < 3.0  # measured: 2.25 s
+    assert not result.fell  # (the late swing fell at 2.25 s while the held pose stretched his raised leg)
 
 
 @pytest.mark.pelvis_joint

@@ -44,8 +44,9 @@ def test_targets_ahead_of_a_runner_stay_within_reach_of_his_stop():
     ahead, fell, fall_s = _run(None)
     # Advanced at his 2.7 m/s (scaled), the targets were 2.1 m ahead of a character started at 1 m/s when he
     # stopped; they came back at 2-3 m/s while the body ran on into his stop at 1.2-1.7 m/s, and it fell 1 s into
-    # the rest after the clip
-    assert fell and ahead > 1.5, (ahead, fell, fall_s)
+    # the rest after the clip (while the rest's held pose stretched his raised leg; since it keeps the leg's lengths,
+    # sources/held_pose.py, the run stands, the targets as far ahead)
+    assert ahead > 1.5, (ahead, fell, fall_s)
     # Bounded, what is left ahead is the anchored targets' own lead (a late contact's held momentum, the path's pull)
     ahead, fell, fall_s = _run(0.3)
     assert not fell and ahead < 1.2, (ahead, fell, fall_s)

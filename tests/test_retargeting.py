@@ -150,10 +150,12 @@ def test_a_recovery_step_that_puts_the_other_foot_ahead_does_not_pull_the_body_b
     # COM over his left (front) foot; its recovery step puts its right foot 0.84 m ahead. By side, Eq. 10 then put
     # the COM target over its left foot, now the rear one: the body was pulled back and sank in the split (4.1 s).
     # Traced before a lift-off waited for the other foot to be down, while one onto a sole the capture point has
-    # passed waited only the weight shift's time, and before the pelvis target came down as his swing went.
+    # passed waited only the weight shift's time, and before the pelvis target came down as his swing went. The fall
+    # by side was traced while the rest's held pose stretched his raised leg (by 0.2 m, his scale 11 % smaller); with
+    # the leg's lengths kept (sources/held_pose.py) the run by side stands too, and the rule itself is held by
+    # test_the_fraction_between_the_feet_needs_them_in_his_order_where_asked above.
     spec = f"bvh:{MOCAP / 'cmu-dev' / '09_11.bvh'}"
     traced = {"liftoff_needs_other_foot_down": False, "liftoff_behind_waits": False,
               "swing_landing_within_reach": False}
     control = TRACED_DIFFERENCED
-    assert suite_run(spec, 0, MotionConfig(fraction_needs_feet_in_his_order=False, **traced), control).fell
     assert not suite_run(spec, 0, MotionConfig(fraction_needs_feet_in_his_order=True, **traced), control).fell
