@@ -80,6 +80,13 @@ class ClipPerformer:
         assert self.clip is not None
         return self.clip.pose_at(t_s).root_pos_world * self.leg_ratio
 
+    def _clip_frame(self, t_s: float, u_s: float) -> OperatorFrame:
+        """His frame at the run's time ``t_s`` [s] in the clip's own pose at its time ``u_s`` [s], the pelvis's path
+        scaled to his legs."""
+        assert self.clip is not None
+        pose = self.clip.pose_at(u_s)
+        return self.human.frame_from_pose(t_s, pose.root_pos_world * self.leg_ratio, pose.local_quats)
+
     def _lowest_feet_phase_s(self) -> tuple[float, float]:
         """The clip time [s] in its first cycle, on its own frames, where the higher of his two ankles is lowest
         above that ankle's lowest in the cycle (a walk's double stance; the first such frame), and that height [m]."""
@@ -87,8 +94,7 @@ class ClipPerformer:
         times = [t for t in self.clip.times if t < self.clip.duration_s] or [0.0]
         heights = []
         for t in times:
-            pose = self.clip.pose_at(t)
-            f = self.human.frame_from_pose(0.0, pose.root_pos_world * self.leg_ratio, pose.local_quats)
+            f = self._clip_frame(0.0, t)
             heights.append((float(f.pos("ANKLE_LEFT")[2]), float(f.pos("ANKLE_RIGHT")[2])))
         z = np.array(heights)
         above = (z - z.min(axis=0)).max(axis=1)
@@ -128,22 +134,21 @@ class ClipPerformer:
 
     def frame_at(self, t_s: float) -> OperatorFrame:
         if self.clip is not None and self.rate_ramp:
-            pose = self.clip.pose_at(self.clip_time_s(t_s))
-            return self.human.frame_from_pose(t_s, pose.root_pos_world * self.leg_ratio, pose.local_quats)
+            return self._clip_frame(t_s, self.clip_time_s(t_s))
         stand_root, stand_quats = self._stand_root, self._stand_quats
         if self.clip is None or t_s < self.lead_in_s - self.blend_s:
             return self.human.frame_from_pose(t_s, stand_root, stand_quats)
         u_s = self.speed * (t_s - self.lead_in_s)  # the clip's time [s]
         if self.start_ramp_s > 0:
             return self.human.frame_from_pose(t_s, *self._ramped(u_s))
-        pose = self.clip.pose_at(max(0.0, u_s))
-        root = pose.root_pos_world * self.leg_ratio
-        if t_s < self.lead_in_s:  # blend from standing into the clip's first pose
-            a = 1.0 - (self.lead_in_s - t_s) / self.blend_s
-            root = (1 - a) * stand_root + a * root
-            quats = {k: rot.slerp(stand_quats.get(k, rot.IDENTITY_WXYZ), q, a) for k, q in pose.local_quats.items()}
-            return self.human.frame_from_pose(t_s, root, quats)
-        return self.human.frame_from_pose(t_s, root, pose.local_quats)
+        if t_s >= self.lead_in_s:
+            return self._clip_frame(t_s, u_s)
+        # blend from standing into the clip's first pose
+        pose = self.clip.pose_at(0.0)
+        a = 1.0 - (self.lead_in_s - t_s) / self.blend_s
+        root = (1 - a) * stand_root + a * (pose.root_pos_world * self.leg_ratio)
+        quats = {k: rot.slerp(stand_quats.get(k, rot.IDENTITY_WXYZ), q, a) for k, q in pose.local_quats.items()}
+        return self.human.frame_from_pose(t_s, root, quats)
 
 
 def sensed(pose_at: Callable[[float], OperatorFrame], operator: OperatorConfig, clocks: ClockConfig,
