@@ -366,11 +366,11 @@ def _add_session_args(p: argparse.ArgumentParser, out_default: str, realtime_hel
     p.add_argument("--follow-path", action="store_true",
                    help="keep closer still to the operator's path over the ground: the targets pulled onto it at "
                         "every speed of his, not only below the character's gait's top speed; its own steps between "
-                        "his make the transition delays longer (README, status)")
+                        "his make the transition delays longer (docs/status-log.md)")
     p.add_argument("--in-place", action="store_true",
                    help="the character's steps planned to stop the body and its targets anchored on its own feet: "
                         "it stays about where it started, trailing an operator who walks off, and a recording "
-                        "starts at rest (README, status)")
+                        "starts at rest (docs/status-log.md)")
     p.add_argument("--free-swing", action="store_true",
                    help="a swing foot follows the operator's while both stand balanced on the other foot, lifted "
                         "only with the weight over that ankle (a kick strikes); by default every swing goes to a "
@@ -378,10 +378,10 @@ def _add_session_args(p: argparse.ArgumentParser, out_default: str, realtime_hel
     p.add_argument("--pelvis-joint", action="store_true",
                    help="his skeleton's pelvis joint as his pelvis and the character's pelvis at his height (the "
                         "settings before 2026-12-06); by default his pelvis is the midpoint of his hip joints and the "
-                        "character's is lowered 7 cm as he goes, for longer steps (README, status)")
+                        "character's is lowered 7 cm as he goes, for longer steps (docs/status-log.md)")
     p.add_argument("--no-track-rise", action="store_true",
                    help="the pelvis height's law damps every vertical speed, a jump's push included (by default it "
-                        "tracks half the operator's rise begun and kept on both feet; README, status)")
+                        "tracks half the operator's rise begun and kept on both feet; docs/status-log.md)")
     p.add_argument("--record", type=typed.out_file, help="session file to write (default: OUT/session.jsonl)")
     p.add_argument("--progress", action="store_true", help="show a progress line (default: when on a terminal)")
     p.add_argument("--continue-after-fall", action="store_true",
