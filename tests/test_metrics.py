@@ -103,6 +103,19 @@ def test_uhc_termination_and_operator_scaling():
     np.testing.assert_allclose(scaled[0, 1], [0.0, 0.0, 0.0])
 
 
+def test_mpjpe_before_the_termination_leaves_out_what_follows_it():
+    ref = _walker()
+    char = ref + np.array([0.12, 0.16, 0.0])  # 20 cm everywhere ...
+    char[250:] += np.array([0.0, 0.0, -0.6])  # ... and 60 cm lower from tick 250 on: the termination there
+    assert im.uhc_fall_index(char, ref) == 250
+    assert im.mpjpe_before_termination_mm(char, ref) == pytest.approx(200.0)
+    assert im.mpjpe_mm(char, ref) > 300.0  # the whole run's counts the 150 ticks after it
+    assert im.mpjpe_before_termination_mm(char, ref, root_relative=True) == pytest.approx(0.0, abs=1e-9)
+    assert im.mpjpe_before_termination_mm(ref + 0.01, ref) == pytest.approx(im.mpjpe_mm(ref + 0.01, ref))
+    first = ref + np.array([0.0, 0.0, 0.7])  # beyond the distance from the first tick: that tick alone
+    assert im.mpjpe_before_termination_mm(first, ref) == pytest.approx(700.0)
+
+
 def test_report_holds_metrics_figures_and_versions(tmp_path):
     from stylesync.metrics.report import write_report
 

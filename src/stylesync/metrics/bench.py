@@ -46,8 +46,9 @@ CONTROLLERS: dict[str, tuple[ControlConfig, MotionConfig]] = {
                  MotionConfig(stance_hip_weight_w0=1.0)),
     "no-compensation": (ControlConfig(lipm_time_sync=False), MotionConfig()),
 }
-COLUMNS = ("fall rate", "time to fall [s]", "MPJPE global [mm]", "MPJPE root-rel. [mm]", "skate [mm]",
-           "jitter [m/s²]", "lag [s]", "realtime factor")
+COLUMNS = ("fall rate", "time to fall [s]", "MPJPE global [mm]", "MPJPE root-rel. [mm]",
+           "MPJPE global / root-rel. before the termination [mm]", "skate [mm]", "jitter [m/s²]", "lag [s]",
+           "realtime factor")
 
 
 def physics_only_rtf(cfg: SessionConfig, sim_s: float) -> float:
@@ -86,7 +87,8 @@ def _run(spec: str, name: str, duration_s: float, seed: int) -> dict:
     fall_t = min(x for x in (m["fall_time_s"], uhc) if x is not None) if (m["fell"] or uhc is not None) else None
     return {"source": spec, "controller": name, "fell": fall_t is not None, "time_to_fall_s": fall_t,
             "sim_duration_s": m["sim_duration_s"], "mpjpe_global_mm": m.get("mpjpe_global_mm"),
-            "mpjpe_root_mm": m.get("mpjpe_root_mm"), "foot_skate_mm": m.get("foot_skate_mm"),
+            "mpjpe_root_mm": m.get("mpjpe_root_mm"), "mpjpe_global_before_uhc_mm": m.get("mpjpe_global_before_uhc_mm"),
+            "mpjpe_root_before_uhc_mm": m.get("mpjpe_root_before_uhc_mm"), "foot_skate_mm": m.get("foot_skate_mm"),
             "jitter_mps2": m.get("jitter_mps2"), "sync_lag_s": m.get("sync_lag_s"),
             "realtime_factor": m["realtime_factor"]}
 
@@ -105,7 +107,8 @@ def aggregate(rows: list[dict]) -> dict[str, dict]:
         fell = [r for r in rs if r["fell"]]
         out[name] = {"runs": len(rs), "fall_rate": len(fell) / len(rs),
                      "time_to_fall_s": _mean(fell, "time_to_fall_s"),
-                     **{k: _mean(rs, k) for k in ("mpjpe_global_mm", "mpjpe_root_mm", "foot_skate_mm", "jitter_mps2",
+                     **{k: _mean(rs, k) for k in ("mpjpe_global_mm", "mpjpe_root_mm", "mpjpe_global_before_uhc_mm",
+                                                  "mpjpe_root_before_uhc_mm", "foot_skate_mm", "jitter_mps2",
                                                   "sync_lag_s", "realtime_factor")}}
     return out
 
@@ -118,9 +121,10 @@ def markdown_table(agg: dict[str, dict], physics_rtf: float, header: str) -> str
     for name, a in agg.items():
         lines.append(f"| {name} | {a['fall_rate']:.0%} ({a['runs']} runs) | {f(a['time_to_fall_s'], '.2f')} | "
                      f"{f(a['mpjpe_global_mm'], '.0f')} | {f(a['mpjpe_root_mm'], '.0f')} | "
+                     f"{f(a['mpjpe_global_before_uhc_mm'], '.0f')} / {f(a['mpjpe_root_before_uhc_mm'], '.0f')} | "
                      f"{f(a['foot_skate_mm'], '.2f')} | {f(a['jitter_mps2'], '.1f')} | {f(a['sync_lag_s'], '.3f')} | "
                      f"{f(a['realtime_factor'], '.2f')}x |")
-    lines.append(f"| physics alone (ceiling) | | | | | | | | {physics_rtf:.2f}x |")
+    lines.append(f"| physics alone (ceiling) | | | | | | | | | {physics_rtf:.2f}x |")
     return "\n".join(lines)
 
 

@@ -111,8 +111,9 @@ def run_clip(spec: str, seed: int, duration_s: float, controller: str,
     result = run_and_release(cfg, opened.source)
     m = summarize(result)
     keys = ("fell", "fall_time_s", "sim_duration_s", "operator_steps", "character_steps",
-            "state_transition_delay_s", "mpjpe_global_mm", "mpjpe_root_mm", "uhc_fall_time_s", "path_progress",
-            "realtime_factor", "fall_reason", "step_width_m")
+            "state_transition_delay_s", "mpjpe_global_mm", "mpjpe_root_mm", "mpjpe_global_before_uhc_mm",
+            "mpjpe_root_before_uhc_mm", "uhc_fall_time_s", "path_progress", "realtime_factor", "fall_reason",
+            "step_width_m")
     return {"clip_end_s": clip_end, **{k: m.get(k) for k in keys}}
 
 
@@ -170,10 +171,18 @@ def category_row(cat: str, version: str, rs: list[dict]) -> str:
              _mean(falls, ".2f"), fall_endings(ok),
              _mean([r["mpjpe_global_mm"] for r in ok if r.get("mpjpe_global_mm") is not None], ".0f"),
              _mean([r["mpjpe_root_mm"] for r in ok if r.get("mpjpe_root_mm") is not None], ".0f"),
+             _before_termination(ok),
              f"{sum(r['character_steps'] for r in ok)}/{sum(r['operator_steps'] for r in ok)}",
              _median([r["path_progress"] for r in ok if r.get("path_progress") is not None], ".2f"),
              f"{np.median(delays):.3f}" if delays else "-", _step_widths(ok)]
     return "| " + " | ".join(cells) + " |"
+
+
+def _before_termination(rs: list[dict]) -> str:
+    """"global / root-relative": the means over runs of the MPJPE before the UHC termination
+    (imitation.mpjpe_before_termination_mm) [mm], "-" where no run has it (a version before it was kept)."""
+    return " / ".join(_mean([r[k] for r in rs if r.get(k) is not None], ".0f")
+                      for k in ("mpjpe_global_before_uhc_mm", "mpjpe_root_before_uhc_mm"))
 
 
 def _step_widths(rs: list[dict]) -> str:
@@ -189,9 +198,9 @@ def table(rows: list[dict], versions: list[str]) -> str:
     """The per-category Markdown table, one row per category and version (controller or code version)."""
     lines = ["| category | version | runs | opened | complete (no fall) | through the clip (no fall before its end) | "
              "no UHC termination | mean fall time [s] | falls: pelvis low / other link down / diverged | "
-             "MPJPE global [mm] | MPJPE root-rel. [mm] | steps char/op | "
-             "along his path, median | max delay median [s] | step width char / op, median [m] |",
-             "|" + "---|" * 15]
+             "MPJPE global [mm] | MPJPE root-rel. [mm] | MPJPE global / root-rel. before the termination [mm] | "
+             "steps char/op | along his path, median | max delay median [s] | step width char / op, median [m] |",
+             "|" + "---|" * 16]
     for cat in ORDER:
         for v in versions:
             rs = [r for r in rows if r["category"] == cat and r["version"] == v]

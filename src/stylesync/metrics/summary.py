@@ -96,6 +96,8 @@ def imitation_metrics(result: SessionResult) -> dict:
     return {
         "mpjpe_global_mm": round(im.mpjpe_mm(ch, ref), 1),
         "mpjpe_root_mm": round(im.mpjpe_mm(ch, ref, root_relative=True), 1),
+        "mpjpe_global_before_uhc_mm": round(im.mpjpe_before_termination_mm(ch, ref), 1),
+        "mpjpe_root_before_uhc_mm": round(im.mpjpe_before_termination_mm(ch, ref, root_relative=True), 1),
         "uhc_fall_time_s": None if uhc is None else float(t[uhc]),
         "path_progress": None if progress is None else round(progress, 3),
         "path_sideways_m": None if sideways is None else round(sideways, 3),
