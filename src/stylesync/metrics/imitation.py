@@ -59,8 +59,9 @@ def uhc_fall_index(char_pos: np.ndarray, ref_pos: np.ndarray, limit_m: float = U
 def mpjpe_before_termination_mm(char_pos: np.ndarray, ref_pos: np.ndarray, root_relative: bool = False,
                                 limit_m: float = UHC_FALL_DISTANCE_M) -> float:
     """:func:`mpjpe_mm` over the ticks before the UHC/PHC termination (:func:`uhc_fall_index`; every tick without
-    one, at least the first): the field's runs end there, so a character that goes on after it is not charged for
-    where it went since, nor one that fell early credited with a short run [mm]."""
+    one, at least the first) [mm]: the field's runs end there. Two controllers are then compared on the ticks each
+    imitates; a character that goes on after its termination is not charged for how far it drifts since (how long
+    each imitates is the termination's time)."""
     end = uhc_fall_index(char_pos, ref_pos, limit_m)
     end = len(char_pos) if end is None else max(end, 1)
     return mpjpe_mm(np.asarray(char_pos)[:end], np.asarray(ref_pos)[:end], root_relative)
