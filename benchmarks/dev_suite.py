@@ -89,7 +89,7 @@ if "mpjpe_global_before_uhc_mm" not in m and len(result.log.array("t")) >= 3:
     ref = (np.array([ch[0, 0, 0], ch[0, 0, 1], 0.0])  # his joints scaled about his first ground point, onto its
            + lg.array("scale")[:, None, None] * (op - np.array([op[0, 0, 0], op[0, 0, 1], 0.0])))
     d = np.linalg.norm(ch - ref, axis=-1)
-    over = np.where(d.mean(axis=1) > 0.5)[0]
+    over = np.where(d.mean(axis=1) > 0.5)[0]  # the UHC/PHC termination distance [m]
     end = max(int(over[0]), 1) if len(over) else len(ch)
     rel = np.linalg.norm((ch - ch[:, :1]) - (ref - ref[:, :1]), axis=-1)
     m["mpjpe_global_before_uhc_mm"] = round(float(d[:end].mean() * 1e3), 1)

@@ -62,9 +62,14 @@ def mpjpe_before_termination_mm(char_pos: np.ndarray, ref_pos: np.ndarray, root_
     one, at least the first) [mm]: the field's runs end there. Two controllers are then compared on the ticks each
     imitates; a character that goes on after its termination is not charged for how far it drifts since (how long
     each imitates is the termination's time)."""
-    end = uhc_fall_index(char_pos, ref_pos, limit_m)
-    end = len(char_pos) if end is None else max(end, 1)
+    end = ticks_before_termination(uhc_fall_index(char_pos, ref_pos, limit_m), len(char_pos))
     return mpjpe_mm(np.asarray(char_pos)[:end], np.asarray(ref_pos)[:end], root_relative)
+
+
+def ticks_before_termination(termination_tick: int | None, n_ticks: int) -> int:
+    """How many of a run's ``n_ticks`` come before its UHC/PHC termination at ``termination_tick``
+    (:func:`uhc_fall_index`; None: every tick), at least the first."""
+    return n_ticks if termination_tick is None else max(termination_tick, 1)
 
 
 PATH_MIN_DISTANCE_M = 0.5  # an operator who moves less than this over the ground has no path to follow [m]

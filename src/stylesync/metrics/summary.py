@@ -89,6 +89,7 @@ def imitation_metrics(result: SessionResult) -> dict:
     ch = lg.array("ch_joints")
     ref = im.scale_operator_to_character(lg.array("op_joints"), lg.array("scale"), ch[0, 0])
     uhc = im.uhc_fall_index(ch, ref)
+    imitating = im.ticks_before_termination(uhc, len(t))  # (im.mpjpe_before_termination_mm, its index found once)
     feet = [im.JOINT_PAIRS.index(("left_ankle", "ANKLE_LEFT")), im.JOINT_PAIRS.index(("right_ankle", "ANKLE_RIGHT"))]
     progress, sideways = im.path_progress(ch[:, 0], ref[:, 0])
     rel_ch, rel_ref = ch - ch[:, :1], ref - ref[:, :1]
@@ -96,8 +97,8 @@ def imitation_metrics(result: SessionResult) -> dict:
     return {
         "mpjpe_global_mm": round(im.mpjpe_mm(ch, ref), 1),
         "mpjpe_root_mm": round(im.mpjpe_mm(ch, ref, root_relative=True), 1),
-        "mpjpe_global_before_uhc_mm": round(im.mpjpe_before_termination_mm(ch, ref), 1),
-        "mpjpe_root_before_uhc_mm": round(im.mpjpe_before_termination_mm(ch, ref, root_relative=True), 1),
+        "mpjpe_global_before_uhc_mm": round(im.mpjpe_mm(ch[:imitating], ref[:imitating]), 1),
+        "mpjpe_root_before_uhc_mm": round(im.mpjpe_mm(ch[:imitating], ref[:imitating], root_relative=True), 1),
         "uhc_fall_time_s": None if uhc is None else float(t[uhc]),
         "path_progress": None if progress is None else round(progress, 3),
         "path_sideways_m": None if sideways is None else round(sideways, 3),
