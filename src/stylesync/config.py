@@ -130,6 +130,10 @@ class MotionConfig:
     # Sec. 5.1 leaves the foot-height threshold open: 4 cm on the operator's ankle heights, with hysteresis.
     stance_height_threshold_m: float = 0.04
     stance_hysteresis_m: float = 0.01
+    # ... and a swing ends only once the swing ankle, at his ankle heights' double stance, moves slower than this over
+    # the ground (scaled to the character): his heel rises as his swing foot comes down, and the heights call his
+    # double stance while that foot still travels a fifth of his step at 2-4 m/s (None: the heights alone) [m/s]
+    his_landing_max_speed_mps: float | None = None
     # Late contact (Sec. 5.1): the reference is held until the character's foot touches down, at most this long.
     late_contact_timeout_s: float = 0.4
     # While a late contact holds the reference (Sec. 5.1), the pelvis and COM targets go on over the ground at the
@@ -449,6 +453,9 @@ class MotionConfig:
     # capture point diverges that way; across it the step catches the body on its ankle (recovery_step.WalkOn).
     # False: along the capture point's own divergence, which carries a sideways drift on from step to step.
     recovery_walk_on_his_way: bool = True
+    # ... and only while his COM moves now at least gait_min_way_speed_mps fast as well (the way's average trails a
+    # stop by its time constant: a run's own steps walked on after he stopped)
+    recovery_walk_on_needs_motion_now: bool = False
     # ... and only as far as his way goes forwards: the walk-on times the share of his way along his heading's
     # forward axis (none where he goes sideways or backwards, and the step stops the body). Walked on sideways, a
     # dance's own steps, which cannot cross or lengthen as a forward stride does, ran the body away from its feet
@@ -553,6 +560,8 @@ class MotionConfig:
         if not lo <= hi:
             raise ConfigError(f"MotionConfig.step_outside_capture_point_m must be (min, max), got {(lo, hi)}")
         _non_negative("MotionConfig.step_behind_capture_point_m", self.step_behind_capture_point_m)
+        if self.his_landing_max_speed_mps is not None:
+            _positive("MotionConfig.his_landing_max_speed_mps", self.his_landing_max_speed_mps)
         if (self.step_behind_capture_point_max_m is not None
                 and self.step_behind_capture_point_max_m < self.step_behind_capture_point_m):
             raise ConfigError(f"MotionConfig.step_behind_capture_point_max_m ({self.step_behind_capture_point_max_m}) "

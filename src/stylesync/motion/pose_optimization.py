@@ -296,6 +296,7 @@ class MotionOptimizer:
         self._com_d_rate = _SmoothedRate(self.dt_s)  # desired COM velocity [m/s]
         self._com_h_rate = _SmoothedRate(self.dt_s)  # operator COM velocity [m/s]
         self._pelvis_h_rate = _SmoothedRate(self.dt_s)  # operator pelvis velocity [m/s]
+        self._ankle_h_rate = {side: _SmoothedRate(self.dt_s) for side in _SIDE_UP}  # operator ankle velocities [m/s]
         self._his_rise = HisRise() if cfg.rise_begun_on_both_feet else None  # his_rise.py
         self.way = OperatorWay(cfg.operator_way_time_s, self.dt_s)  # his way over the ground (operator_way.py)
         # His way in his own heading frame (x forwards; its velocity_world holds heading-frame axes), kept up when
@@ -494,7 +495,15 @@ class MotionOptimizer:
                       analysis: OperatorAnalysis, mass: MassProperties) -> _Tick:
         """Both stance FSMs, the operator's swing time, and the sample the reference follows (held while the
         character waits for a late contact)."""
-        op_state = self.op_fsm.update(sample.pos["ANKLE_LEFT"][2], sample.pos["ANKLE_RIGHT"][2])
+        swing_moving = False
+        landing_mps = self.cfg.his_landing_max_speed_mps
+        if landing_mps is not None:
+            rates = {side: self._ankle_h_rate[side](sample.pos[f"ANKLE_{up}"]) for side, up in _SIDE_UP.items()}
+            sw = swing_side(self.op_fsm.state)
+            if sw is not None and self._op_leg_m:
+                scale = CHAR_LEG_LENGTH_M / self._op_leg_m
+                swing_moving = scale * float(np.hypot(rates[sw][0], rates[sw][1])) > landing_mps
+        op_state = self.op_fsm.update(sample.pos["ANKLE_LEFT"][2], sample.pos["ANKLE_RIGHT"][2], swing_moving)
         # His raised foot read as bearing weight (its side, for the band; none once his ankle heights say DS)
         bears = op_state is not Stance.DS and self._rear_foot_bears_weight(sample, analysis, op_state)
         self._rear_foot_bearing = swing_side(op_state) if bears else None
@@ -893,8 +902,9 @@ class MotionOptimizer:
         MotionConfig.recovery_walk_on_m None; along his way over the ground (operator_way.py, or his heading while
         the average is zero) with recovery_walk_on_his_way."""
         distance_m = self.cfg.recovery_walk_on_m
+        now = tick.scale * tick.com_vel_h if self.cfg.recovery_walk_on_needs_motion_now else None
         if (distance_m is None or self._operator_stands(tick)
-                or not self.way.goes(self.cfg.gait_min_way_speed_mps)):
+                or not self.way.goes(self.cfg.gait_min_way_speed_mps, now)):
             return None
         if not self.cfg.recovery_walk_on_his_way:
             return WalkOn(distance_m)

@@ -45,7 +45,8 @@ class OperatorStanceFsm:
         self.hysteresis_m = hysteresis_m
         self.state = Stance.DS
 
-    def update(self, ankle_left_z: float, ankle_right_z: float) -> Stance:
+    def update(self, ankle_left_z: float, ankle_right_z: float, swing_moving: bool = False) -> Stance:
+        """``swing_moving``: the swing foot still travels over the ground (a single stance does not end then)."""
         diff = ankle_left_z - ankle_right_z  # > 0: left foot higher
         if self.state is Stance.DS:
             leave = self.threshold_m + self.hysteresis_m
@@ -55,7 +56,8 @@ class OperatorStanceFsm:
                 self.state = Stance.LS
         else:
             if abs(diff) < self.threshold_m - self.hysteresis_m:
-                self.state = Stance.DS
+                if not swing_moving:
+                    self.state = Stance.DS
             elif diff > self.threshold_m + self.hysteresis_m:
                 self.state = Stance.RS
             elif diff < -(self.threshold_m + self.hysteresis_m):
