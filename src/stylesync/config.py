@@ -132,7 +132,7 @@ class MotionConfig:
     stance_hysteresis_m: float = 0.01
     # ... and a swing ends only once the swing ankle, at his ankle heights' double stance, moves slower than this over
     # the ground (scaled to the character): his heel rises as his swing foot comes down, and the heights call his
-    # double stance while that foot still travels a fifth of his step at 2-4 m/s (None: the heights alone) [m/s]
+    # double stance while that foot still travels 0.1-0.3 m at 2-4 m/s (None: the heights alone) [m/s]
     his_landing_max_speed_mps: float | None = None
     # Late contact (Sec. 5.1): the reference is held until the character's foot touches down, at most this long.
     late_contact_timeout_s: float = 0.4
