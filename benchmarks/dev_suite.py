@@ -82,18 +82,16 @@ if "step_width_m" not in m:  # a version before metrics/imitation.step_widths_m:
     m["step_width_m"] = {"character": width(ch[..., :2], lg.array("char_state")),
                          "operator": width(op, lg.array("op_state"))}
 if "mpjpe_global_before_uhc_mm" not in m and len(result.log.array("t")) >= 3:
-    # a version before metrics/imitation.mpjpe_before_termination_mm: the same definition, here
-    import numpy as np
+    # a version before metrics/imitation.mpjpe_before_termination_mm: the same definition on that version's own
+    # scaling, termination and MPJPE (metrics/imitation.py has had all three since its first version)
+    from stylesync.metrics import imitation as im
     lg = result.log
-    ch, op = lg.array("ch_joints"), lg.array("op_joints")
-    ref = (np.array([ch[0, 0, 0], ch[0, 0, 1], 0.0])  # his joints scaled about his first ground point, onto its
-           + lg.array("scale")[:, None, None] * (op - np.array([op[0, 0, 0], op[0, 0, 1], 0.0])))
-    d = np.linalg.norm(ch - ref, axis=-1)
-    over = np.where(d.mean(axis=1) > 0.5)[0]  # the UHC/PHC termination distance [m]
-    end = max(int(over[0]), 1) if len(over) else len(ch)
-    rel = np.linalg.norm((ch - ch[:, :1]) - (ref - ref[:, :1]), axis=-1)
-    m["mpjpe_global_before_uhc_mm"] = round(float(d[:end].mean() * 1e3), 1)
-    m["mpjpe_root_before_uhc_mm"] = round(float(rel[:end].mean() * 1e3), 1)
+    ch = lg.array("ch_joints")
+    ref = im.scale_operator_to_character(lg.array("op_joints"), lg.array("scale"), ch[0, 0])
+    uhc = im.uhc_fall_index(ch, ref)
+    end = len(ch) if uhc is None else max(uhc, 1)
+    m["mpjpe_global_before_uhc_mm"] = round(im.mpjpe_mm(ch[:end], ref[:end]), 1)
+    m["mpjpe_root_before_uhc_mm"] = round(im.mpjpe_mm(ch[:end], ref[:end], root_relative=True), 1)
 keys = ("fell", "fall_time_s", "sim_duration_s", "operator_steps", "character_steps", "state_transition_delay_s",
         "mpjpe_global_mm", "mpjpe_root_mm", "mpjpe_global_before_uhc_mm", "mpjpe_root_before_uhc_mm",
         "uhc_fall_time_s", "path_progress", "realtime_factor", "fall_reason", "step_width_m")

@@ -1,8 +1,9 @@
 """Motion states and state transitions (Sec. 5.1, Fig. 6): LS, RS and DS.
 
 Operator side: DS while the height difference of the two ankles is within a threshold (with hysteresis);
-otherwise the lower foot is the stance foot. Character side: follows the operator, with the contact-driven
-transitions of Sec. 5.1:
+otherwise the lower foot is the stance foot. Optionally (MotionConfig.his_landing_max_speed_mps) a single stance
+ends only once the swing foot has also stopped travelling over the ground. Character side: follows the operator,
+with the contact-driven transitions of Sec. 5.1:
 * early contact: the swing foot touches down before the operator's state changes -> DS at once (held until the
   operator's state changes, so that it does not flip back);
 * late contact: the operator is back in DS but the character's swing foot is still in the air -> the reference
