@@ -176,6 +176,7 @@ class OperatorPrefetch:
         child.close()
         self._rows = np.zeros((0, ROW_WIDTH))
         self._next = 0
+        self.last_row = np.zeros(ROW_WIDTH)  # the row of the last tick (motion_ahead.py forwards it)
         self._rejected = int(getattr(source, "rejected_frames", 0))
         self._dropped = processing.dropped_joint_values
 
@@ -193,7 +194,7 @@ class OperatorPrefetch:
     def tick(self, time_s: float) -> tuple[OperatorSample, OperatorAnalysis | None]:
         if self._next == len(self._rows):
             self._receive()
-        row = self._rows[self._next]
+        row = self.last_row = self._rows[self._next]
         self._next += 1
         sample, analysis, self._rejected, self._dropped = unpack(row)
         if sample.time_s != time_s:

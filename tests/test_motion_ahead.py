@@ -1,0 +1,129 @@
+"""The motion stage one tick ahead of the controller (motion_ahead.py): in a forked worker it gives exactly what it
+gives in line, the rows carry every field, and the worker's errors and death reach the session."""
+
+import multiprocessing
+import threading
+
+import numpy as np
+import pytest
+
+from stylesync.config import SessionConfig
+from stylesync.errors import StylesyncError
+from stylesync.motion.pose_optimization import MotionOptimizer
+from stylesync.motion_ahead import pack_reference, pack_state, unpack_reference, unpack_state
+from stylesync.session import Session
+from stylesync.sources.builtin_operator import builtin_operator
+
+
+def _session(duration_s: float, ahead: bool, on_tick=None) -> Session:
+    cfg = SessionConfig(duration_s=duration_s, seed=1)
+    source, _ = builtin_operator(cfg.operator, cfg.clocks, duration_s + 1.0, cfg.seed)
+    session = Session(cfg, source, on_tick=on_tick)
+    session.motion_ahead = ahead
+    return session
+
+
+def _assert_same(a, b, where: str) -> None:
+    """Dataclass values field by field: arrays bit for bit, dicts with their keys in the same order."""
+    for name, va in vars(a).items():
+        vb = getattr(b, name)
+        if isinstance(va, dict):
+            assert list(va) == list(vb), (where, name)
+            for k in va:
+                assert np.array_equal(va[k], vb[k]), (where, name, k)
+        elif isinstance(va, np.ndarray):
+            assert va.dtype == vb.dtype and np.array_equal(va, vb), (where, name)
+        elif hasattr(va, "__dataclass_fields__"):
+            _assert_same(va, vb, f"{where}.{name}")
+        else:
+            assert va == vb and type(va) is type(vb), (where, name, va, vb)
+
+
+def test_rows_restore_the_state_and_the_reference_exactly():
+    seen = []
+    session = _session(4.0, ahead=False)
+    session.on_tick = lambda state, ref: seen.append((state, ref, session.motion.reading,
+                                                      session.bounds.counts["step_length"]))
+    session.run()
+    kinds = set()
+    for state, ref, reading, count in seen[::7]:
+        _assert_same(unpack_state(pack_state(state)), state, "state")
+        back, back_reading, back_count = unpack_reference(pack_reference(ref, reading, count))
+        _assert_same(back, ref, "reference")
+        assert back_reading.operator_stance is reading.operator_stance and back_reading.held == reading.held
+        assert back_reading.operator_features.as_row() == reading.operator_features.as_row()
+        assert back_count == count
+        kinds.add((ref.lipm is None, ref.recovery_ankle_world is None, ref.character_stance))
+    # the walk's ticks include single stances with the LIPM map, double stances without, and steps of its own
+    assert {k[0] for k in kinds} == {True, False} and {k[1] for k in kinds} == {True, False}
+
+
+def test_a_run_with_the_motion_stage_ahead_is_the_same_simulation_as_in_line():
+    assert threading.active_count() == 1, f"threads left running: {threading.enumerate()}"
+    ahead, inline = _session(3.0, ahead=True).run(), _session(3.0, ahead=False).run()
+    assert ahead.operator_prefetched
+    assert set(ahead.log.columns) == set(inline.log.columns)
+    for key in ahead.log.columns:
+        if key != "tick_ms":  # (wall time)
+            assert np.array_equal(ahead.log.array(key), inline.log.array(key)), key
+    assert ahead.bound_counts == inline.bound_counts
+    assert not multiprocessing.active_children()  # both workers ended with the run
+
+
+def test_the_controller_tracks_the_last_ticks_answer():
+    refs, times = [], []
+    _session(0.3, ahead=False, on_tick=lambda state, ref: (refs.append(ref), times.append(state.time_s))).run()
+    assert refs[0] is refs[1]  # the first tick's answer serves the first two ticks
+    assert [r.time_s for r in refs[2:]] == times[1:-1]  # then each tick the answer to the tick before
+
+
+def test_an_error_of_the_motion_stage_reaches_the_session_and_leaves_no_process(monkeypatch):
+    update = MotionOptimizer.update
+    calls = []
+
+    def failing(self, *args, **kwargs):
+        calls.append(1)
+        if len(calls) > 40:
+            raise StylesyncError("the motion stage broke at its 41st tick")
+        return update(self, *args, **kwargs)
+
+    monkeypatch.setattr(MotionOptimizer, "update", failing)  # (the worker is forked with it)
+    with pytest.raises(StylesyncError, match="broke at its 41st tick"):
+        _session(2.0, ahead=True).run()
+    assert not multiprocessing.active_children()
+
+
+def test_a_motion_worker_that_dies_is_reported(monkeypatch):
+    import os
+
+    update = MotionOptimizer.update
+    calls = []
+
+    def dying(self, *args, **kwargs):
+        calls.append(1)
+        if len(calls) > 40:
+            os._exit(3)
+        return update(self, *args, **kwargs)
+
+    monkeypatch.setattr(MotionOptimizer, "update", dying)
+    with pytest.raises(StylesyncError, match="motion-stage process ended unexpectedly"):
+        _session(2.0, ahead=True).run()
+    assert not multiprocessing.active_children()
+
+
+def test_a_session_file_is_the_same_with_the_motion_stage_ahead(tmp_path):
+    from stylesync.export.session_file import SessionRecorder, read_session
+
+    lines = {}
+    for ahead in (True, False):
+        session = _session(3.0, ahead=ahead)
+        path = tmp_path / f"{ahead}.jsonl"
+        recorder = SessionRecorder(path, session.cfg, session, deferred=ahead)
+        session.on_tick = recorder.tick
+        session.run()
+        recorder.close()
+        lines[ahead] = path.read_text().splitlines()
+    assert lines[True] == lines[False]
+    ticks = read_session(tmp_path / "True.jsonl").ticks
+    assert len(ticks) == len(lines[True]) - 1  # every tick's line, its operator reading included
+    assert {t["operator_stance"] for t in ticks} >= {"DS", "LS", "RS"}
