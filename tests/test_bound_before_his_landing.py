@@ -23,7 +23,7 @@ def _followed_walk(bounded: bool) -> tuple[float, int, float, bool]:
 
     def watch(session):
         def on_tick(state, ref) -> None:
-            reading = session.motion.reading
+            reading = session.reading
             if ref.character_stance is Stance.DS and reading.operator_stance is not Stance.DS:
                 speeds.append(float(np.hypot(ref.com_vel_world[0], ref.com_vel_world[1])))
 

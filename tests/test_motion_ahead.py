@@ -1,4 +1,4 @@
-"""The motion stage one tick ahead of the controller (motion_ahead.py): in a forked worker it gives exactly what it
+"""The motion stage a tick ahead of the controller (motion_ahead.py): in a forked worker it gives exactly what it
 gives in line, the rows carry every field, and the worker's errors and death reach the session."""
 
 import multiprocessing
@@ -42,7 +42,7 @@ def _assert_same(a, b, where: str) -> None:
 def test_rows_restore_the_state_and_the_reference_exactly():
     seen = []
     session = _session(4.0, ahead=False)
-    session.on_tick = lambda state, ref: seen.append((state, ref, session.motion.reading,
+    session.on_tick = lambda state, ref: seen.append((state, ref, session.reading,
                                                       session.bounds.counts["step_length"]))
     session.run()
     kinds = set()
@@ -70,11 +70,15 @@ def test_a_run_with_the_motion_stage_ahead_is_the_same_simulation_as_in_line():
     assert not multiprocessing.active_children()  # both workers ended with the run
 
 
-def test_the_controller_tracks_the_last_ticks_answer():
-    refs, times = [], []
-    _session(0.3, ahead=False, on_tick=lambda state, ref: (refs.append(ref), times.append(state.time_s))).run()
-    assert refs[0] is refs[1]  # the first tick's answer serves the first two ticks
-    assert [r.time_s for r in refs[2:]] == times[1:-1]  # then each tick the answer to the tick before
+def test_the_motion_stage_reads_the_last_ticks_state_and_this_ticks_operator():
+    refs, times, samples = [], [], []
+    session = _session(0.3, ahead=False)
+    session.on_tick = lambda state, ref: (refs.append(ref), times.append(state.time_s),
+                                          samples.append(session.last_sample.time_s))
+    session.run()
+    assert refs[0].time_s == times[0]  # the first tick's own state
+    assert [r.time_s for r in refs[1:]] == times[:-1]  # then the state of the tick before
+    assert samples == times  # and the operator's sample of the tick itself
 
 
 def test_an_error_of_the_motion_stage_reaches_the_session_and_leaves_no_process(monkeypatch):

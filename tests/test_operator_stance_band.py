@@ -29,7 +29,7 @@ def _his_stances(hysteresis_m: float, t0_s: float, t1_s: float) -> list[Stance]:
 
     def on_tick(state, ref):
         if t0_s <= state.time_s <= t1_s:
-            stances.append(session.motion.reading.operator_stance)
+            stances.append(session.reading.operator_stance)
 
     session.on_tick = on_tick
     session.run()

@@ -720,7 +720,7 @@ def test_a_rear_foot_on_its_toes_is_read_as_still_standing():
 
         def on_tick(state, ref, stances=stances, session=session):
             if 2.7 <= state.time_s <= 3.0:
-                stances.append(session.motion.reading.operator_stance)
+                stances.append(session.reading.operator_stance)
 
         session.on_tick = on_tick
         result = session.run()

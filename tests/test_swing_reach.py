@@ -26,7 +26,7 @@ def _late_contact_drops(within_reach: bool) -> tuple[np.ndarray, bool]:
 
     def tick(state, ref):
         z.append(float(ref.pelvis_world[2]))
-        held.append(session.motion.reading.held)
+        held.append(session.reading.held)
 
     session.on_tick = tick
     result = session.run()

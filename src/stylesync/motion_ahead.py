@@ -1,25 +1,21 @@
-"""The motion stage one control tick ahead of the controller, in a second process (offline runs).
+"""The motion stage a control tick ahead of the controller, in a second process (offline runs).
 
 The pipeline's stages run in a chain at every control tick: the motion optimisation reads the operator's sample and
 the character's state and hands its reference to the controller, which turns it into torques for the physics steps
-up to the next tick. Here the chain is pipelined by one tick, as a real-time controller pipelines its stages: the
-reference the controller tracks at tick k is the motion stage's answer to tick k-1's operator sample and state
-(at the first tick, to the first tick's own). Every run does this (session.py), so the simulation is the same
-whichever process computes the motion stage:
+up to the next tick. Here the motion stage reads the character's state of the last control tick (at the first, the
+first tick's own), 7.5 ms old at 133 Hz, as a state estimator a tick behind would give it; the operator's sample is
+the tick's own. Every run does this (session.py), so the simulation is the same whichever process computes it:
 
-- in line (``MotionInline``): the motion stage runs in this process after the controller's update of its tick;
+- in line (``MotionInline``): the motion stage runs in this process before the controller's update;
 - ahead (``MotionAhead``): a forked worker holds the motion stage (its copy of the session's, made when the run
-  starts) and computes tick k's reference while this process runs tick k's controller and physics; this process
-  sends it the tick's operator row and the character's state and receives the reference at the next tick. Used
-  with the operator side prefetched (prefetch.py), under the same conditions, whose rows it forwards.
+  starts) and computes the next tick's reference, from the next tick's operator row and this tick's state, while
+  this process runs this tick's controller and physics. Used with the operator side prefetched (prefetch.py),
+  under the same conditions: its rows are known a tick ahead.
 
 Values cross the pipe as float64 rows, packed and unpacked by field (pickling them would cost more than a third of
 the motion stage). The worker's arrays are laid out as the engine's reading lays them out (the link table's columns
 as views of one array), so that every computation on them is the same to the last bit; a test runs both ways and
 compares the tick logs.
-
-The operator's reading of a tick (his stance, style features) is known once the motion stage has run on it: the run's
-log records it against its own tick, the character's stance against the tick it is tracked at.
 """
 
 from __future__ import annotations
@@ -205,36 +201,23 @@ def unpack_reference(row: np.ndarray) -> tuple[ReferencePose, MotionReading, int
 
 
 class MotionInline:
-    """The motion stage in this process, one tick ahead of the controller (see the module's notes)."""
+    """The motion stage in this process, on the last tick's state (see the module's notes)."""
 
     def __init__(self, motion: MotionOptimizer, mass: MassProperties):
         self.motion = motion
         self.mass = mass
-        self._latest: tuple[ReferencePose, MotionReading] | None = None
+        self._last_state: CharacterState | None = None
 
     def reference(self, sample: OperatorSample, analysis: OperatorAnalysis | None,
-                  state: CharacterState) -> tuple[ReferencePose, MotionReading | None]:
-        """The reference the controller tracks at this tick (the motion stage's answer to the last tick's inputs;
-        at the first tick, to this tick's) and, when the first tick's, that tick's reading; else None: this tick's
-        reading comes from :meth:`after_control`."""
-        if self._latest is None:
-            self._latest = (self.motion.update(sample, state, self.mass, analysis), self._reading())
-            return self._latest[0], self._latest[1]
-        return self._latest[0], None
-
-    def after_control(self, sample: OperatorSample, analysis: OperatorAnalysis | None, state: CharacterState,
-                      first: bool) -> MotionReading | None:
-        """After the controller's update of a tick: the motion stage on this tick's inputs, for the next tick. Returns
-        this tick's reading (None at the first tick, whose reading :meth:`reference` gave)."""
-        if first:
-            return None
-        self._latest = (self.motion.update(sample, state, self.mass, analysis), self._reading())
-        return self._latest[1]
-
-    def _reading(self) -> MotionReading:
+                  state: CharacterState) -> tuple[ReferencePose, MotionReading]:
+        """This tick's reference and the operator's reading, from this tick's sample and the last tick's state
+        (at the first tick, this tick's)."""
+        basis = state if self._last_state is None else self._last_state
+        self._last_state = state
+        ref = self.motion.update(sample, basis, self.mass, analysis)
         reading = self.motion.reading
         assert reading is not None  # the motion stage has run
-        return reading
+        return ref, reading
 
     def close(self) -> None:
         """Nothing to release."""
@@ -250,8 +233,7 @@ def _worker(conn: Connection, session_end: Connection, motion: MotionOptimizer, 
         while True:
             message = conn.recv_bytes()  # b"bounds", or a state row and an operator row
             if message == b"bounds":
-                conn.send_bytes(b"B" + pickle.dumps((motion.bounds.counts[STEP_BOUND],
-                                                      motion.bounds.first.get(STEP_BOUND))))
+                conn.send_bytes(b"B" + pickle.dumps(motion.bounds.first.get(STEP_BOUND)))
                 continue
             row = np.frombuffer(message)
             try:
@@ -272,8 +254,8 @@ def _worker(conn: Connection, session_end: Connection, motion: MotionOptimizer, 
 
 
 class MotionAhead:
-    """The motion stage in a forked worker, one tick ahead of the controller (see the module's notes). Its copy of
-    ``motion`` is made now; the session's own is not advanced."""
+    """The motion stage in a forked worker, a tick ahead of the controller (see the module's notes). Its copy of
+    ``motion`` is made now; the session's own is not advanced. ``bounds`` gets the step-length bound's record."""
 
     def __init__(self, motion: MotionOptimizer, mass: MassProperties, bounds: BoundsMonitor):
         ctx = multiprocessing.get_context("fork")
@@ -290,28 +272,26 @@ class MotionAhead:
                 signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM})
         child.close()
         self._bounds = bounds
-        self._latest: ReferencePose | None = None
         self._pending = False
+        self._first = True
 
-    def reference(self, operator_row: np.ndarray,
-                  state: CharacterState) -> tuple[ReferencePose, MotionReading | None, MotionReading | None]:
-        """Send this tick's inputs; return the reference the controller tracks at this tick, the last tick's reading
-        when it has just come (None at the first two ticks) and, at the first tick, this tick's reading."""
-        last_reading = self._receive() if self._pending else None
+    def reference(self, operator_row: np.ndarray, next_operator_row: np.ndarray | None,
+                  state: CharacterState) -> tuple[ReferencePose, MotionReading]:
+        """This tick's reference and the operator's reading (computed during the last tick; at the first, now), and
+        the next tick's asked for from ``next_operator_row`` (None: this is the last) and this tick's state."""
+        if self._first:
+            self._first = False
+            self._send(operator_row, state)
+        ref, reading = self._receive()
+        if next_operator_row is not None:
+            self._send(next_operator_row, state)
+        return ref, reading
+
+    def _send(self, operator_row: np.ndarray, state: CharacterState) -> None:
         self._conn.send_bytes(np.concatenate([pack_state(state), operator_row]).tobytes())
         self._pending = True
-        first_reading = None
-        if self._latest is None:
-            first_reading = self._receive()
-        assert self._latest is not None
-        return self._latest, last_reading, first_reading
 
-    def finish(self) -> MotionReading:
-        """The reading of the last tick sent, once the run has ended."""
-        assert self._pending  # (a tick's record waits for it)
-        return self._receive()
-
-    def _receive(self) -> MotionReading:
+    def _receive(self) -> tuple[ReferencePose, MotionReading]:
         try:
             message = self._conn.recv_bytes()
         except (EOFError, OSError):
@@ -320,20 +300,22 @@ class MotionAhead:
         if message[:1] == b"E":
             raise pickle.loads(message[1:])
         ref, reading, count = unpack_reference(np.frombuffer(message, offset=1).copy())
-        self._latest = ref
         self._bounds.active[STEP_BOUND] = reading.step_bound_exceeded
         self._bounds.counts[STEP_BOUND] = count
-        return reading
+        return ref, reading
 
     def close(self) -> None:
-        """Take the worker's record of the step-length bound (its first excess), end it and release the pipe."""
+        """Take the worker's first excess of the step-length bound (when the ticks used exceeded it), end the
+        worker and release the pipe. A reference asked for and not used (the run ended first) is dropped."""
         try:
-            if self._proc.is_alive() and not self._pending:
+            if self._proc.is_alive():
+                if self._pending:
+                    self._conn.recv_bytes()
+                    self._pending = False
                 self._conn.send_bytes(b"bounds")
                 message = self._conn.recv_bytes()
-                if message[:1] == b"B":
-                    count, first = pickle.loads(message[1:])
-                    self._bounds.counts[STEP_BOUND] = count
+                if message[:1] == b"B" and self._bounds.counts[STEP_BOUND] > 0:
+                    first = pickle.loads(message[1:])
                     if first is not None:
                         self._bounds.first.setdefault(STEP_BOUND, first)
         except (EOFError, OSError):

@@ -177,6 +177,7 @@ class OperatorPrefetch:
         self._rows = np.zeros((0, ROW_WIDTH))
         self._next = 0
         self.last_row = np.zeros(ROW_WIDTH)  # the row of the last tick (motion_ahead.py forwards it)
+        self._remaining = len(tick_times_s)
         self._rejected = int(getattr(source, "rejected_frames", 0))
         self._dropped = processing.dropped_joint_values
 
@@ -196,10 +197,20 @@ class OperatorPrefetch:
             self._receive()
         row = self.last_row = self._rows[self._next]
         self._next += 1
+        self._remaining -= 1
         sample, analysis, self._rejected, self._dropped = unpack(row)
         if sample.time_s != time_s:
             raise RuntimeError(f"operator prefetch out of step: sample for t={sample.time_s} at t={time_s}")
         return sample, analysis
+
+    def next_row(self) -> np.ndarray | None:
+        """The row of the control tick after the last one ticked, without moving on to it (motion_ahead.py runs the
+        motion stage on it a tick ahead); None after the last tick."""
+        if self._remaining == 0:
+            return None
+        if self._next == len(self._rows):
+            self._receive()
+        return self._rows[self._next]
 
     def _receive(self) -> None:
         try:

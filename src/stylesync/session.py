@@ -120,9 +120,6 @@ class _RunState:
 
     render_every_s: float | None
     log: TickLog = field(default_factory=TickLog)
-    # A tick's record waiting for the operator's reading of that tick (motion_ahead.py: the worker's answer comes
-    # at the next tick): its values, and the control tick's time [ms]
-    waiting: tuple[dict, float] | None = None
     stage_ms: dict[str, list[float]] = field(default_factory=lambda: {
         "processing": [], "motion": [], "control_update": [], "torques": [], "physics": []})
     latency_ms: list[float] = field(default_factory=list)
@@ -167,13 +164,12 @@ class Session:
                 config.control, self.model, self.mass, config.world.gravity_mps2, 1.0 / config.clocks.physics_hz,
                 1.0 / config.clocks.control_hz, self.bounds, config.world.friction)
         self.on_tick = on_tick
-        # Called with each control tick's operator reading (his stance, style features, the scale), in tick order,
-        # after that tick's on_tick: with the motion stage ahead, at the next tick (motion_ahead.py)
-        self.on_reading: Callable[[MotionReading], None] | None = None
         self.renders: list[tuple[float, np.ndarray]] = []
         self.last_sample: OperatorSample | None = None  # newest processed operator sample (recorders, viewers)
         self.last_torques: np.ndarray | None = None  # (n_joints, 3) torques of the last physics step [N·m]
         self.last_com_world: np.ndarray | None = None  # character COM at the last control tick [m]
+        # The motion stage's reading of the operator at the last control tick (his stance, style features, scale)
+        self.reading: MotionReading | None = None
         # Interactive use (viewers): callables run in the loop's thread at the next control tick, a pause flag
         # honoured there, and whether a fall ends the run (it is recorded either way).
         self.commands: queue.SimpleQueue[Callable[[Session], None]] = queue.SimpleQueue()
@@ -182,7 +178,7 @@ class Session:
         # An offline run of a recorded operator computes the operator side ahead in a second process
         # (prefetch.py; the same results). False keeps it in this process.
         self.prefetch_operator = True
-        # With the operator side prefetched, the motion stage runs in a second forked worker one tick ahead of the
+        # With the operator side prefetched, the motion stage runs in a second forked worker, a tick ahead of the
         # controller (motion_ahead.py; the same simulation as in line). False keeps it in this process.
         self.motion_ahead = True
         # Ctrl-C (or SIGTERM, turned into it by the command line) ends the run as its duration would, with
@@ -305,7 +301,7 @@ class Session:
         operator: OperatorInline | OperatorPrefetch = OperatorInline(self.source, self.processing)
         stage: MotionInline | MotionAhead = MotionInline(self.motion, self.mass)
         if self.prefetch_operator and OperatorPrefetch.usable(self.source, cfg.realtime, cfg.gui):
-            if self.motion_ahead:  # forked first: the operator's worker then holds no end of its pipe
+            if self.motion_ahead:  # forked first: the operator side's worker then holds no end of its pipe
                 stage = MotionAhead(self.motion, self.mass, self.bounds)
             operator = OperatorPrefetch(self.source, self.processing, [k * dt for k in tick_steps])
         self.fell = False
@@ -331,9 +327,6 @@ class Session:
             run.end_reason = "interrupted"  # the run ends here and its outputs are written
             run.log.drop_partial_tick()  # the interrupt may have come while the tick was being recorded
             log.warning("interrupted at t=%.2f s: the run ends there", step * dt)
-        else:
-            if isinstance(stage, MotionAhead) and run.waiting is not None:
-                self._record(run, stage.finish())
         finally:
             operator.close()
             stage.close()
@@ -362,8 +355,8 @@ class Session:
 
     def _control_tick(self, t: float, operator: OperatorInline | OperatorPrefetch, stage: MotionInline | MotionAhead,
                       run: _RunState) -> CharacterState:
-        """Operator side, motion optimisation and the controller's update for the control tick at ``t``. The
-        controller tracks the motion stage's answer to the last tick's operator sample and state (motion_ahead.py)."""
+        """Operator side, motion optimisation and the controller's update for the control tick at ``t``. The motion
+        stage reads the operator's sample of this tick and the character's state of the last (motion_ahead.py)."""
         c0 = time.perf_counter()
         frames = operator.poll(t)
         for f in frames:
@@ -375,26 +368,19 @@ class Session:
         c1 = time.perf_counter()
         state = self.backend.read_state(t)
         if isinstance(stage, MotionAhead):
-            assert isinstance(operator, OperatorPrefetch)  # (MotionAhead runs only with the operator prefetched)
-            ref, last_reading, reading = stage.reference(operator.last_row, state)
-            if last_reading is not None:
-                self._record(run, last_reading)
+            assert isinstance(operator, OperatorPrefetch)  # (the motion stage runs ahead only beside it)
+            ref, self.reading = stage.reference(operator.last_row, operator.next_row(), state)
         else:
-            ref, reading = stage.reference(sample, analysis, state)
+            ref, self.reading = stage.reference(sample, analysis, state)
         c2 = time.perf_counter()
         self.controller.update(state, ref)
         c3 = time.perf_counter()
-        if isinstance(stage, MotionInline):
-            reading = stage.after_control(sample, analysis, state, first=reading is not None) or reading
-        c4 = time.perf_counter()
         run.stage_ms["processing"].append((c1 - c0) * 1e3)
-        run.stage_ms["motion"].append((c2 - c1 + c4 - c3) * 1e3)
+        run.stage_ms["motion"].append((c2 - c1) * 1e3)
         run.stage_ms["control_update"].append((c3 - c2) * 1e3)
-        run.waiting = (self._tick_values(t, sample, state, ref), (c4 - c0) * 1e3)
+        self._log(run.log, t, sample, state, ref, (c3 - c0) * 1e3)
         if self.on_tick is not None:
             self.on_tick(state, ref)
-        if reading is not None:
-            self._record(run, reading)
         return state
 
     def _watch_stream(self, got_frames: bool, t: float, run: _RunState) -> None:
@@ -463,14 +449,17 @@ class Session:
                     f"limits {DIVERGED_LINK_SPEED_MPS:.0f} m/s, {DIVERGED_ROOT_HEIGHT_M:.1f} m)")
         return ""
 
-    def _tick_values(self, t: float, sample, state: CharacterState, ref) -> dict:
-        """A control tick's record but the operator's reading (:meth:`_record` adds it)."""
+    def _log(self, lg: TickLog, t: float, sample, state: CharacterState, ref, tick_ms: float) -> None:
         com = self.mass.com(state)
         self.last_com_world = com
         # Vectors are recorded whole and split into their x, y, z columns after the run (_add_after_run_columns):
         # the tick pays for one append per vector. The arrays recorded are new at every tick, never changed later.
-        return dict(
-            t=t, char_state=STANCE_CODE[ref.character_stance],
+        reading = self.reading
+        assert reading is not None  # the motion stage has run this tick
+        lg.add(
+            t=t, tick_ms=tick_ms,
+            op_state=STANCE_CODE[reading.operator_stance], char_state=STANCE_CODE[ref.character_stance],
+            held=float(reading.held), scale=reading.scale,
             _v_com=com, _v_com_d=ref.com_world, _v_op_com=sample.com_world,
             _v_op_al=sample.pos["ANKLE_LEFT"], _v_op_ar=sample.pos["ANKLE_RIGHT"],
             _v_al=state.link_origin_world[_LINK["left_ankle"]], _v_ar=state.link_origin_world[_LINK["right_ankle"]],
@@ -479,23 +468,13 @@ class Session:
             ch_joints=state.link_origin_world[CHARACTER_LINKS],
             _op_pos=sample.pos,
             _v_lipm=self.controller.telemetry.lipm_force_n,
+            _op_features=reading.operator_features,
             # The joint error and the character's style features are computed from these after the run
             # (_add_after_run_columns). The arrays are the state's and the reference's own, new at every tick.
             _q=state.joint_pos, _q_ref=ref.joint_pos,
             _ch_legs=state.link_origin_world[_LEG_LINKS], _ch_leg_quats=state.link_quat_wxyz[_LEG_LINKS[:, 1:]],
             _ch_root_quat=state.root_quat_wxyz,
         )
-
-    def _record(self, run: _RunState, reading: MotionReading) -> None:
-        """The waiting tick's record, with the operator's reading of that tick, into the run's log; the reading to
-        ``on_reading``."""
-        assert run.waiting is not None
-        values, tick_ms = run.waiting
-        run.waiting = None
-        if self.on_reading is not None:
-            self.on_reading(reading)
-        run.log.add(tick_ms=tick_ms, op_state=STANCE_CODE[reading.operator_stance], held=float(reading.held),
-                    scale=reading.scale, _op_features=reading.operator_features, **values)
 
 
 # Vector columns recorded whole at each tick: (recorded name, column prefix, axes split off).

@@ -18,10 +18,6 @@ A recorder may defer the writing (``deferred=True``, for runs as fast as possibl
 to its values (arrays the session never changes once made), and the lines are written when the run ends, the
 same lines. Formatting a line costs about 0.2 ms, a sixth of the control tick; an offline run can be run again if
 it is cut short. At most MAX_DEFERRED_TICKS are held; beyond, the lines are written as they come.
-
-A tick's operator reading (``scale``, ``operator_stance``, ``operator_features``) is the motion stage's, which may
-come a tick after the tick itself (motion_ahead.py): the recorder takes each tick's values from the session's
-``on_tick`` and completes them with the session's ``on_reading`` (set when the recorder is made), in tick order.
 """
 
 from __future__ import annotations
@@ -30,7 +26,6 @@ import dataclasses
 import json
 import logging
 import time
-from collections import deque
 from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any, NamedTuple
@@ -80,8 +75,6 @@ class SessionRecorder:
         self.deferred = deferred
         self.wall_clock = wall_clock  # each tick's line says when it ran (monotonic_s)
         self._held: list[_TickValues] = []  # deferred ticks' values
-        self._awaiting: deque[_TickValues] = deque()  # ticks' values waiting for the operator's reading of the tick
-        session.on_reading = self.reading
         header = {"format": FORMAT, "version": VERSION,
                   "config": _config_dict(config),
                   "joints": [j.name for j in JOINTS], "links": list(LINK_NAMES),
@@ -95,18 +88,13 @@ class SessionRecorder:
         self._f.write(json.dumps(obj, default=_jsonable) + "\n")
 
     def tick(self, state: Any, ref: Any) -> None:
-        """The session's ``on_tick``: the tick's values but the operator's reading (:meth:`reading`)."""
         sess = self._session
-        self._awaiting.append(_TickValues(
-            state.time_s, state.root_pos_world, state.root_quat_wxyz, state.joint_pos, state.link_quat_wxyz,
-            getattr(sess, "last_torques", None), 0.0, None, ref.character_stance, None,
-            getattr(sess, "last_com_world", None), getattr(sess, "last_sample", None),
-            time.monotonic() if self.wall_clock else None))
-
-    def reading(self, reading: Any) -> None:
-        """The session's ``on_reading``: the operator's reading of the oldest tick waiting for it; its line."""
-        values = self._awaiting.popleft()._replace(scale=reading.scale, operator_stance=reading.operator_stance,
-                                                   operator_features=reading.operator_features)
+        reading = sess.reading
+        values = _TickValues(state.time_s, state.root_pos_world, state.root_quat_wxyz, state.joint_pos,
+                             state.link_quat_wxyz, getattr(sess, "last_torques", None), reading.scale,
+                             reading.operator_stance, ref.character_stance, reading.operator_features,
+                             getattr(sess, "last_com_world", None), getattr(sess, "last_sample", None),
+                             time.monotonic() if self.wall_clock else None)
         if self.deferred and len(self._held) < MAX_DEFERRED_TICKS:
             self._held.append(values)
             return

@@ -100,8 +100,8 @@ def session_hook(session, viewer, draw_hz: float) -> Callable:
         com = session.last_com_world if session.last_com_world is not None else session.mass.com(state)
         balls = tuple(session.backend.body_position(b) for b in getattr(session.backend, "balls", []))
         viewer.publish(snapshot_from_state(
-            state, com, ref.character_stance, session.motion.reading.operator_stance,
-            None if sample is None else sample.pos, session.motion.reading.scale, session.bounds.active, balls,
+            state, com, ref.character_stance, session.reading.operator_stance,
+            None if sample is None else sample.pos, session.reading.scale, session.bounds.active, balls,
             fell=session.fell))
 
     return hook
