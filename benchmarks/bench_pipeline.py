@@ -5,9 +5,10 @@
 Physics alone: the same world and character stepped at the physics rate with zero joint torques (the character
 simply falls and lies; contact work is comparable). Whole pipeline: source -> processing -> motion -> control ->
 physics, headless, as fast as possible, as `stylesync demo` runs it: the operator side (source, processing, style
-features) computed ahead in a second process (prefetch.py). The pipeline is also timed with everything in one
-process. All are timed alternately (--repeat times each), and their medians and per-round ratios are printed: the
-ratio is meaningful on a noisy machine even when the absolute figures are not.
+features) computed ahead in a second process (prefetch.py), the motion stage a tick ahead in a third
+(motion_ahead.py). The pipeline is also timed with everything in one process (the same simulation). All are
+timed alternately (--repeat times each), and their medians and per-round ratios are printed: the ratio is
+meaningful on a noisy machine even when the absolute figures are not.
 """
 
 from __future__ import annotations

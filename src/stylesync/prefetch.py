@@ -17,6 +17,7 @@ clock, headless, a recorded source (not live), no other thread in the process, o
 from __future__ import annotations
 
 import multiprocessing
+import os
 import signal
 import sys
 import threading
@@ -34,6 +35,9 @@ from stylesync.sources.base import OperatorSource
 
 BATCH_TICKS = 32  # control ticks per message from the worker (about 35 kB)
 WORKER_EXIT_TIMEOUT_S = 2.0
+# The worker runs ahead by up to a pipe's worth of batches: it yields a core to the session and to the motion
+# stage's worker (motion_ahead.py), which wait on each other at every tick [nice increment]
+WORKER_NICENESS = 10
 
 # Row layout: time, mocap time, rejected frames, dropped joint values (the last two cumulative), then the sample's
 # and the analysis's arrays.
@@ -121,6 +125,7 @@ def _worker(conn: Connection, session_end: Connection, source: OperatorSource, p
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the session ends the worker; a terminal's Ctrl-C is its own
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM})  # held by the session while it forked
+    os.nice(WORKER_NICENESS)
     rows: list[np.ndarray] = []
     batch = 1  # the first tick at once, so that the run starts without waiting for a whole batch
     try:
