@@ -16,10 +16,13 @@ from stylesync.sources.builtin_operator import builtin_operator
 
 
 def _session(duration_s: float, ahead: bool, on_tick=None) -> Session:
-    cfg = SessionConfig(duration_s=duration_s, seed=1)
+    """A session with the motion stage on the last tick's state: computed ahead in its worker or (``ahead`` False,
+    the operator side prefetched all the same) in line."""
+    cfg = SessionConfig(duration_s=duration_s, seed=1, motion_ahead=True)
     source, _ = builtin_operator(cfg.operator, cfg.clocks, duration_s + 1.0, cfg.seed)
     session = Session(cfg, source, on_tick=on_tick)
-    session.motion_ahead = ahead
+    if not ahead:
+        session.prefetch_operator = False  # (then the motion stage runs in line)
     return session
 
 
@@ -61,7 +64,7 @@ def test_rows_restore_the_state_and_the_reference_exactly():
 def test_a_run_with_the_motion_stage_ahead_is_the_same_simulation_as_in_line():
     assert threading.active_count() == 1, f"threads left running: {threading.enumerate()}"
     ahead, inline = _session(3.0, ahead=True).run(), _session(3.0, ahead=False).run()
-    assert ahead.operator_prefetched
+    assert ahead.operator_prefetched and not inline.operator_prefetched
     assert set(ahead.log.columns) == set(inline.log.columns)
     for key in ahead.log.columns:
         if key != "tick_ms":  # (wall time)
@@ -79,6 +82,19 @@ def test_the_motion_stage_reads_the_last_ticks_state_and_this_ticks_operator():
     assert refs[0].time_s == times[0]  # the first tick's own state
     assert [r.time_s for r in refs[1:]] == times[:-1]  # then the state of the tick before
     assert samples == times  # and the operator's sample of the tick itself
+
+
+def test_by_default_the_motion_stage_reads_this_ticks_state_in_this_process():
+    refs, times = [], []
+    cfg = SessionConfig(duration_s=0.3, seed=1)
+    source, _ = builtin_operator(cfg.operator, cfg.clocks, 1.3, cfg.seed)
+    session = Session(cfg, source, on_tick=lambda state, ref: (refs.append(ref), times.append(state.time_s)))
+    children = []
+    session.on_tick = lambda state, ref: (refs.append(ref), times.append(state.time_s),
+                                          children.append(len(multiprocessing.active_children())))
+    assert session.run().operator_prefetched
+    assert [r.time_s for r in refs] == times
+    assert max(children) == 1  # the operator side's worker alone
 
 
 def test_an_error_of_the_motion_stage_reaches_the_session_and_leaves_no_process(monkeypatch):

@@ -171,7 +171,7 @@ def _demo(args: argparse.Namespace) -> int:
                               start_ramp=args.start_ramp)
     cfg = SessionConfig(duration_s=args.duration, seed=args.seed, gui=args.gui,
                         realtime=args.realtime or args.viewer != "none", operator=operator,
-                        control=ControlConfig(lipm_time_sync=not args.no_lipm))
+                        control=ControlConfig(lipm_time_sync=not args.no_lipm), motion_ahead=args.motion_ahead)
     cfg = _motion_options(cfg, args)
     source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
     return _run_session(cfg, source, Path(args.out), {"clip": args.clip, "turn_rate_rad_s": args.turn_rate,
@@ -182,7 +182,8 @@ def _demo(args: argparse.Namespace) -> int:
                                                       "in_place": args.in_place,
                                                       "free_swing": args.free_swing,
                                                       "pelvis_joint": args.pelvis_joint,
-                                                      "track_rise": not args.no_track_rise}, args)
+                                                      "track_rise": not args.no_track_rise,
+                                                      "motion_ahead": args.motion_ahead}, args)
 
 
 def _suite_operator(args: argparse.Namespace) -> OperatorConfig:
@@ -232,7 +233,7 @@ def _run(args: argparse.Namespace) -> int:
                         realtime=args.realtime or live or args.viewer != "none",
                         clocks=dataclasses.replace(clocks, mocap_hz=opened.mocap_hz),
                         control=ControlConfig(lipm_time_sync=not args.no_lipm),
-                        operator=OperatorConfig(mirror=args.mirror))
+                        operator=OperatorConfig(mirror=args.mirror), motion_ahead=args.motion_ahead)
     cfg = _motion_options(cfg, args)
     return _run_session(cfg, opened.source, Path(args.out), {"source": args.source, "sensor": opened.sensor,
                                                               "lipm_time_sync": not args.no_lipm,
@@ -242,6 +243,7 @@ def _run(args: argparse.Namespace) -> int:
                                                               "free_swing": args.free_swing,
                                                               "pelvis_joint": args.pelvis_joint,
                                                               "track_rise": not args.no_track_rise,
+                                                              "motion_ahead": args.motion_ahead,
                                                               **opened.extras}, args)
 
 
@@ -382,6 +384,9 @@ def _add_session_args(p: argparse.ArgumentParser, out_default: str, realtime_hel
     p.add_argument("--no-track-rise", action="store_true",
                    help="the pelvis height's law damps every vertical speed, a jump's push included (by default it "
                         "tracks half the operator's rise begun and kept on both feet; docs/status-log.md)")
+    p.add_argument("--motion-ahead", action="store_true",
+                   help="the motion stage on the last control tick's state, computed a tick ahead in a second process "
+                        "(offline runs about 1.3 times as fast; another simulation: docs/decisions.md)")
     p.add_argument("--record", type=typed.out_file, help="session file to write (default: OUT/session.jsonl)")
     p.add_argument("--progress", action="store_true", help="show a progress line (default: when on a terminal)")
     p.add_argument("--continue-after-fall", action="store_true",

@@ -2,9 +2,10 @@
 
 The pipeline's stages run in a chain at every control tick: the motion optimisation reads the operator's sample and
 the character's state and hands its reference to the controller, which turns it into torques for the physics steps
-up to the next tick. Here the motion stage reads the character's state of the last control tick (at the first, the
-first tick's own), 7.5 ms old at 133 Hz, as a state estimator a tick behind would give it; the operator's sample is
-the tick's own. Every run does this (session.py), so the simulation is the same whichever process computes it:
+up to the next tick. With ``SessionConfig.motion_ahead`` the motion stage reads the character's state of the last
+control tick instead (at the first, the first tick's own), 7.5 ms old at 133 Hz, as a state estimator a tick behind
+would give it; the operator's sample is the tick's own. Then the simulation is the same whichever process computes
+it (session.py):
 
 - in line (``MotionInline``): the motion stage runs in this process before the controller's update;
 - ahead (``MotionAhead``): a forked worker holds the motion stage (its copy of the session's, made when the run
@@ -201,19 +202,22 @@ def unpack_reference(row: np.ndarray) -> tuple[ReferencePose, MotionReading, int
 
 
 class MotionInline:
-    """The motion stage in this process, on the last tick's state (see the module's notes)."""
+    """The motion stage in this process, on this tick's state or, ``on_last_state``, on the last tick's (see the
+    module's notes)."""
 
-    def __init__(self, motion: MotionOptimizer, mass: MassProperties):
+    def __init__(self, motion: MotionOptimizer, mass: MassProperties, on_last_state: bool):
         self.motion = motion
         self.mass = mass
+        self.on_last_state = on_last_state
         self._last_state: CharacterState | None = None
 
     def reference(self, sample: OperatorSample, analysis: OperatorAnalysis | None,
                   state: CharacterState) -> tuple[ReferencePose, MotionReading]:
-        """This tick's reference and the operator's reading, from this tick's sample and the last tick's state
-        (at the first tick, this tick's)."""
+        """This tick's reference and the operator's reading, from this tick's sample and this tick's state, or the
+        last tick's (at the first tick, this tick's)."""
         basis = state if self._last_state is None else self._last_state
-        self._last_state = state
+        if self.on_last_state:
+            self._last_state = state
         ref = self.motion.update(sample, basis, self.mass, analysis)
         reading = self.motion.reading
         assert reading is not None  # the motion stage has run

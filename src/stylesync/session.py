@@ -178,9 +178,6 @@ class Session:
         # An offline run of a recorded operator computes the operator side ahead in a second process
         # (prefetch.py; the same results). False keeps it in this process.
         self.prefetch_operator = True
-        # With the operator side prefetched, the motion stage runs in a second forked worker, a tick ahead of the
-        # controller (motion_ahead.py; the same simulation as in line). False keeps it in this process.
-        self.motion_ahead = True
         # Ctrl-C (or SIGTERM, turned into it by the command line) ends the run as its duration would, with
         # end_reason "interrupted", instead of propagating (the command line then writes the outputs and exits 130)
         self.finish_on_interrupt = False
@@ -299,9 +296,9 @@ class Session:
         for k in tick_steps:
             is_tick[k] = True
         operator: OperatorInline | OperatorPrefetch = OperatorInline(self.source, self.processing)
-        stage: MotionInline | MotionAhead = MotionInline(self.motion, self.mass)
+        stage: MotionInline | MotionAhead = MotionInline(self.motion, self.mass, cfg.motion_ahead)
         if self.prefetch_operator and OperatorPrefetch.usable(self.source, cfg.realtime, cfg.gui):
-            if self.motion_ahead:  # forked first: the operator side's worker then holds no end of its pipe
+            if cfg.motion_ahead:  # forked first: the operator side's worker then holds no end of its pipe
                 stage = MotionAhead(self.motion, self.mass, self.bounds)
             operator = OperatorPrefetch(self.source, self.processing, [k * dt for k in tick_steps])
         self.fell = False
@@ -356,7 +353,8 @@ class Session:
     def _control_tick(self, t: float, operator: OperatorInline | OperatorPrefetch, stage: MotionInline | MotionAhead,
                       run: _RunState) -> CharacterState:
         """Operator side, motion optimisation and the controller's update for the control tick at ``t``. The motion
-        stage reads the operator's sample of this tick and the character's state of the last (motion_ahead.py)."""
+        stage reads the operator's sample of this tick and the character's state of this tick, or with
+        ``SessionConfig.motion_ahead`` of the last (motion_ahead.py)."""
         c0 = time.perf_counter()
         frames = operator.poll(t)
         for f in frames:
