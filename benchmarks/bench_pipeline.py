@@ -1,14 +1,15 @@
 """Speed of the whole pipeline against physics alone, measured in one run (prints figures; not a test).
 
-    python benchmarks/bench_pipeline.py [--clip stand] [--duration 20] [--repeat 3]
+    python benchmarks/bench_pipeline.py [--clip stand] [--duration 20] [--repeat 3] [--motion-ahead]
 
 Physics alone: the same world and character stepped at the physics rate with zero joint torques (the character
 simply falls and lies; contact work is comparable). Whole pipeline: source -> processing -> motion -> control ->
 physics, headless, as fast as possible, as `stylesync demo` runs it: the operator side (source, processing, style
-features) computed ahead in a second process (prefetch.py), the motion stage a tick ahead in a third
-(motion_ahead.py). The pipeline is also timed with everything in one process (the same simulation). All are
-timed alternately (--repeat times each), and their medians and per-round ratios are printed: the ratio is
-meaningful on a noisy machine even when the absolute figures are not.
+features) computed ahead in a second process (prefetch.py). The pipeline is also timed with everything in one
+process, and with ``--motion-ahead`` as `stylesync demo --motion-ahead` runs it too: the motion stage on the last
+tick's state, computed a tick ahead in a third process (motion_ahead.py; another simulation). All are timed
+alternately (--repeat times each), and their medians and per-round ratios are printed: the ratio is meaningful on a
+noisy machine even when the absolute figures are not.
 """
 
 from __future__ import annotations
@@ -31,15 +32,17 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3,
                     help="alternating measurements of each (physics alone, pipeline); medians are reported")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--motion-ahead", action="store_true", help="also the pipeline with the motion stage a tick ahead")
     args = ap.parse_args()
     logging.getLogger("stylesync").setLevel(logging.ERROR)  # the runs' warnings (movement bounds) are not measured here
     cfg = SessionConfig(duration_s=args.duration, seed=args.seed, operator=OperatorConfig(clip=args.clip))
-    phys_rtfs, rtfs, one_rtfs = [], [], []
-    result = None
+    phys_rtfs, rtfs, one_rtfs, ahead_rtfs = [], [], [], []
+    result = ahead = None
 
-    def pipeline(prefetch: bool) -> SessionResult:
-        source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
-        session = Session(cfg, source)
+    def pipeline(prefetch: bool, motion_ahead: bool = False) -> SessionResult:
+        run_cfg = cfg.replace(motion_ahead=motion_ahead)
+        source, _ = builtin_operator(run_cfg.operator, run_cfg.clocks, run_cfg.duration_s + 1.0, run_cfg.seed)
+        session = Session(run_cfg, source)
         session.prefetch_operator = prefetch
         return session.run()
 
@@ -49,6 +52,9 @@ def main() -> None:
         one_rtfs.append(one.sim_duration_s / one.wall_duration_s)
         result = pipeline(prefetch=True)
         rtfs.append(result.sim_duration_s / result.wall_duration_s)
+        if args.motion_ahead:
+            ahead = pipeline(prefetch=True, motion_ahead=True)
+            ahead_rtfs.append(ahead.sim_duration_s / ahead.wall_duration_s)
     assert result is not None
     phys, rtf, one_rtf = float(np.median(phys_rtfs)), float(np.median(rtfs)), float(np.median(one_rtfs))
     ratios = [r / p for r, p in zip(rtfs, phys_rtfs, strict=True)]
@@ -66,6 +72,12 @@ def main() -> None:
           f"({', '.join(f'{x:.2f}' for x in ratios)})")
     print(f"  ... in one process:            {float(np.median(one_ratios)):6.2f} median   "
           f"({', '.join(f'{x:.2f}' for x in one_ratios)})")
+    if ahead is not None:
+        ahead_ratios = [r / p for r, p in zip(ahead_rtfs, phys_rtfs, strict=True)]
+        print(f"  ... the motion stage ahead:    {float(np.median(ahead_ratios)):6.2f} median   "
+              f"({', '.join(f'{x:.2f}' for x in ahead_ratios)}); {float(np.median(ahead_rtfs)):.2f}x median; "
+              f"motion / control update in the main process {np.mean(ahead.stage_ms['motion']):.3f} / "
+              f"{np.mean(ahead.stage_ms['control_update']):.3f} ms a tick at the mean")
     print("time per control tick in the main process [ms], mean / p99 (last pipeline measurement):")
     per_tick = {k: np.asarray(v) for k, v in result.stage_ms.items()}
     steps_per_tick = steps / max(ticks, 1)

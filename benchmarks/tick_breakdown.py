@@ -2,9 +2,9 @@
 
     python benchmarks/tick_breakdown.py [--clip walk] [--duration 12] [--seed 0] [--motion-ahead]
 
-Runs the built-in clip headless as `stylesync demo` does (the operator side prefetched; the motion stage in this
-process, so that its calls are timed here, unless ``--motion-ahead``: then in its worker, as the demo runs it,
-motion_ahead.py, and its calls are not timed) with a timer around each
+Runs the built-in clip headless as `stylesync demo` does (the operator side prefetched; with ``--motion-ahead`` as
+`stylesync demo --motion-ahead` does, the motion stage in its worker, whose calls are then not timed: motion_ahead.py)
+with a timer around each
 of the calls listed in PARTS, and prints each call's mean time per control tick [µs] and per call, beside the
 session's own stages. The same calls timed in a loop by themselves cost two to three times less: in the pipeline
 each runs after the engine and the other stages have evicted its data from the caches (docs/decisions.md, "The
@@ -66,7 +66,7 @@ def main() -> None:
     ap.add_argument("--clip", default="walk")
     ap.add_argument("--duration", type=float, default=12.0, help="simulated seconds")
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--motion-ahead", action="store_true", help="the motion stage in its worker, as the demo runs it")
+    ap.add_argument("--motion-ahead", action="store_true", help="the motion stage a tick ahead in its worker")
     args = ap.parse_args()
     logging.getLogger("stylesync").setLevel(logging.ERROR)
     totals: dict[str, list[float]] = {label: [0.0, 0] for *_, label in PARTS}
@@ -76,11 +76,10 @@ def main() -> None:
         for part in outer:
             owner = getattr(owner, part)
         setattr(owner, name, _timed(getattr(owner, name), totals, label))
-    cfg = SessionConfig(duration_s=args.duration, seed=args.seed, operator=OperatorConfig(clip=args.clip))
+    cfg = SessionConfig(duration_s=args.duration, seed=args.seed, operator=OperatorConfig(clip=args.clip),
+                        motion_ahead=args.motion_ahead)
     source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
-    session = Session(cfg, source)
-    session.motion_ahead = args.motion_ahead
-    result = session.run()
+    result = Session(cfg, source).run()
     ticks = len(result.stage_ms["motion"])
     steps = len(result.stage_ms["physics"])
     wall_ms = result.wall_duration_s * 1e3
