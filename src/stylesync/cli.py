@@ -386,7 +386,7 @@ def _add_session_args(p: argparse.ArgumentParser, out_default: str, realtime_hel
                         "tracks half the operator's rise begun and kept on both feet; docs/status-log.md)")
     p.add_argument("--motion-ahead", action="store_true",
                    help="the motion stage on the last control tick's state, computed a tick ahead in a second process "
-                        "(offline runs about 1.3 times as fast; another simulation: docs/decisions.md)")
+                        "(offline runs about 1.1 times as fast; another simulation: docs/decisions.md)")
     p.add_argument("--record", type=typed.out_file, help="session file to write (default: OUT/session.jsonl)")
     p.add_argument("--progress", action="store_true", help="show a progress line (default: when on a terminal)")
     p.add_argument("--continue-after-fall", action="store_true",

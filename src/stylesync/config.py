@@ -949,9 +949,9 @@ class SessionConfig:
     # A live stream silent for longer than this ends the run (its outputs written); shorter silences are held [s]
     stream_timeout_s: float = 5.0
     # The motion stage on the last control tick's state (7.5 ms old) with this tick's operator sample, computed a tick
-    # ahead in a second process when the operator side is prefetched (motion_ahead.py): the pipeline about 1.3 times
-    # as fast; off, the motion stage reads this tick's state in this process (docs/decisions.md, "The motion stage a
-    # tick ahead")
+    # ahead in a second process when the operator side is prefetched (motion_ahead.py): the pipeline about 1.1 times
+    # as fast, and another simulation; off, the motion stage reads this tick's state in this process
+    # (docs/decisions.md, "The motion stage a tick ahead")
     motion_ahead: bool = False
 
     def __post_init__(self) -> None:
