@@ -2,10 +2,7 @@
 gives in line, the rows carry every field, and the worker's errors and death reach the session."""
 
 import multiprocessing
-import subprocess
-import sys
 import threading
-import time
 
 import numpy as np
 import pytest
@@ -151,44 +148,3 @@ def test_a_session_file_is_the_same_with_the_motion_stage_ahead(tmp_path):
     assert len(ticks) == len(lines[True]) - 1  # every tick's line, its operator reading included
     assert {t["operator_stance"] for t in ticks} >= {"DS", "LS", "RS"}
 
-
-def _process_running(pid: int) -> bool:
-    try:
-        with open(f"/proc/{pid}/stat") as f:
-            return f.read().rsplit(")", 1)[1].split()[0] != "Z"  # a zombie has ended
-    except FileNotFoundError:
-        return False
-
-
-@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
-def test_the_workers_end_when_their_session_is_killed():
-    # Killed (SIGKILL), the session cannot end its workers: each must notice (its pipe has no other end left).
-    script = """
-import multiprocessing
-from stylesync.config import SessionConfig
-from stylesync.session import Session
-from stylesync.sources.builtin_operator import builtin_operator
-cfg = SessionConfig(duration_s=60.0, seed=0, motion_ahead=True)
-source, _ = builtin_operator(cfg.operator, cfg.clocks, 61.0, 0)
-told = []
-def on_tick(state, ref):
-    if not told:
-        told.append(1)
-        print("workers:", *(p.pid for p in multiprocessing.active_children()), flush=True)
-Session(cfg, source, on_tick=on_tick).run()
-"""
-    proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
-    try:
-        assert proc.stdout is not None
-        line = next((ln for ln in proc.stdout if ln.startswith("workers:")), "")  # the engine prints too
-        workers = [int(p) for p in line.split()[1:]]
-        assert len(workers) == 2, "the session did not start its operator-side and motion-stage workers"
-        proc.kill()
-        proc.wait(timeout=10)
-        deadline = time.monotonic() + 5.0
-        while any(_process_running(w) for w in workers) and time.monotonic() < deadline:
-            time.sleep(0.1)
-        assert not any(_process_running(w) for w in workers), "a worker outlived its killed session"
-    finally:
-        if proc.poll() is None:
-            proc.kill()

@@ -157,14 +157,16 @@ def _process_running(pid: int) -> bool:
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
-def test_the_worker_ends_when_its_session_is_killed():
-    # Killed (SIGKILL), the session cannot end its worker: the worker must notice (its pipe has no reader left).
-    script = """
+@pytest.mark.parametrize("motion_ahead", [False, True])
+def test_the_workers_end_when_their_session_is_killed(motion_ahead):
+    # Killed (SIGKILL), the session cannot end its workers: each must notice (its pipe has no other end left). With
+    # the motion stage ahead (motion_ahead.py) it has two.
+    script = f"""
 import multiprocessing, sys
 from stylesync.config import SessionConfig
 from stylesync.session import Session
 from stylesync.sources.builtin_operator import builtin_operator
-cfg = SessionConfig(duration_s=60.0, seed=0)
+cfg = SessionConfig(duration_s=60.0, seed=0, motion_ahead={motion_ahead})
 source, _ = builtin_operator(cfg.operator, cfg.clocks, 61.0, 0)
 told = []
 def on_tick(state, ref):
@@ -178,13 +180,13 @@ Session(cfg, source, on_tick=on_tick).run()
         assert proc.stdout is not None
         line = next((ln for ln in proc.stdout if ln.startswith("workers:")), "")  # the engine prints too
         workers = [int(p) for p in line.split()[1:]]
-        assert len(workers) == 1, "the session did not start its operator-side worker"
+        assert len(workers) == (2 if motion_ahead else 1), "the session did not start its workers"
         proc.kill()
         proc.wait(timeout=10)
         deadline = time.monotonic() + 5.0
-        while _process_running(workers[0]) and time.monotonic() < deadline:
+        while any(_process_running(w) for w in workers) and time.monotonic() < deadline:
             time.sleep(0.1)
-        assert not _process_running(workers[0]), "the worker outlived its killed session"
+        assert not any(_process_running(w) for w in workers), "a worker outlived its killed session"
     finally:
         if proc.poll() is None:
             proc.kill()
