@@ -2,6 +2,7 @@
 gives in line, the rows carry every field, and the worker's errors and death reach the session."""
 
 import multiprocessing
+import os
 import threading
 
 import numpy as np
@@ -97,39 +98,35 @@ def test_by_default_the_motion_stage_reads_this_ticks_state_in_this_process():
     assert max(children) == 1  # the operator side's worker alone
 
 
-def test_an_error_of_the_motion_stage_reaches_the_session_and_leaves_no_process(monkeypatch):
+def _motion_stage_failing_at_tick_41(monkeypatch, fail) -> None:
+    """The motion stage calls ``fail()`` at its 41st tick (the worker is forked with the patch)."""
     update = MotionOptimizer.update
     calls = []
 
     def failing(self, *args, **kwargs):
         calls.append(1)
         if len(calls) > 40:
-            raise StylesyncError("the motion stage broke at its 41st tick")
+            fail()
         return update(self, *args, **kwargs)
 
-    monkeypatch.setattr(MotionOptimizer, "update", failing)  # (the worker is forked with it)
+    monkeypatch.setattr(MotionOptimizer, "update", failing)
+
+
+def test_an_error_of_the_motion_stage_reaches_the_session_and_leaves_no_process(monkeypatch):
+    def fail():
+        raise StylesyncError("the motion stage broke at its 41st tick")
+
+    _motion_stage_failing_at_tick_41(monkeypatch, fail)
     with pytest.raises(StylesyncError, match="broke at its 41st tick"):
         _session(2.0, ahead=True).run()
     assert not multiprocessing.active_children()
 
 
 def test_a_motion_worker_that_dies_is_reported(monkeypatch):
-    import os
-
-    update = MotionOptimizer.update
-    calls = []
-
-    def dying(self, *args, **kwargs):
-        calls.append(1)
-        if len(calls) > 40:
-            os._exit(3)
-        return update(self, *args, **kwargs)
-
-    monkeypatch.setattr(MotionOptimizer, "update", dying)
+    _motion_stage_failing_at_tick_41(monkeypatch, lambda: os._exit(3))
     with pytest.raises(StylesyncError, match="motion-stage process ended unexpectedly"):
         _session(2.0, ahead=True).run()
     assert not multiprocessing.active_children()
-
 
 def test_a_session_file_is_the_same_with_the_motion_stage_ahead(tmp_path):
     from stylesync.export.session_file import SessionRecorder, read_session

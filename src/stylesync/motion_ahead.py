@@ -23,8 +23,6 @@ from __future__ import annotations
 
 import multiprocessing
 import pickle
-import signal
-import threading
 from multiprocessing.connection import Connection
 
 import numpy as np
@@ -38,6 +36,7 @@ from stylesync.motion.pose_optimization import MotionOptimizer
 from stylesync.motion.reference import LipmMap, MotionReading, ReferencePose
 from stylesync.motion.stance_fsm import Stance
 from stylesync.motion.style_features import ROW_NAMES, StyleFeatures
+from stylesync.prefetch import start_forked, worker_signals
 from stylesync.prefetch import unpack as unpack_operator
 from stylesync.processing.operator_processing import OperatorSample
 
@@ -230,9 +229,7 @@ class MotionInline:
 def _worker(conn: Connection, session_end: Connection, motion: MotionOptimizer, mass: MassProperties) -> None:
     """The forked process: one reference per request, until the session closes its end."""
     session_end.close()  # (as prefetch._worker: a session that dies leaves no writer, and recv ends)
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM})
+    worker_signals()
     try:
         while True:
             message = conn.recv_bytes()  # b"bounds", or a state row and an operator row
@@ -266,14 +263,7 @@ class MotionAhead:
         self._conn, child = ctx.Pipe(duplex=True)
         self._proc = ctx.Process(target=_worker, args=(child, self._conn, motion, mass), name="stylesync-motion",
                                  daemon=True)
-        held = threading.current_thread() is threading.main_thread()
-        if held:  # (as prefetch.OperatorPrefetch: SIGTERM held while forking)
-            signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGTERM})
-        try:
-            self._proc.start()
-        finally:
-            if held:
-                signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM})
+        start_forked(self._proc)
         child.close()
         self._bounds = bounds
         self._pending = False

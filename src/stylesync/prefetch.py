@@ -122,9 +122,7 @@ def _worker(conn: Connection, session_end: Connection, source: OperatorSource, p
     # The fork copied the session's end of the pipe too: closed here, a session that dies (even killed) leaves no
     # reader, and the next send fails instead of waiting forever.
     session_end.close()
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the session ends the worker; a terminal's Ctrl-C is its own
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM})  # held by the session while it forked
+    worker_signals()
     os.nice(WORKER_NICENESS)
     rows: list[np.ndarray] = []
     batch = 1  # the first tick at once, so that the run starts without waiting for a whole batch
@@ -154,6 +152,29 @@ def _worker(conn: Connection, session_end: Connection, source: OperatorSource, p
         return
 
 
+def start_forked(proc: multiprocessing.process.BaseProcess) -> None:
+    """Start a forked worker. It is ended by SIGTERM when the run no longer needs it, possibly while it is still
+    starting; it must not inherit a handler of the session's (the command line turns SIGTERM into KeyboardInterrupt),
+    which would print an ignored exception. The signal is held while forking and restored to its default in the
+    worker (:func:`worker_signals`)."""
+    held = threading.current_thread() is threading.main_thread()
+    if held:
+        signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGTERM})
+    try:
+        proc.start()
+    finally:
+        if held:
+            signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM})
+
+
+def worker_signals() -> None:
+    """In a worker forked by :func:`start_forked`: the session ends it (SIGTERM, restored); a terminal's Ctrl-C is
+    the session's."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM})
+
+
 class OperatorPrefetch:
     """The operator side of the listed control ticks, computed ahead by a forked worker (see the module's notes).
 
@@ -166,18 +187,7 @@ class OperatorPrefetch:
         self._conn, child = ctx.Pipe(duplex=False)
         self._proc = ctx.Process(target=_worker, args=(child, self._conn, source, processing, list(tick_times_s)),
                                  name="stylesync-operator", daemon=True)
-        # The worker is ended by SIGTERM when the run no longer needs it, possibly while it is still starting; it
-        # must not inherit a handler of the session's (the command line turns SIGTERM into KeyboardInterrupt),
-        # which would print an ignored exception. The signal is held while forking and restored to its default in
-        # the worker (_worker).
-        held = threading.current_thread() is threading.main_thread()
-        if held:
-            signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGTERM})
-        try:
-            self._proc.start()
-        finally:
-            if held:
-                signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM})
+        start_forked(self._proc)
         child.close()
         self._rows = np.zeros((0, ROW_WIDTH))
         self._next = 0
