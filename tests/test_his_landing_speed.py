@@ -46,7 +46,7 @@ def _his_landings(max_speed_mps: float | None) -> tuple[list[float], list[float]
 
     def recorded(sample, *args, **kwargs):
         ref = update(sample, *args, **kwargs)
-        reading = session.reading
+        reading = session.motion.reading
         rows.append((sample.time_s, reading.operator_stance, reading.scale,
                      sample.pos["ANKLE_LEFT"].copy(), sample.pos["ANKLE_RIGHT"].copy()))
         return ref
