@@ -36,7 +36,7 @@ from stylesync.motion.pose_optimization import MotionOptimizer
 from stylesync.motion.reference import LipmMap, MotionReading, ReferencePose
 from stylesync.motion.stance_fsm import Stance
 from stylesync.motion.style_features import ROW_NAMES, StyleFeatures
-from stylesync.prefetch import start_forked, worker_signals
+from stylesync.prefetch import row_layout, start_forked, worker_signals
 from stylesync.prefetch import unpack as unpack_operator
 from stylesync.processing.operator_processing import OperatorSample
 
@@ -49,23 +49,15 @@ _STANCES = (Stance.LS, Stance.RS, Stance.DS)
 _NJ, _NL = len(JOINT_NAMES), len(LINK_NAMES)
 
 
-def _layout(fields: list[tuple[str, int]]) -> tuple[dict[str, slice], int]:
-    out, offset = {}, 0
-    for name, size in fields:
-        out[name] = slice(offset, offset + size)
-        offset += size
-    return out, offset
-
-
 # The character's state: the link table in the engine reading's columns (COM 0:3, origin 3:6, COM velocity 10:13,
 # angular velocity 13:16; 6:10 unused here), then the rest.
-_STATE, STATE_WIDTH = _layout([
+_STATE, STATE_WIDTH = row_layout([
     ("time_s", 1), ("root_pos", 3), ("root_quat", 4), ("root_lin_vel", 3), ("root_ang_vel", 3),
     ("joint_pos", 4 * _NJ), ("joint_vel", 3 * _NJ), ("table", 16 * _NL), ("link_quat", 4 * _NL),
     ("foot_force", len(_FEET)), ("non_foot", 1)])
 
 # The reference pose and the operator's reading of one tick. Optional values carry a presence flag first.
-_REF, REF_WIDTH = _layout([
+_REF, REF_WIDTH = row_layout([
     ("time_s", 1), ("joint_pos", 4 * _NJ), ("root_quat", 4), ("pelvis", 3), ("com", 3), ("com_vel", 3),
     ("stance", 1), ("weight", 2), ("ankle", 6), ("lipm", 9), ("press", 1), ("hand", 7),
     ("own_ankle", 9), ("own_ankle_vel", 9), ("while_he_stands", 1), ("pelvis_vel_z", 1), ("way_speed", 1),
@@ -214,8 +206,9 @@ class MotionInline:
                   state: CharacterState) -> tuple[ReferencePose, MotionReading]:
         """This tick's reference and the operator's reading, from this tick's sample and this tick's state, or the
         last tick's (at the first tick, this tick's)."""
-        basis = state if self._last_state is None else self._last_state
+        basis = state
         if self.on_last_state:
+            basis = state if self._last_state is None else self._last_state
             self._last_state = state
         ref = self.motion.update(sample, basis, self.mass, analysis)
         reading = self.motion.reading

@@ -46,12 +46,18 @@ _FIELDS: list[tuple[str, int]] = [("time_s", 1), ("mocap_time_s", 1), ("rejected
                                   ("quat", 4 * len(TRACKED_ORIENTATIONS)), ("pos", 3 * len(TRACKED_POSITIONS)),
                                   ("com", 3), ("support", 3 * len(_SIDES)), ("features", len(ROW_NAMES)),
                                   ("root", 4), ("upper", 4 * len(UPPER_JOINTS)), ("leg", 1)]
-_SLICE: dict[str, slice] = {}
-_offset = 0
-for _name, _size in _FIELDS:
-    _SLICE[_name] = slice(_offset, _offset + _size)
-    _offset += _size
-ROW_WIDTH = _offset
+
+
+def row_layout(fields: list[tuple[str, int]]) -> tuple[dict[str, slice], int]:
+    """Each named field's slice of a float64 row holding ``fields`` (name, size) in order, and the row's width."""
+    out, offset = {}, 0
+    for name, size in fields:
+        out[name] = slice(offset, offset + size)
+        offset += size
+    return out, offset
+
+
+_SLICE, ROW_WIDTH = row_layout(_FIELDS)
 
 
 def pack(sample: OperatorSample, analysis: OperatorAnalysis, rejected: int, dropped: int) -> np.ndarray:

@@ -360,6 +360,11 @@ class MotionOptimizer:
         self._sole_bound = sole_corner_points(cfg.capture_bound_sole_share)  # shrunk for capture_bound.py [m]
         self.reading: MotionReading | None = None  # the last tick's reading of the operator, besides the targets
 
+    def _last_scale(self) -> float | None:
+        """The character / operator size ratio of the last tick (Eq. 9, from his smoothed leg length); None before
+        his leg is known."""
+        return CHAR_LEG_LENGTH_M / self._op_leg_m if self._op_leg_m else None
+
     def prime_rates(self, com_vel_h_world: np.ndarray, com_vel_d_world: np.ndarray) -> None:
         """Start the operator's COM velocity and the desired COM velocity (Eq. 19) from these [m/s] instead of
         rest: a character started with a recording's velocities (OperatorConfig.start_with_clip_velocity)."""
@@ -410,7 +415,7 @@ class MotionOptimizer:
         xi, _ = capture_point(mass.com(state), mass.com_velocity(state), self.g)
         pressing = state.feet_pressing()
         if after_stand:
-            scale = CHAR_LEG_LENGTH_M / self._op_leg_m if self._op_leg_m else 1.0
+            scale = self._last_scale() or 1.0
             h_h = max(sample.com_world[2] - min(sample.pos["ANKLE_LEFT"][2], sample.pos["ANKLE_RIGHT"][2]), 0.1)
             xi_h = sample.com_world + self._com_h_rate.rate * np.sqrt(h_h / self.g)
             edge = FOOT_WIDTH_M / 2 + cfg.liftoff_margin_m
@@ -472,9 +477,9 @@ class MotionOptimizer:
         until his capture point is ``rear_foot_support_hysteresis_m`` less far behind the heel than the margin (a
         band, as the stance threshold's)."""
         margin = self.cfg.rear_foot_support_margin_m
-        if margin is None or self._op_leg_m is None or sample.time_s < OPERATOR_VELOCITY_SETTLE_S:
+        scale = self._last_scale()
+        if margin is None or scale is None or sample.time_s < OPERATOR_VELOCITY_SETTLE_S:
             return False
-        scale = CHAR_LEG_LENGTH_M / self._op_leg_m
         stance, raised = ("LEFT", "RIGHT") if op_state is Stance.LS else ("RIGHT", "LEFT")
         if self._rear_foot_bearing == swing_side(op_state):
             margin -= self.cfg.rear_foot_support_hysteresis_m
@@ -499,9 +504,8 @@ class MotionOptimizer:
         landing_mps = self.cfg.his_landing_max_speed_mps
         if landing_mps is not None:
             rates = {side: self._ankle_h_rate[side](sample.pos[f"ANKLE_{up}"]) for side, up in _SIDE_UP.items()}
-            sw = swing_side(self.op_fsm.state)
-            if sw is not None and self._op_leg_m:
-                scale = CHAR_LEG_LENGTH_M / self._op_leg_m
+            sw, scale = swing_side(self.op_fsm.state), self._last_scale()
+            if sw is not None and scale is not None:
                 swing_moving = scale * float(np.hypot(rates[sw][0], rates[sw][1])) > landing_mps
         op_state = self.op_fsm.update(sample.pos["ANKLE_LEFT"][2], sample.pos["ANKLE_RIGHT"][2], swing_moving)
         # His raised foot read as bearing weight (its side, for the band; none once his ankle heights say DS)
