@@ -6,8 +6,11 @@ not a test).
 
 Each recorded clip of the chosen categories of ``../shared/mocap`` (BVH and DeepMimic files; the built-in humanoid3d
 clips are the dev suite's own and are not varied) is written to a temporary file as a variant: ``reversed`` (its frames
-in reverse order: the same person walking backwards, facing forwards; a jump or a kick played back to front), or
-``speedX`` (its frame time divided by X: the same motion X times as fast, cadence and speed). Each variant runs with
+in reverse order: the same person walking backwards, facing forwards; a jump or a kick played back to front),
+``speedX`` (its frame time divided by X: the same motion X times as fast, cadence and speed), ``fromX`` (its first X
+seconds cut off, BVH only: the same take started at another phase of its motion), ``fpsN`` (every k-th frame kept, k
+the nearest to the clip's rate over N: the same take captured at about N frames a second) or ``statureX`` (BVH only:
+every offset and position channel times X, a person X times as tall moving alike). Each variant runs with
 each sensor seed as the development suite runs a clip (``metrics.dev_suite.run_clip``), by default, and with
 ``--follow-path`` also with `--follow-path`. Prints per variant and mode the figures of ``takes.summary`` and each fall
 (docs/decisions.md, "A backward walk").
@@ -20,6 +23,7 @@ import json
 import math
 import tempfile
 from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
 from pathlib import Path
 
 from takes import print_falls, summary
@@ -29,50 +33,120 @@ from stylesync.metrics.dev_suite import FOLLOW_PATH_VERSION, clip_specs, run_cli
 DURATION_S = 12.0  # as the development suite
 
 
-def bvh_variant(source: Path, target: Path, reverse: bool, speed: float) -> None:
-    """``source`` (BVH) written to ``target`` with its frames reversed and/or its frame time divided by ``speed``."""
+@dataclass(frozen=True)
+class Variant:
+    """How a clip is changed: frames reversed, frame time divided by ``speed``, the first ``cut_s`` seconds cut off,
+    every ``every``-th frame kept at about ``fps`` frames a second (None: all), lengths times ``stature``."""
+    reverse: bool = False
+    speed: float = 1.0
+    cut_s: float = 0.0
+    fps: float | None = None
+    stature: float = 1.0
+
+    @property
+    def bvh_only(self) -> bool:
+        """A stature or a cut start: not for DeepMimic clips (the humanoid's own skeleton; a looping cycle)."""
+        return self.stature != 1.0 or self.cut_s > 0.0
+
+
+def _kept(durations_s: list[float], v: Variant) -> list[int]:
+    """Indices of the frames a variant keeps, of frames lasting ``durations_s`` [s] each (at their recorded pace)."""
+    start, t = 0, 0.0
+    while start < len(durations_s) - 1 and t + 1e-9 < v.cut_s:
+        t += durations_s[start]
+        start += 1
+    step = 1 if v.fps is None else max(1, round(1.0 / (v.fps * max(durations_s[0], 1e-9))))
+    return list(range(start, len(durations_s), step))
+
+
+def _position_channels(head: str) -> list[int]:
+    """Indices, in a BVH frame line, of the channels that are positions (every joint's, in header order)."""
+    out, k = [], 0
+    for line in head.splitlines():
+        words = line.split()
+        if words and words[0] == "CHANNELS":
+            names = words[2:2 + int(words[1])]
+            out += [k + i for i, name in enumerate(names) if name.lower().endswith("position")]
+            k += len(names)
+    return out
+
+
+def _scaled_offsets(head: str, factor: float) -> str:
+    """A BVH header with every OFFSET times ``factor``."""
+    lines = []
+    for line in head.splitlines():
+        words = line.split()
+        if words and words[0] == "OFFSET":
+            indent = line[:len(line) - len(line.lstrip())]
+            line = indent + "OFFSET " + " ".join(f"{float(w) * factor:.6f}" for w in words[1:])
+        lines.append(line)
+    return "\n".join(lines) + "\n"
+
+
+def bvh_variant(source: Path, target: Path, v: Variant) -> None:
+    """``source`` (BVH) written to ``target`` as the variant ``v``."""
     head, motion = source.read_text(errors="replace").split("MOTION", 1)
     lines = [ln for ln in motion.splitlines() if ln.strip()]
-    frame_time_s = float(lines[1].split(":", 1)[1]) / speed
-    frames = lines[2:][::-1] if reverse else lines[2:]
+    recorded_s = float(lines[1].split(":", 1)[1])
+    frames = lines[2:]
+    kept = _kept([recorded_s] * len(frames), v)
+    frames = [frames[k] for k in kept]
+    frame_time_s = recorded_s * (kept[1] - kept[0] if len(kept) > 1 else 1) / v.speed
+    if v.stature != 1.0:
+        positions = set(_position_channels(head))
+        head = _scaled_offsets(head, v.stature)
+        frames = [" ".join(f"{float(w) * v.stature:.6f}" if i in positions else w for i, w in enumerate(f.split()))
+                  for f in frames]
+    frames = frames[::-1] if v.reverse else frames
     target.write_text(f"{head}MOTION\nFrames: {len(frames)}\nFrame Time: {frame_time_s:.8f}\n"
                       + "\n".join(frames) + "\n")
 
 
-def deepmimic_variant(source: Path, target: Path, reverse: bool, speed: float) -> None:
-    """``source`` (DeepMimic) written to ``target`` with its poses reversed (each frame's duration kept in its place:
-    the last frame's is zero) and/or its durations divided by ``speed``."""
+def deepmimic_variant(source: Path, target: Path, v: Variant) -> None:
+    """``source`` (DeepMimic) written to ``target`` as the variant ``v`` (not :attr:`Variant.bvh_only`): poses
+    reversed (each frame's duration kept in its place: the last frame's is zero),
+    durations divided by ``speed``, a kept frame lasting until the next kept one."""
     clip = json.loads(source.read_text())
     frames = [list(f) for f in clip["Frames"]]
-    durations = [f[0] / speed for f in frames]
-    if reverse:
+    kept = _kept([f[0] for f in frames], v)
+    durations = [sum(f[0] for f in frames[a:b]) / v.speed for a, b in zip(kept, kept[1:] + [len(frames)], strict=True)]
+    frames = [frames[k] for k in kept]
+    if v.reverse:
         frames = frames[::-1]
     for frame, duration in zip(frames, durations, strict=True):
         frame[0] = duration
     target.write_text(json.dumps({**clip, "Frames": frames}))
 
 
-def parse_variant(variant: str) -> tuple[bool, float]:
-    """(reversed, speed) of a variant's name, ``reversed`` or ``speedX`` with X > 0; ValueError otherwise."""
+VARIANT_HELP = "reversed, speedX (X > 0), fromX (X >= 0 s), fpsN (N > 0), statureX (X > 0)"
+
+
+def parse_variant(variant: str) -> Variant:
+    """The variant of a name (VARIANT_HELP); ValueError otherwise."""
     if variant == "reversed":
-        return True, 1.0
-    speed = float(variant.removeprefix("speed")) if variant.startswith("speed") else math.nan
-    if not speed > 0.0:
-        raise ValueError(f"unknown variant '{variant}': reversed or speedX with X > 0")
-    return False, speed
+        return Variant(reverse=True)
+    for prefix, field in (("speed", "speed"), ("from", "cut_s"), ("fps", "fps"), ("stature", "stature")):
+        if variant.startswith(prefix):
+            try:
+                value = float(variant.removeprefix(prefix))
+            except ValueError:
+                value = math.nan
+            if value > 0.0 or (field == "cut_s" and value == 0.0):
+                return Variant(**{field: value})
+    raise ValueError(f"unknown variant '{variant}': {VARIANT_HELP}")
 
 
 def variant_specs(mocap: Path, categories: set[str], variant: str, folder: Path) -> list[tuple[str, str]]:
     """(spec, name) of each recorded clip of ``categories`` as ``variant``, written into ``folder``."""
-    reverse, speed = parse_variant(variant)
+    v = parse_variant(variant)
     out = []
     for spec, name, category in clip_specs(mocap):
         kind, _, path = spec.partition(":")
-        if category not in categories or kind not in ("bvh", "deepmimic"):
+        if category not in categories or kind not in ("bvh", "deepmimic") or (kind != "bvh" and v.bvh_only):
             continue
         source = Path(path)
         target = folder / f"{variant}_{source.name}"
-        (bvh_variant if kind == "bvh" else deepmimic_variant)(source, target, reverse, speed)
+        (bvh_variant if kind == "bvh" else deepmimic_variant)(source, target, v)
         out.append((f"{kind}:{target}", name))
     return out
 
@@ -84,7 +158,7 @@ def _run(job: tuple[str, str, int, str]) -> dict:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--variants", default="reversed", help="comma-separated: reversed, speedX (X > 0)")
+    ap.add_argument("--variants", default="reversed", help=f"comma-separated: {VARIANT_HELP}")
     ap.add_argument("--categories", default="walk,styled walk,uneven", help="comma-separated dev-suite categories")
     ap.add_argument("--seeds", type=int, default=2)
     ap.add_argument("--workers", type=int, default=2)
@@ -98,7 +172,7 @@ def main() -> None:
         try:
             parse_variant(v)
         except ValueError as exc:
-            raise SystemExit(f"unknown variant '{v}': reversed or speedX with X > 0") from exc
+            raise SystemExit(str(exc)) from exc
     categories = {c.strip() for c in args.categories.split(",")}
     versions = ("stylesync", FOLLOW_PATH_VERSION) if args.follow_path else ("stylesync",)
     with tempfile.TemporaryDirectory() as tmp:
