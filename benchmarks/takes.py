@@ -54,8 +54,9 @@ def summary(rows: list[dict]) -> str:
     uhc = [r["uhc_fall_time_s"] for r in ok if r["uhc_fall_time_s"] is not None]
     way = [r["path_progress"] for r in ok if r["path_progress"] is not None]
 
-    def median(values: list[float], fmt: str) -> str:
-        return format(statistics.median(values), fmt) if values else "-"
+    def median(values: list[float | None], fmt: str) -> str:
+        known = [v for v in values if v is not None]  # a run too short for a figure has none
+        return format(statistics.median(known), fmt) if known else "-"
 
     mpjpe_global = median([r["mpjpe_global_mm"] for r in ok], ".0f")
     mpjpe_root = median([r["mpjpe_root_mm"] for r in ok], ".0f")
