@@ -4,17 +4,21 @@
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 
 import numpy as np
 import pytest
 from conftest import suite_run
 
+from stylesync import session as session_module
 from stylesync.config import ControlConfig, MotionConfig, SessionConfig
 from stylesync.errors import ConfigError
 from stylesync.experiments import squat_jump
 from stylesync.experiments.common import run_session
+from stylesync.model.character import ANKLE_HEIGHT_M
 from stylesync.model.state import CONTACT_FORCE_N
 from stylesync.motion import pose_optimization
+from stylesync.motion.initial_state import initial_state
 from stylesync.session import FALL_ROOT_HEIGHT_M, Session
 from stylesync.sources.builtin_operator import sensed
 from stylesync.sources.human_model import HumanModel
@@ -66,3 +70,42 @@ def test_an_operator_who_lies_down_is_followed_to_the_ground(monkeypatch):
 def test_the_pelvis_floor_must_be_positive():
     with pytest.raises(ConfigError, match="pelvis_min_height_m"):
         MotionConfig(pelvis_min_height_m=0.0)
+
+
+_MOCAP = Path(__file__).resolve().parents[2] / "shared" / "mocap"
+_JUMP = _MOCAP / "cmu-dev" / "13_41.bvh"
+
+
+def _from_his_crouch(tmp_path: Path) -> Path:
+    """CMU-dev 13_41 (a jump) from 1.1 s on: its first frame is his crouch before the take-off, his trunk upright."""
+    head, motion = _JUMP.read_text().split("MOTION", 1)
+    lines = [ln for ln in motion.splitlines() if ln.strip()]
+    frame_time_s = float(lines[1].split(":", 1)[1])
+    frames = lines[2 + round(1.1 / frame_time_s):]
+    out = tmp_path / "13_41_from_crouch.bvh"
+    out.write_text(f"{head}MOTION\nFrames: {len(frames)}\nFrame Time: {frame_time_s}\n" + "\n".join(frames) + "\n")
+    return out
+
+
+@pytest.mark.skipif(not _JUMP.is_file(), reason="../shared/mocap/cmu-dev (CMU 13_41) is not present")
+def test_a_clip_that_starts_in_a_crouch_starts_above_the_fall_height(tmp_path, monkeypatch):
+    """A recording started in his first pose (motion/initial_state.py) puts the pelvis where his is, scaled: in this
+    crouch 0.48 m up, below the session's fall height, and the run counted a fall at 0.00 s. The start takes the
+    motion stage's floor too: the pelvis at 0.6 m, the legs stretched and both feet on the ground where his are, and
+    the run goes on (measured: it completes the clip and the rest on seeds 0 and 1)."""
+    clip = _from_his_crouch(tmp_path)
+    short = {"configure": lambda cfg: cfg.replace(duration_s=1.0)}
+    started = suite_run(f"bvh:{clip}", 0, MotionConfig(), ControlConfig(), **short)
+    assert not started.fell
+    pelvis_z = started.log.array("ch_joints")[:, 0, 2]
+    assert pelvis_z[0] == pytest.approx(MotionConfig().pelvis_min_height_m, abs=0.03)
+    ankles_z = [started.log.array(side)[0] for side in ("al_z", "ar_z")]
+    assert min(ankles_z) == pytest.approx(ANKLE_HEIGHT_M, abs=0.005)  # the lower foot on the ground
+    assert max(ankles_z) < ANKLE_HEIGHT_M + 0.03  # the other as far above it as his (measured: 0.023 m, as without)
+
+    def unfloored(*args):  # the start in his pose as it is, the floor left to the motion stage alone
+        return initial_state(*args[:5])
+
+    monkeypatch.setattr(session_module, "initial_state", unfloored)
+    as_his = suite_run(f"bvh:{clip}", 0, MotionConfig(), ControlConfig(), **short)
+    assert as_his.fell and as_his.fall_time_s < 0.05

@@ -269,7 +269,8 @@ class Session:
                 return False
             samples.append(processing.step(f.timestamp_s))
         s0, s1 = samples
-        init = initial_state(s0, analyse_operator(s0), s1, analyse_operator(s1), self.cfg.motion.pelvis_from_hip_joints)
+        init = initial_state(s0, analyse_operator(s0), s1, analyse_operator(s1), self.cfg.motion.pelvis_from_hip_joints,
+                             self.cfg.motion.pelvis_min_height_m)
         self.backend.reset(init.root_pos_world, init.root_quat_wxyz, init.joint_pos)
         ankle_z = self.backend.read_state(0.0).link_origin_world[_LEG_LINKS[:, 2], 2]
         root = init.root_pos_world + np.array([0.0, 0.0, ANKLE_HEIGHT_M + 0.002 - float(ankle_z.min())])

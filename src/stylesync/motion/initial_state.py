@@ -6,7 +6,9 @@ initialisation" answers the same problem in training). Here the first operator s
 stage does, without the character's state:
 
 - root: level, with the operator's heading H (Sec. 5.4), at the operator's pelvis over the ground, at the height of
-  Eq. 9 above the lower of his ankles;
+  Eq. 9 above the lower of his ankles, and, as the motion stage's pelvis target, no lower than
+  ``MotionConfig.pelvis_min_height_m`` while his trunk is upright (a clip that starts in a deep crouch starts the
+  character crouched above the session's fall height, its feet on the ground where his are);
 - legs: the leg IK of Sec. 5.3 in the motion plane N of each leg, each ankle where the operator's is relative to
   his pelvis, scaled (h_C / h_H, Eq. 9), never below the ground; feet flat with the operator's foot heading;
 - upper body: the joint map (as the motion stage).
@@ -33,7 +35,7 @@ from stylesync.model.character import (
 )
 from stylesync.motion.leg_ik import solve_leg
 from stylesync.motion.operator_analysis import OperatorAnalysis
-from stylesync.motion.pose_optimization import CHAR_LEG_LENGTH_M, joint_targets, map_upper_body
+from stylesync.motion.pose_optimization import CHAR_LEG_LENGTH_M, joint_targets, map_upper_body, trunk_upright
 from stylesync.processing.body_parameters import operator_pelvis_world
 from stylesync.processing.operator_processing import OperatorSample
 
@@ -55,11 +57,14 @@ class InitialState:
 
 
 def retargeted_pose(s: OperatorSample, analysis: OperatorAnalysis, scale: float | None = None,
-                    from_hip_joints: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                    from_hip_joints: bool = False, pelvis_min_height_m: float | None = None
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(root position [m], root quaternion, joint positions) of the character for one operator sample, the pelvis
     over the ground at the operator's, scaled by ``scale`` (default h_C / h_H of this sample, Eq. 9) from the world
     origin (differences of poses at one scale give velocities). His pelvis is the midpoint of his hip joints with
-    ``from_hip_joints`` (MotionConfig.pelvis_from_hip_joints), else his skeleton's pelvis joint."""
+    ``from_hip_joints`` (MotionConfig.pelvis_from_hip_joints), else his skeleton's pelvis joint. While his trunk is
+    upright the pelvis is no lower than ``pelvis_min_height_m`` (None: as low as his) [m], the ankles then where his
+    are over the ground (the legs stretched instead of the feet lifted)."""
     if scale is None:
         scale = CHAR_LEG_LENGTH_M / analysis.leg_m  # Eq. 9
     q_root = analysis.root_quat_wxyz
@@ -68,11 +73,17 @@ def retargeted_pose(s: OperatorSample, analysis: OperatorAnalysis, scale: float 
     ankles = {side: s.pos[f"ANKLE_{side.upper()}"] for side in ("left", "right")}
     ankle_h_z = min(a[2] for a in ankles.values())
     pelvis = np.array([scale * p_h[0], scale * p_h[1], ANKLE_HEIGHT_M + scale * (p_h[2] - ankle_h_z)])  # Eq. 9
+    raised = (pelvis_min_height_m is not None and pelvis[2] < pelvis_min_height_m
+              and trunk_upright(s.pos["NECK"] - p_h))
+    if raised:
+        pelvis[2] = pelvis_min_height_m  # as the motion stage's floor under his crouch
     local: dict[str, np.ndarray] = {}
     hinge: dict[str, float] = {}
     for side, sign in (("left", 1.0), ("right", -1.0)):
         hip = pelvis + R_root @ np.array([0.0, sign * HIP_HALF_WIDTH_M, 0.0])
         target = pelvis + scale * (ankles[side] - p_h)
+        if raised:
+            target[2] = ANKLE_HEIGHT_M + scale * (ankles[side][2] - ankle_h_z)  # where his is above the ground
         target[2] = max(target[2], ANKLE_HEIGHT_M)
         N = analysis.features.N_l if side == "left" else analysis.features.N_r
         ik = solve_leg(hip, target, THIGH_LENGTH_M, SHANK_LENGTH_M, N)
@@ -85,9 +96,9 @@ def retargeted_pose(s: OperatorSample, analysis: OperatorAnalysis, scale: float 
 
 
 def initial_state(s0: OperatorSample, a0: OperatorAnalysis, s1: OperatorSample, a1: OperatorAnalysis,
-                  from_hip_joints: bool = False) -> InitialState:
+                  from_hip_joints: bool = False, pelvis_min_height_m: float | None = None) -> InitialState:
     """The character's state at ``s0``, with velocities from the forward difference to ``s1`` (later); his pelvis
-    as :func:`retargeted_pose` takes it."""
+    and the pelvis's floor as :func:`retargeted_pose` takes them."""
     dt = s1.time_s - s0.time_s
     if not dt > 0:
         raise ValueError("initial_state needs a second sample later than the first")
@@ -95,8 +106,8 @@ def initial_state(s0: OperatorSample, a0: OperatorAnalysis, s1: OperatorSample, 
     # operator's leg length (Eq. 1) changes the scale from sample to sample by about 1 %, which alone would add some
     # 0.3 m/s to a forward difference over a 16 Hz frame.
     scale = CHAR_LEG_LENGTH_M / a0.leg_m
-    p0, q0, j0 = retargeted_pose(s0, a0, scale, from_hip_joints)
-    p1, q1, j1 = retargeted_pose(s1, a1, scale, from_hip_joints)
+    p0, q0, j0 = retargeted_pose(s0, a0, scale, from_hip_joints, pelvis_min_height_m)
+    p1, q1, j1 = retargeted_pose(s1, a1, scale, from_hip_joints, pelvis_min_height_m)
     q1 = rot.align_sign(q1, q0)
     ang_root = rot.rotvec_from_quat(rot.multiply(q1, rot.conjugate(q0))) / dt
     joint_vel = np.zeros((len(JOINTS), 3))

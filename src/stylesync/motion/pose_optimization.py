@@ -269,7 +269,7 @@ def _sole_within_m(state: CharacterState, side: str, gap_m: float) -> bool:
     return sole_within_m(state.link_origin_world[ankle], state.link_quat_wxyz[ankle], gap_m)
 
 
-def _trunk_upright(pelvis_to_neck: np.ndarray) -> bool:
+def trunk_upright(pelvis_to_neck: np.ndarray) -> bool:
     """Whether his trunk (the (3,) pelvis-to-neck vector, world, z up) is within CROUCH_TRUNK_MAX_DEG of vertical."""
     return bool(pelvis_to_neck[2] > _CROUCH_TRUNK_COS * np.linalg.norm(pelvis_to_neck))
 
@@ -668,7 +668,7 @@ class MotionOptimizer:
         if self._his_rise is not None:
             tick.pelvis_vel_z = self._his_rise.rise_mps(tick.pelvis_vel_z, tick.op_state is Stance.DS)
         floor_m = self.cfg.pelvis_min_height_m
-        if floor_m is not None and tick.pelvis_d[2] < floor_m and _trunk_upright(s.pos["NECK"] - p_h):
+        if floor_m is not None and tick.pelvis_d[2] < floor_m and trunk_upright(s.pos["NECK"] - p_h):
             # (lowered by the offset only as far as the floor: a crouch of his own below it is not the offset's)
             tick.pelvis_offset_m = min(0.0, floor_m - (float(tick.pelvis_d[2]) - offset_m))
             tick.pelvis_d[2] = floor_m  # his crouch followed down to the floor, above a fall's height
