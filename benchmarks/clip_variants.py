@@ -83,13 +83,16 @@ def _scaled_offsets(head: str, factor: float) -> str:
     return "\n".join(lines) + "\n"
 
 
-def bvh_variant(source: Path, target: Path, v: Variant) -> None:
-    """``source`` (BVH) written to ``target`` as the variant ``v``."""
+def bvh_variant(source: Path, target: Path, v: Variant) -> bool:
+    """``source`` (BVH) written to ``target`` as the variant ``v``; False (nothing written) where the cut leaves
+    fewer than two frames."""
     head, motion = source.read_text(errors="replace").split("MOTION", 1)
     lines = [ln for ln in motion.splitlines() if ln.strip()]
     recorded_s = float(lines[1].split(":", 1)[1])
     frames = lines[2:]
     kept = _kept([recorded_s] * len(frames), v)
+    if len(kept) < 2:
+        return False
     frames = [frames[k] for k in kept]
     frame_time_s = recorded_s * (kept[1] - kept[0] if len(kept) > 1 else 1) / v.speed
     if v.stature != 1.0:
@@ -100,9 +103,10 @@ def bvh_variant(source: Path, target: Path, v: Variant) -> None:
     frames = frames[::-1] if v.reverse else frames
     target.write_text(f"{head}MOTION\nFrames: {len(frames)}\nFrame Time: {frame_time_s:.8f}\n"
                       + "\n".join(frames) + "\n")
+    return True
 
 
-def deepmimic_variant(source: Path, target: Path, v: Variant) -> None:
+def deepmimic_variant(source: Path, target: Path, v: Variant) -> bool:
     """``source`` (DeepMimic) written to ``target`` as the variant ``v`` (not :attr:`Variant.bvh_only`): poses
     reversed (each frame's duration kept in its place: the last frame's is zero),
     durations divided by ``speed``, a kept frame lasting until the next kept one."""
@@ -116,6 +120,7 @@ def deepmimic_variant(source: Path, target: Path, v: Variant) -> None:
     for frame, duration in zip(frames, durations, strict=True):
         frame[0] = duration
     target.write_text(json.dumps({**clip, "Frames": frames}))
+    return True
 
 
 VARIANT_HELP = "reversed, speedX (X > 0), fromX (X >= 0 s), fpsN (N > 0), statureX (X > 0)"
@@ -137,7 +142,8 @@ def parse_variant(variant: str) -> Variant:
 
 
 def variant_specs(mocap: Path, categories: set[str], variant: str, folder: Path) -> list[tuple[str, str]]:
-    """(spec, name) of each recorded clip of ``categories`` as ``variant``, written into ``folder``."""
+    """(spec, name) of each recorded clip of ``categories`` as ``variant``, written into ``folder`` (a clip the
+    variant leaves fewer than two frames of is left out)."""
     v = parse_variant(variant)
     out = []
     for spec, name, category in clip_specs(mocap):
@@ -146,8 +152,8 @@ def variant_specs(mocap: Path, categories: set[str], variant: str, folder: Path)
             continue
         source = Path(path)
         target = folder / f"{variant}_{source.name}"
-        (bvh_variant if kind == "bvh" else deepmimic_variant)(source, target, v)
-        out.append((f"{kind}:{target}", name))
+        if (bvh_variant if kind == "bvh" else deepmimic_variant)(source, target, v):
+            out.append((f"{kind}:{target}", name))
     return out
 
 
