@@ -9,8 +9,10 @@ clips are the dev suite's own and are not varied) is written to a temporary file
 in reverse order: the same person walking backwards, facing forwards; a jump or a kick played back to front),
 ``speedX`` (its frame time divided by X: the same motion X times as fast, cadence and speed), ``fromX`` (its first X
 seconds cut off, BVH only: the same take started at another phase of its motion), ``fpsN`` (every k-th frame kept, k
-the nearest to the clip's rate over N: the same take captured at about N frames a second) or ``statureX`` (BVH only:
-every offset and position channel times X, a person X times as tall moving alike). Each variant runs with
+the nearest to the clip's rate over N: the same take captured at about N frames a second), ``statureX`` (BVH only:
+every offset and position channel times X, a person X times as tall moving alike) or ``yawX`` (BVH only, a Y-up
+file: the take turned X degrees about the vertical through the origin, its root's position and rotation channels
+turned, a walk in another direction of the room). Each variant runs with
 each sensor seed as the development suite runs a clip (``metrics.dev_suite.run_clip``), by default, and with
 ``--follow-path`` also with `--follow-path`. Prints per variant and mode the figures of ``takes.summary`` and each fall
 (docs/decisions.md, "A backward walk").
@@ -26,6 +28,7 @@ from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
+from scipy.spatial.transform import Rotation
 from takes import print_falls, summary
 
 from stylesync.metrics.dev_suite import FOLLOW_PATH_VERSION, clip_specs, run_clip
@@ -42,11 +45,13 @@ class Variant:
     cut_s: float = 0.0
     fps: float | None = None
     stature: float = 1.0
+    yaw_deg: float = 0.0
 
     @property
     def bvh_only(self) -> bool:
-        """A stature or a cut start: not for DeepMimic clips (the humanoid's own skeleton; a looping cycle)."""
-        return self.stature != 1.0 or self.cut_s > 0.0
+        """A stature, a cut start or a turn: not for DeepMimic clips (the humanoid's own skeleton; a looping
+        cycle; the clip's own root frame)."""
+        return self.stature != 1.0 or self.cut_s > 0.0 or self.yaw_deg != 0.0
 
 
 def _kept(durations_s: list[float], v: Variant) -> list[int]:
@@ -68,6 +73,31 @@ def _position_channels(head: str) -> list[int]:
             names = words[2:2 + int(words[1])]
             out += [k + i for i, name in enumerate(names) if name.lower().endswith("position")]
             k += len(names)
+    return out
+
+
+def _root_channels(head: str) -> list[str]:
+    """The root joint's channel names, in order."""
+    for line in head.splitlines():
+        words = line.split()
+        if words and words[0] == "CHANNELS":
+            return words[2:2 + int(words[1])]
+    raise ValueError("no CHANNELS line")
+
+
+def _turned(frame: list[str], channels: list[str], yaw_deg: float) -> list[str]:
+    """A BVH frame's values (Y-up) with its root turned ``yaw_deg`` about the vertical: the position channels
+    rotated, the root's rotation left-multiplied by the turn (its channels are intrinsic rotations in order)."""
+    turn = Rotation.from_euler("y", yaw_deg, degrees=True)
+    pos = [channels.index(f"{a}position") for a in "XYZ"]
+    angles = [k for k, name in enumerate(channels) if name.endswith("rotation")]
+    order = "".join(channels[k][0].upper() for k in angles)
+    out = list(frame)
+    for k, v in zip(pos, turn.apply([float(frame[k]) for k in pos]), strict=True):
+        out[k] = f"{v:.6f}"
+    root = turn * Rotation.from_euler(order, [float(frame[k]) for k in angles], degrees=True)
+    for k, v in zip(angles, root.as_euler(order, degrees=True), strict=True):
+        out[k] = f"{v:.6f}"
     return out
 
 
@@ -100,6 +130,9 @@ def bvh_variant(source: Path, target: Path, v: Variant) -> bool:
         head = _scaled_offsets(head, v.stature)
         frames = [" ".join(f"{float(w) * v.stature:.6f}" if i in positions else w for i, w in enumerate(f.split()))
                   for f in frames]
+    if v.yaw_deg != 0.0:
+        channels = _root_channels(head)
+        frames = [" ".join(_turned(f.split(), channels, v.yaw_deg)) for f in frames]
     frames = frames[::-1] if v.reverse else frames
     target.write_text(f"{head}MOTION\nFrames: {len(frames)}\nFrame Time: {frame_time_s:.8f}\n"
                       + "\n".join(frames) + "\n")
@@ -123,20 +156,21 @@ def deepmimic_variant(source: Path, target: Path, v: Variant) -> bool:
     return True
 
 
-VARIANT_HELP = "reversed, speedX (X > 0), fromX (X >= 0 s), fpsN (N > 0), statureX (X > 0)"
+VARIANT_HELP = "reversed, speedX (X > 0), fromX (X >= 0 s), fpsN (N > 0), statureX (X > 0), yawX (X deg)"
 
 
 def parse_variant(variant: str) -> Variant:
     """The variant of a name (VARIANT_HELP); ValueError otherwise."""
     if variant == "reversed":
         return Variant(reverse=True)
-    for prefix, field in (("speed", "speed"), ("from", "cut_s"), ("fps", "fps"), ("stature", "stature")):
+    for prefix, field in (("speed", "speed"), ("from", "cut_s"), ("fps", "fps"), ("stature", "stature"),
+                          ("yaw", "yaw_deg")):
         if variant.startswith(prefix):
             try:
                 value = float(variant.removeprefix(prefix))
             except ValueError:
                 value = math.nan
-            if value > 0.0 or (field == "cut_s" and value == 0.0):
+            if value > 0.0 or (field == "cut_s" and value == 0.0) or (field == "yaw_deg" and math.isfinite(value)):
                 return Variant(**{field: value})
     raise ValueError(f"unknown variant '{variant}': {VARIANT_HELP}")
 
