@@ -24,6 +24,7 @@ import argparse
 import json
 import math
 import tempfile
+import warnings
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
@@ -96,7 +97,10 @@ def _turned(frame: list[str], channels: list[str], yaw_deg: float) -> list[str]:
     for k, v in zip(pos, turn.apply([float(frame[k]) for k in pos]), strict=True):
         out[k] = f"{v:.6f}"
     root = turn * Rotation.from_euler(order, [float(frame[k]) for k in angles], degrees=True)
-    for k, v in zip(angles, root.as_euler(order, degrees=True), strict=True):
+    with warnings.catch_warnings():  # at a gimbal lock one of the equal sets of angles: the rotation is the same
+        warnings.simplefilter("ignore", UserWarning)
+        euler = root.as_euler(order, degrees=True)
+    for k, v in zip(angles, euler, strict=True):
         out[k] = f"{v:.6f}"
     return out
 
