@@ -6,16 +6,18 @@ not a test).
 
 Each recorded clip of the chosen categories of ``../shared/mocap`` (BVH and DeepMimic files; the built-in humanoid3d
 clips are the dev suite's own and are not varied) is written to a temporary file as a variant: ``reversed`` (its frames
-in reverse order: the same person walking backwards, facing forwards; a jump or a kick played back to front),
-``speedX`` (its frame time divided by X: the same motion X times as fast, cadence and speed), ``fromX`` (its first X
-seconds cut off, BVH only: the same take started at another phase of its motion), ``fpsN`` (every k-th frame kept, k
-the nearest to the clip's rate over N: the same take captured at about N frames a second), ``statureX`` (BVH only:
-every offset and position channel times X, a person X times as tall moving alike) or ``yawX`` (BVH only, a Y-up
-file: the take turned X degrees about the vertical through the origin, its root's position and rotation channels
-turned, a walk in another direction of the room). Each variant runs with
-each sensor seed as the development suite runs a clip (``metrics.dev_suite.run_clip``), by default, and with
-``--follow-path`` also with `--follow-path`. Prints per variant and mode the figures of ``takes.summary`` and each fall
-(docs/decisions.md, "A backward walk").
+in reverse order: the same person walking backwards, facing forwards; a jump or a kick played back to front), ``speedX``
+(its frame time divided by X: the same motion X times as fast, cadence and speed), ``fromX`` (its first X seconds cut
+off, BVH only: the same take started at another phase of its motion), ``fpsN`` (every k-th frame kept, k the nearest to
+the clip's rate over N: the same take captured at about N frames a second), ``statureX`` (BVH only: every offset and
+position channel times X, a person X times as tall moving alike), ``yawX`` (BVH only, a Y-up file: the take turned X
+degrees about the vertical through the origin, its root's position and rotation channels turned, a walk in another
+direction of the room) or ``turnX`` (BVH only, a Y-up file: the take bent into a turn of X degrees a second, each
+frame's root displacement over the ground and its rotation turned by the angle reached then: a straight walk becomes a
+circle, a planted foot sliding a little, as `--turn-rate` bends the built-in walk). Each variant runs with each sensor
+seed as the development suite runs a clip (``metrics.dev_suite.run_clip``), by default, and with ``--follow-path`` also
+with `--follow-path`. Prints per variant and mode the figures of ``takes.summary`` and each fall (docs/decisions.md, "A
+backward walk").
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 from scipy.spatial.transform import Rotation
 from takes import print_falls, summary
 
@@ -47,12 +50,13 @@ class Variant:
     fps: float | None = None
     stature: float = 1.0
     yaw_deg: float = 0.0
+    turn_deg_s: float = 0.0
 
     @property
     def bvh_only(self) -> bool:
         """A stature, a cut start or a turn: not for DeepMimic clips (the humanoid's own skeleton; a looping
         cycle; the clip's own root frame)."""
-        return self.stature != 1.0 or self.cut_s > 0.0 or self.yaw_deg != 0.0
+        return self.stature != 1.0 or self.cut_s > 0.0 or self.yaw_deg != 0.0 or self.turn_deg_s != 0.0
 
 
 def _kept(durations_s: list[float], v: Variant) -> list[int]:
@@ -86,15 +90,17 @@ def _root_channels(head: str) -> list[str]:
     raise ValueError("no CHANNELS line")
 
 
-def _turned(frame: list[str], channels: list[str], yaw_deg: float) -> list[str]:
+def _turned(frame: list[str], channels: list[str], yaw_deg: float, position: np.ndarray | None = None) -> list[str]:
     """A BVH frame's values (Y-up) with its root turned ``yaw_deg`` about the vertical: the position channels
-    rotated, the root's rotation left-multiplied by the turn (its channels are intrinsic rotations in order)."""
+    rotated (or set to ``position``, file units), the root's rotation left-multiplied by the turn (its channels are
+    intrinsic rotations in order)."""
     turn = Rotation.from_euler("y", yaw_deg, degrees=True)
     pos = [channels.index(f"{a}position") for a in "XYZ"]
     angles = [k for k, name in enumerate(channels) if name.endswith("rotation")]
     order = "".join(channels[k][0].upper() for k in angles)
     out = list(frame)
-    for k, v in zip(pos, turn.apply([float(frame[k]) for k in pos]), strict=True):
+    moved = turn.apply([float(frame[k]) for k in pos]) if position is None else position
+    for k, v in zip(pos, moved, strict=True):
         out[k] = f"{v:.6f}"
     root = turn * Rotation.from_euler(order, [float(frame[k]) for k in angles], degrees=True)
     with warnings.catch_warnings():  # at a gimbal lock one of the equal sets of angles: the rotation is the same
@@ -102,6 +108,24 @@ def _turned(frame: list[str], channels: list[str], yaw_deg: float) -> list[str]:
         euler = root.as_euler(order, degrees=True)
     for k, v in zip(angles, euler, strict=True):
         out[k] = f"{v:.6f}"
+    return out
+
+
+def _bent(frames: list[str], channels: list[str], deg_per_frame: float) -> list[str]:
+    """BVH frames (Y-up) bent into a turn: frame k's root turned by k ``deg_per_frame`` about the vertical, its
+    displacement over the ground since the last frame turned by the same angle and added up (the height as
+    recorded)."""
+    pos = [channels.index(f"{a}position") for a in "XYZ"]
+    values = [f.split() for f in frames]
+    recorded = np.array([[float(f[k]) for k in pos] for f in values])
+    at = recorded[0].copy()
+    out = []
+    for k, f in enumerate(values):
+        if k:
+            step = Rotation.from_euler("y", k * deg_per_frame, degrees=True).apply(recorded[k] - recorded[k - 1])
+            at = at + step
+            at[1] = recorded[k, 1]
+        out.append(" ".join(_turned(f, channels, k * deg_per_frame, at)))
     return out
 
 
@@ -137,6 +161,8 @@ def bvh_variant(source: Path, target: Path, v: Variant) -> bool:
     if v.yaw_deg != 0.0:
         channels = _root_channels(head)
         frames = [" ".join(_turned(f.split(), channels, v.yaw_deg)) for f in frames]
+    if v.turn_deg_s != 0.0:
+        frames = _bent(frames, _root_channels(head), v.turn_deg_s * frame_time_s)
     frames = frames[::-1] if v.reverse else frames
     target.write_text(f"{head}MOTION\nFrames: {len(frames)}\nFrame Time: {frame_time_s:.8f}\n"
                       + "\n".join(frames) + "\n")
@@ -160,7 +186,8 @@ def deepmimic_variant(source: Path, target: Path, v: Variant) -> bool:
     return True
 
 
-VARIANT_HELP = "reversed, speedX (X > 0), fromX (X >= 0 s), fpsN (N > 0), statureX (X > 0), yawX (X deg)"
+VARIANT_HELP = ("reversed, speedX (X > 0), fromX (X >= 0 s), fpsN (N > 0), statureX (X > 0), yawX (X deg), "
+                "turnX (X deg/s)")
 
 
 def parse_variant(variant: str) -> Variant:
@@ -168,13 +195,14 @@ def parse_variant(variant: str) -> Variant:
     if variant == "reversed":
         return Variant(reverse=True)
     for prefix, field in (("speed", "speed"), ("from", "cut_s"), ("fps", "fps"), ("stature", "stature"),
-                          ("yaw", "yaw_deg")):
+                          ("yaw", "yaw_deg"), ("turn", "turn_deg_s")):
         if variant.startswith(prefix):
             try:
                 value = float(variant.removeprefix(prefix))
             except ValueError:
                 value = math.nan
-            if value > 0.0 or (field == "cut_s" and value == 0.0) or (field == "yaw_deg" and math.isfinite(value)):
+            signed = field in ("yaw_deg", "turn_deg_s")  # any finite angle or rate
+            if value > 0.0 or (field == "cut_s" and value == 0.0) or (signed and math.isfinite(value)):
                 return Variant(**{field: value})
     raise ValueError(f"unknown variant '{variant}': {VARIANT_HELP}")
 
