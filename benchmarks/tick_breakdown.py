@@ -4,10 +4,9 @@
 
 Runs the built-in clip headless as `stylesync demo` does (the operator side prefetched; with ``--motion-ahead`` as
 `stylesync demo --motion-ahead` does, the motion stage in its worker, whose calls are then not timed: motion_ahead.py)
-with a timer around each
-of the calls listed in PARTS, and prints each call's mean time per control tick [µs] and per call, beside the
-session's own stages. The same calls timed in a loop by themselves cost two to three times less: in the pipeline
-each runs after the engine and the other stages have evicted its data from the caches (docs/decisions.md, "The
+with a timer around each of the calls listed in PARTS, and prints each call's mean time per control tick [µs] and per
+call, beside the session's own stages. The same calls timed in a loop by themselves cost two to three times less: in the
+pipeline each runs after the engine and the other stages have evicted its data from the caches (docs/decisions.md, "The
 control tick on the model and the QP: where the time goes"). The timers add about 0.2 µs a call.
 """
 

@@ -86,13 +86,11 @@ def test_the_motion_stage_reads_the_last_ticks_state_and_this_ticks_operator():
 
 
 def test_by_default_the_motion_stage_reads_this_ticks_state_in_this_process():
-    refs, times = [], []
+    refs, times, children = [], [], []
     cfg = SessionConfig(duration_s=0.3, seed=1)
     source, _ = builtin_operator(cfg.operator, cfg.clocks, 1.3, cfg.seed)
-    session = Session(cfg, source, on_tick=lambda state, ref: (refs.append(ref), times.append(state.time_s)))
-    children = []
-    session.on_tick = lambda state, ref: (refs.append(ref), times.append(state.time_s),
-                                          children.append(len(multiprocessing.active_children())))
+    session = Session(cfg, source, on_tick=lambda state, ref: (refs.append(ref), times.append(state.time_s),
+                                                               children.append(len(multiprocessing.active_children()))))
     assert session.run().operator_prefetched
     assert [r.time_s for r in refs] == times
     assert max(children) == 1  # the operator side's worker alone
@@ -128,6 +126,7 @@ def test_a_motion_worker_that_dies_is_reported(monkeypatch):
         _session(2.0, ahead=True).run()
     assert not multiprocessing.active_children()
 
+
 def test_a_session_file_is_the_same_with_the_motion_stage_ahead(tmp_path):
     from stylesync.export.session_file import SessionRecorder, read_session
 
@@ -144,4 +143,3 @@ def test_a_session_file_is_the_same_with_the_motion_stage_ahead(tmp_path):
     ticks = read_session(tmp_path / "True.jsonl").ticks
     assert len(ticks) == len(lines[True]) - 1  # every tick's line, its operator reading included
     assert {t["operator_stance"] for t in ticks} >= {"DS", "LS", "RS"}
-

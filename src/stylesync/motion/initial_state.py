@@ -35,7 +35,7 @@ from stylesync.model.character import (
 )
 from stylesync.motion.leg_ik import solve_leg
 from stylesync.motion.operator_analysis import OperatorAnalysis
-from stylesync.motion.pose_optimization import CHAR_LEG_LENGTH_M, joint_targets, map_upper_body, trunk_upright
+from stylesync.motion.pose_optimization import CHAR_LEG_LENGTH_M, below_crouch_floor, joint_targets, map_upper_body
 from stylesync.processing.body_parameters import operator_pelvis_world
 from stylesync.processing.operator_processing import OperatorSample
 
@@ -73,8 +73,8 @@ def retargeted_pose(s: OperatorSample, analysis: OperatorAnalysis, scale: float 
     ankles = {side: s.pos[f"ANKLE_{side.upper()}"] for side in ("left", "right")}
     ankle_h_z = min(a[2] for a in ankles.values())
     pelvis = np.array([scale * p_h[0], scale * p_h[1], ANKLE_HEIGHT_M + scale * (p_h[2] - ankle_h_z)])  # Eq. 9
-    raised = (pelvis_min_height_m is not None and pelvis[2] < pelvis_min_height_m
-              and trunk_upright(s.pos["NECK"] - p_h))
+    raised = (pelvis_min_height_m is not None
+              and below_crouch_floor(pelvis[2], pelvis_min_height_m, s.pos["NECK"] - p_h))
     if raised:
         pelvis[2] = pelvis_min_height_m  # as the motion stage's floor under his crouch
     local: dict[str, np.ndarray] = {}

@@ -269,9 +269,16 @@ def _sole_within_m(state: CharacterState, side: str, gap_m: float) -> bool:
     return sole_within_m(state.link_origin_world[ankle], state.link_quat_wxyz[ankle], gap_m)
 
 
-def trunk_upright(pelvis_to_neck: np.ndarray) -> bool:
+def _trunk_upright(pelvis_to_neck: np.ndarray) -> bool:
     """Whether his trunk (the (3,) pelvis-to-neck vector, world, z up) is within CROUCH_TRUNK_MAX_DEG of vertical."""
     return bool(pelvis_to_neck[2] > _CROUCH_TRUNK_COS * np.linalg.norm(pelvis_to_neck))
+
+
+def below_crouch_floor(pelvis_z_m: float, floor_m: float, pelvis_to_neck: np.ndarray) -> bool:
+    """Whether a pelvis target at ``pelvis_z_m`` [m] is held up by the crouch's floor ``floor_m``
+    (MotionConfig.pelvis_min_height_m) [m]: below it while his trunk (pelvis to neck, world) is upright. The motion
+    stage's pelvis target and the start in his first pose (initial_state.py) both keep it."""
+    return pelvis_z_m < floor_m and _trunk_upright(pelvis_to_neck)
 
 
 class MotionOptimizer:
@@ -668,7 +675,7 @@ class MotionOptimizer:
         if self._his_rise is not None:
             tick.pelvis_vel_z = self._his_rise.rise_mps(tick.pelvis_vel_z, tick.op_state is Stance.DS)
         floor_m = self.cfg.pelvis_min_height_m
-        if floor_m is not None and tick.pelvis_d[2] < floor_m and trunk_upright(s.pos["NECK"] - p_h):
+        if floor_m is not None and below_crouch_floor(tick.pelvis_d[2], floor_m, s.pos["NECK"] - p_h):
             # (lowered by the offset only as far as the floor: a crouch of his own below it is not the offset's)
             tick.pelvis_offset_m = min(0.0, floor_m - (float(tick.pelvis_d[2]) - offset_m))
             tick.pelvis_d[2] = floor_m  # his crouch followed down to the floor, above a fall's height
