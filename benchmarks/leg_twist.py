@@ -39,7 +39,7 @@ def twist_figures(clip: str, seed: int, duration_s: float) -> str:
     def on_tick(state, ref) -> None:
         rows.append([state.time_s, *_twists_deg(state.joint_pos, joints), *_twists_deg(ref.joint_pos, joints)])
 
-    result, _ = run_suite_clip(clip, seed, duration_s, lambda session: on_tick)
+    result, _, _ = run_suite_clip(clip, seed, duration_s, lambda session: on_tick)
     a = np.abs(np.array(rows))
     if result.fell and result.fall_time_s is not None:
         a = a[a[:, 0] <= result.fall_time_s]

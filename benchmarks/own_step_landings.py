@@ -45,7 +45,7 @@ def landings(clip: str, seed: int, duration_s: float, window_s: float) -> str:
                               bool(np.any(np.abs(tau[k]) >= 0.999 * TORQUE_LIMIT[k, 0]))))
         return on_tick
 
-    result, planned_s = run_suite_clip(clip, seed, duration_s, on_tick_for)
+    result, planned_s, _ = run_suite_clip(clip, seed, duration_s, on_tick_for)
     end_s = result.fall_time_s if result.fell and result.fall_time_s is not None else planned_s
     seen = [t for t in ticks if t[0] >= end_s - window_s] if result.fell else ticks
     head = f"{clip} seed {seed}: " + (f"fell at {end_s:.2f} s, last {window_s:.1f} s" if result.fell

@@ -59,16 +59,16 @@ def resolve(clip: str) -> str:
 
 
 def run_suite_clip(clip: str, seed: int, duration_s: float,
-                   on_tick_for: Callable[[Session], Callable]) -> tuple[SessionResult, float]:
+                   on_tick_for: Callable[[Session], Callable]) -> tuple[SessionResult, float, float]:
     """Run ``clip`` with sensor seed ``seed`` as the development suite runs it, ``on_tick_for(session)`` called on
-    each control tick; the result and the run's planned duration [s]."""
+    each control tick; the result, the run's planned duration [s] and the time his clip ends [s]."""
     spec = resolve(clip)
     opened = open_source(spec, seed=seed, duration_s=duration_s)
-    cfg, _ = suite_config(spec, opened, seed, duration_s)
+    cfg, clip_end_s = suite_config(spec, opened, seed, duration_s)
     session = Session(cfg, opened.source)
     session.on_tick = on_tick_for(session)
     try:
-        return session.run(), cfg.duration_s
+        return session.run(), cfg.duration_s, clip_end_s
     finally:
         opened.source.close()
 
