@@ -5,11 +5,11 @@ figures; a tool for explaining why a walk falls behind its operator).
 
 Each argument is a development-suite clip (`stylesync bench --suite dev`: a humanoid3d clip or a file of
 ../shared/mocap) and a sensor seed, run as the suite runs it (benchmarks/trace_run.py). Over the run from ``--from``
-to the UHC termination (the field's end of an imitation run; to the run's end without one, or with ``--whole``), or
-to the end of his clip (``--whole``: how the walk goes on past the termination), each of the character's
-landings (a single stance of its ending) is put in one of two kinds: *with his*, the operator on both feet or on the
-other foot by then, and *before his*, the operator still on the same foot (its step landed before his: a step of its
-own, taken over at the reach limit). Per kind:
+to the UHC termination (the field's end of an imitation run; the run's end without one), or with ``--whole`` to the
+end of his clip (how the walk goes on past the termination), each of the character's landings (a single stance of
+its ending) is put in one of two kinds: *with his*, the operator on both feet or on the other foot by then, and
+*before his*, the operator still on the same foot (its step landed before his: a step of its own, mostly a swing taken
+over at the reach limit). Per kind:
 
     landings       how many
     speed lost     the character's COM speed along his way over the 0.05 s before the landing, less the least over
@@ -112,7 +112,11 @@ def gait_losses(clip: str, seed: int, duration_s: float, from_s: float, whole: b
     kinds = _landings(t, log.array("char_state").astype(int), log.array("op_state").astype(int), along_mps, k0, k1)
     tick_t = np.array([s[0] for s in shares])
     tick_share = np.array([s[1] for s in shares])[(tick_t >= t[k0]) & (tick_t < t[k1 - 1])]
-    speed = lambda xy: float(np.linalg.norm(xy[k1 - 1] - xy[k0]) / max(t[k1 - 1] - t[k0], 1e-9))  # noqa: E731
+
+    def speed(xy: np.ndarray) -> float:
+        """Straight-line speed over the window [m/s]."""
+        return float(np.linalg.norm(xy[k1 - 1] - xy[k0]) / max(t[k1 - 1] - t[k0], 1e-9))
+
     end = "no UHC termination" if uhc is None else f"UHC termination at {t[uhc]:.2f} s"
     end += f", measured {t[k0]:.2f}-{t[k1 - 1]:.2f} s"
     line = (f"{clip} seed {seed}: {end}; his speed {speed(his_com):.2f} m/s, the character's {speed(com):.2f} m/s\n"
