@@ -152,7 +152,7 @@ def bvh_variant(source: Path, target: Path, v: Variant) -> bool:
     if len(kept) < 2:
         return False
     frames = [frames[k] for k in kept]
-    frame_time_s = recorded_s * (kept[1] - kept[0] if len(kept) > 1 else 1) / v.speed
+    frame_time_s = recorded_s * (kept[1] - kept[0]) / v.speed
     if v.stature != 1.0:
         positions = set(_position_channels(head))
         head = _scaled_offsets(head, v.stature)
