@@ -343,6 +343,10 @@ class MotionConfig:
     # a recovery step's swing from now. Predicted for now, the capture point ran out of reach in the single stance
     # before the rule fired (docs/decisions.md, "A swing past its usual time: when it can land")
     recovery_overdue_swing_horizon: bool = True
+    # ... and while a late contact holds the reference (Sec. 5.1: he has landed, the character's swing foot has not):
+    # by the same rules, the held swing becomes the character's own step (off: a held swing lands where his did,
+    # whatever the capture point does, for up to late_contact_timeout_s)
+    recovery_in_late_contact: bool = False
     # ... and in the character's double stance, whatever the operator does: once its capture point has been outside
     # the support polygon of its soles (by more than the margin) for this many times his usual double stance, a
     # recovery step (he walks on, or stands on one foot, while the character waits for a lift-off of his that

@@ -105,7 +105,7 @@ class CharacterStanceFsm:
         ends at its contact, or ``timeout_s`` later, whatever the operator does meanwhile."""
         assert swing_side(self.state) is not None
         self._early_latched_for = None
-        self._holding = False
+        self._holding = self.hold_reference = False
         self.recovery_step, self._recovery_timeout_s = True, timeout_s
         self._recovery_start_s = time_s
 
