@@ -320,7 +320,7 @@ class MotionOptimizer:
         self._swing_decay = np.exp(-self.dt_s / SWING_BLEND_S)  # per tick
         self._last_xy: np.ndarray | None = None
         self._op_ankle_floor_z: float | None = None  # the operator's floor under his ankles [m]
-        self._held_landing_xy: np.ndarray | None = None  # his swing's landing as the last tick planned it [m]
+        self._planned_landing_xy: np.ndarray | None = None  # his swing's landing as the last tick planned it [m]
         self._op_ankle_ground_z: dict[str, float] = {}  # per side, his ankle's height when it last could bear weight
         self._hold_velocity: np.ndarray | None = None  # the desired COM velocity a late-contact hold began with
         self._hold_shift = np.zeros(2)  # the held targets' travel since the hold began [m]
@@ -1179,7 +1179,9 @@ class MotionOptimizer:
         the capture point (he stops on this step, the character cannot) becomes one at once: his foot, lowered as
         he comes to rest, would land it 0.3-0.5 s later while the capture point runs on. With
         ``recovery_on_reach_limit``, so does a swing that, held to his timing, would land when the capture point is
-        already out of a recovery step's reach (:meth:`_capture_beyond_reach_at_his_landing`)."""
+        already out of a recovery step's reach (:meth:`_capture_beyond_reach_at_his_landing`). With
+        ``recovery_in_late_contact`` these rules also take over a swing held for a late contact, unless his landing,
+        as the swing last planned it, would hold the capture point a recovery swing from now."""
         cfg = self.cfg
         sw = swing_side(tick.ch_state)
         overrun_s = cfg.recovery_swing_overrun * self._op_swing_s
@@ -1191,12 +1193,12 @@ class MotionOptimizer:
             return
         other = OTHER_SIDE[sw]
         stance_q = state.link_quat_wxyz[_LINK[f"{other}_ankle"]]
-        if self.char_fsm.hold_reference and self._held_landing_xy is not None:
+        if self.char_fsm.hold_reference and self._planned_landing_xy is not None:
             # A held swing (recovery_in_late_contact) lands where he did: taken over only if that landing would not
             # hold the capture point a recovery swing from now.
             _, xi_land = self.recovery.capture_landing(cfg.recovery_swing_s, tick.com_c, tick.com_vel_c,
                                                        tick.a_c[other], stance_q, tick.R_root_d, sw)
-            landing = np.array([*self._held_landing_xy, ANKLE_HEIGHT_M])
+            landing = np.array([*self._planned_landing_xy, ANKLE_HEIGHT_M])
             if stands_on(xi_land, tick.a_c[other], stance_q, landing, tick.R_root_d):
                 return
         if (overrun_s > 0.0 and cfg.recovery_on_reach_limit
@@ -1280,7 +1282,7 @@ class MotionOptimizer:
             if cfg.recovery_steps:
                 landing = self._stopping_landing(tick, state, side, xi_h, landing)
             tick.swing_landing_xy = landing[:2]
-            self._held_landing_xy = landing[:2].copy()
+            self._planned_landing_xy = landing[:2].copy()
             target[:2] = start + progress * (landing[:2] - start)
             if cfg.free_swing:  # a swing neither needs to land: his foot from the stance foot (a kick's strike)
                 if first_tick:
