@@ -25,6 +25,7 @@ from stylesync.config import (
     follow_path,
     free_swing,
     in_place,
+    late_contact_steps,
     no_track_rise,
     pelvis_joint,
 )
@@ -181,6 +182,7 @@ def _demo(args: argparse.Namespace) -> int:
                                                       "follow_path": args.follow_path,
                                                       "in_place": args.in_place,
                                                       "free_swing": args.free_swing,
+                                                      "late_contact_steps": args.late_contact_steps,
                                                       "pelvis_joint": args.pelvis_joint,
                                                       "track_rise": not args.no_track_rise,
                                                       "motion_ahead": args.motion_ahead}, args)
@@ -195,7 +197,7 @@ def _suite_operator(args: argparse.Namespace) -> OperatorConfig:
 
 def _motion_options(cfg: SessionConfig, args: argparse.Namespace) -> SessionConfig:
     """``cfg`` with the options asked for on the command line (--in-place, --follow-path, --free-swing,
-    --pelvis-joint, --no-track-rise)."""
+    --late-contact-steps, --pelvis-joint, --no-track-rise)."""
     if args.in_place and args.follow_path:
         raise ConfigError("--in-place and --follow-path contradict each other: give one of them")
     if args.in_place:
@@ -204,6 +206,8 @@ def _motion_options(cfg: SessionConfig, args: argparse.Namespace) -> SessionConf
         cfg = follow_path(cfg)
     if args.free_swing:
         cfg = free_swing(cfg)
+    if args.late_contact_steps:
+        cfg = late_contact_steps(cfg)
     if args.pelvis_joint:
         cfg = pelvis_joint(cfg)
     if args.no_track_rise:
@@ -241,6 +245,7 @@ def _run(args: argparse.Namespace) -> int:
                                                               "follow_path": args.follow_path,
                                                               "in_place": args.in_place,
                                                               "free_swing": args.free_swing,
+                                                              "late_contact_steps": args.late_contact_steps,
                                                               "pelvis_joint": args.pelvis_joint,
                                                               "track_rise": not args.no_track_rise,
                                                               "motion_ahead": args.motion_ahead,
@@ -377,6 +382,10 @@ def _add_session_args(p: argparse.ArgumentParser, out_default: str, realtime_hel
                    help="a swing foot follows the operator's while both stand balanced on the other foot, lifted "
                         "only with the weight over that ankle (a kick strikes); by default every swing goes to a "
                         "landing placed for balance")
+    p.add_argument("--late-contact-steps", action="store_true",
+                   help="a swing held for the operator's landing becomes a step of the character's own where that "
+                        "landing would not hold its balance (leaps on one foot, spins); the walks' transition delays "
+                        "grow (docs/decisions.md)")
     p.add_argument("--pelvis-joint", action="store_true",
                    help="his skeleton's pelvis joint as his pelvis and the character's pelvis at his height (the "
                         "settings before 2026-12-06); by default his pelvis is the midpoint of his hip joints and the "

@@ -1039,6 +1039,13 @@ FREE_SWING_MOTION: dict[str, Any] = {
 }
 
 
+# A swing held for a late contact taken over by the balance where his landing would not hold the capture point
+# (docs/decisions.md, "A late contact that the balance takes over"): `--late-contact-steps`.
+LATE_CONTACT_STEPS_MOTION: dict[str, Any] = {
+    "recovery_in_late_contact": True,
+}
+
+
 # His skeleton's pelvis joint as his pelvis and the pelvis target at his, scaled: the settings before 2026-12-06
 # (docs/decisions.md, "His pelvis at his hip joints", "His pelvis at his hip joints by default"): `--pelvis-joint`.
 PELVIS_JOINT_MOTION: dict[str, Any] = {
@@ -1055,6 +1062,11 @@ def pelvis_joint(cfg: SessionConfig) -> SessionConfig:
 def free_swing(cfg: SessionConfig) -> SessionConfig:
     """``cfg`` with FREE_SWING_MOTION."""
     return with_settings(cfg, motion=FREE_SWING_MOTION)
+
+
+def late_contact_steps(cfg: SessionConfig) -> SessionConfig:
+    """``cfg`` with LATE_CONTACT_STEPS_MOTION."""
+    return with_settings(cfg, motion=LATE_CONTACT_STEPS_MOTION)
 
 
 # The pelvis height's law without the operator's rise, the regulator alone (docs/decisions.md, "A jump's rise"):
