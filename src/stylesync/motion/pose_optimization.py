@@ -1282,7 +1282,7 @@ class MotionOptimizer:
             if cfg.recovery_steps:
                 landing = self._stopping_landing(tick, state, side, xi_h, landing)
             tick.swing_landing_xy = landing[:2]
-            self._planned_landing_xy = landing[:2].copy()
+            self._planned_landing_xy = tick.swing_landing_xy  # (a fresh array each tick, not changed after)
             target[:2] = start + progress * (landing[:2] - start)
             if cfg.free_swing:  # a swing neither needs to land: his foot from the stance foot (a kick's strike)
                 if first_tick:
