@@ -1017,15 +1017,23 @@ class MotionOptimizer:
         the character can stop where he does."""
         if not self._operator_stands(tick):
             return landing
-        other = OTHER_SIDE[side]
-        stance_q = state.link_quat_wxyz[_LINK[f"{other}_ankle"]]
+        stance_q = state.link_quat_wxyz[_LINK[f"{OTHER_SIDE[side]}_ankle"]]
         remaining_s = max(self._op_swing_s - (state.time_s - self._swing_t0_s), 0.0)
-        capture, xi_land = self.recovery.capture_landing(remaining_s, tick.com_c, tick.com_vel_c, tick.a_c[other],
-                                                         stance_q, tick.R_root_d, side)
-        if stands_on(xi_land, tick.a_c[other], stance_q, landing, tick.R_root_d):
+        capture, holds = self._landing_holds(tick, side, stance_q, landing, remaining_s)
+        if holds:
             return landing
         self._stopping_capture_side = side  # landed by a recovery step next tick (_land_overrun_swing)
         return capture
+
+    def _landing_holds(self, tick: _Tick, side: str, stance_quat_wxyz: np.ndarray, landing: np.ndarray,
+                       in_s: float) -> tuple[np.ndarray, bool]:
+        """The landing of a recovery step of ``side`` made ``in_s`` [s] from now (RecoveryStepper.capture_landing),
+        and whether the capture point it predicts for then stands on the stance sole and a sole at ``landing`` (3,)
+        [m] instead (recovery_step.stands_on)."""
+        other = OTHER_SIDE[side]
+        capture, xi_land = self.recovery.capture_landing(in_s, tick.com_c, tick.com_vel_c, tick.a_c[other],
+                                                         stance_quat_wxyz, tick.R_root_d, side)
+        return capture, stands_on(xi_land, tick.a_c[other], stance_quat_wxyz, landing, tick.R_root_d)
 
     def _recovery_step(self, tick: _Tick, state: CharacterState) -> None:
         """Ends a recovery step the stance FSM has ended; begins one when the character stands on both feet and its
@@ -1196,10 +1204,8 @@ class MotionOptimizer:
         if self.char_fsm.hold_reference and self._planned_landing_xy is not None:
             # A held swing (recovery_in_late_contact) lands where he did: taken over only if that landing would not
             # hold the capture point a recovery swing from now.
-            _, xi_land = self.recovery.capture_landing(cfg.recovery_swing_s, tick.com_c, tick.com_vel_c,
-                                                       tick.a_c[other], stance_q, tick.R_root_d, sw)
             landing = np.array([*self._planned_landing_xy, ANKLE_HEIGHT_M])
-            if stands_on(xi_land, tick.a_c[other], stance_q, landing, tick.R_root_d):
+            if self._landing_holds(tick, sw, stance_q, landing, cfg.recovery_swing_s)[1]:
                 return
         if (overrun_s > 0.0 and cfg.recovery_on_reach_limit
                 and self._capture_beyond_reach_at_his_landing(tick, state, sw, stance_q)):
