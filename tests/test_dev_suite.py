@@ -126,3 +126,79 @@ def test_the_dev_suite_runs_the_pelvis_joint_settings_beside_the_default(tmp_pat
     # starts)
     default, joint = (run_clip("builtin:walk", 0, 3.0, v) for v in ("stylesync", PELVIS_JOINT_VERSION))
     assert default["mpjpe_root_mm"] != joint["mpjpe_root_mm"]
+
+
+# A standing figure in a small BVH (centimetres, Y up, MotionBuilder names; T-pose rest, every rotation zero):
+# (name, parent, offset)
+_FIGURE = [("Hips", None, (0, 95, 0)), ("LeftUpLeg", "Hips", (10, 0, 0)), ("LeftLeg", "LeftUpLeg", (0, -42, 0)),
+           ("LeftFoot", "LeftLeg", (0, -42, 0)), ("LeftToeBase", "LeftFoot", (0, -5, 14)),
+           ("RightUpLeg", "Hips", (-10, 0, 0)), ("RightLeg", "RightUpLeg", (0, -42, 0)),
+           ("RightFoot", "RightLeg", (0, -42, 0)), ("RightToeBase", "RightFoot", (0, -5, 14)),
+           ("Spine", "Hips", (0, 25, 0)), ("Neck", "Spine", (0, 25, 0)), ("Head", "Neck", (0, 15, 0)),
+           ("LeftArm", "Spine", (18, 22, 0)), ("LeftForeArm", "LeftArm", (28, 0, 0)),
+           ("LeftHand", "LeftForeArm", (25, 0, 0)), ("RightArm", "Spine", (-18, 22, 0)),
+           ("RightForeArm", "RightArm", (-28, 0, 0)), ("RightHand", "RightForeArm", (-25, 0, 0))]
+
+
+def _standing_bvh(path, frames: int = 30):
+    def block(name: str, depth: int) -> list[str]:
+        _, parent, (x, y, z) = next(j for j in _FIGURE if j[0] == name)
+        pad, children = "  " * depth, [j[0] for j in _FIGURE if j[1] == name]
+        chans = "6 Xposition Yposition Zposition Zrotation Xrotation Yrotation" if parent is None else \
+            "3 Zrotation Xrotation Yrotation"
+        lines = [f"{pad}{'ROOT' if parent is None else 'JOINT'} {name}", f"{pad}{{", f"{pad}  OFFSET {x} {y} {z}",
+                 f"{pad}  CHANNELS {chans}"]
+        for child in children:
+            lines += block(child, depth + 1)
+        if not children:
+            lines += [f"{pad}  End Site", f"{pad}  {{", f"{pad}    OFFSET 0 5 0", f"{pad}  }}"]
+        return lines + [f"{pad}}}"]
+
+    row = " ".join(["0", "95", "0"] + ["0"] * (3 + 3 * (len(_FIGURE) - 1)))
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text("HIERARCHY\n" + "\n".join(block("Hips", 0)) + f"\nMOTION\nFrames: {frames}\n"
+                    "Frame Time: 0.0333333\n" + "\n".join([row] * frames) + "\n")
+    return path
+
+
+def test_your_own_clips_take_their_category_from_their_folders(tmp_path):
+    from stylesync.metrics.dev_suite import category_of_folder, user_clip_specs
+
+    mine = tmp_path / "mine"
+    for rel in ("walk/a.bvh", "Styled-Walk/slow/b.bvh", "misc/c.bvh"):
+        _standing_bvh(mine / rel)
+    (mine / "notes.md").write_text("not a clip")
+    specs = user_clip_specs(str(mine))
+    assert [(name, cat) for _, name, cat in specs] == [("Styled-Walk/slow/b", "styled walk"), ("misc/c", "other"),
+                                                       ("walk/a", "walk")]
+    assert all(spec.startswith("bvh:") and spec.endswith(".bvh") for spec, _, _ in specs)
+    assert [(n, c) for _, n, c in user_clip_specs(str(mine / "walk"))] == [("a", "walk")]  # the folder given is one
+    assert category_of_folder("styled_walk") == "styled walk" and category_of_folder("walks") is None
+
+
+def test_the_dev_suite_runs_your_own_clips(tmp_path, capsys):
+    mine = tmp_path / "mine"
+    _standing_bvh(mine / "jump" / "stand.bvh")
+    (mine / "jump" / "broken.bvh").write_text("HIERARCHY\nROOT Hips\n{\n")
+    out = tmp_path / "dev"
+    assert cli_main(["bench", "--suite", "dev", "--clips", str(mine), "--clips-only", "--seeds", "1",
+                     "--duration", "1.5", "--workers", "1", "--out", str(out)]) == 0
+    rows = json.loads((out / "dev_suite.json").read_text())
+    # named within the folder they share (mine/jump), whose name gives their category
+    assert {(r["clip"], r["version"]) for r in rows} == {(c, v) for c in ("stand", "broken")
+                                                        for v in ("stylesync", "plain-pd")}
+    assert all(r["category"] == "jump" for r in rows)
+    assert all(("error" in r) == (r["clip"] == "broken") for r in rows)
+    stand = next(r for r in rows if r["clip"] == "stand" and r["version"] == "stylesync")
+    assert not stand["fell"] and stand["sim_duration_s"] > 0
+    md = (out / "dev_suite.md").read_text()
+    assert "| jump | stylesync | 1 | 1 |" not in md and "| jump | stylesync | 2 | 1 |" in md  # 2 runs, 1 opened
+
+
+def test_own_clips_options_are_checked_in_one_line(tmp_path, capsys):
+    for argv, word in ((["--suite", "dev", "--clips-only"], "--clips"),
+                       (["--suite", "dev", "--clips", str(tmp_path / "none")], "none"),
+                       (["--clips", str(tmp_path)], "--clips")):
+        assert cli_main(["bench", *argv, "--out", str(tmp_path / "o")]) == 2
+        err = capsys.readouterr().err.strip()
+        assert err.startswith("stylesync: error:") and word in err and "\n" not in err

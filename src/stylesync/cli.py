@@ -298,7 +298,9 @@ def _bench(args: argparse.Namespace) -> int:
             ORDER,
             PELVIS_JOINT_VERSION,
             SUITE_CONTROLLERS,
+            clip_specs,
             run_dev_suite,
+            user_clip_specs,
         )
 
         only = tuple(c.strip() for c in args.only.split(",") if c.strip()) if args.only else ()
@@ -310,11 +312,16 @@ def _bench(args: argparse.Namespace) -> int:
         versions = tuple(v for v, given in ((FOLLOW_PATH_VERSION, args.follow_path), (IN_PLACE_VERSION, args.in_place),
                                             (PELVIS_JOINT_VERSION, args.pelvis_joint)) if given)
         controllers = (*SUITE_CONTROLLERS[:1], *versions, *SUITE_CONTROLLERS[1:])
+        if args.clips_only and not args.clips:
+            raise ConfigError("--clips-only needs --clips")
+        own = [spec for given in args.clips or () for spec in user_clip_specs(given)]
+        clips = own if args.clips_only else [*clip_specs(mocap if mocap.is_dir() else None), *own]
         report = run_dev_suite(Path(args.out), args.seeds, args.duration, mocap if mocap.is_dir() else None, only,
                                controllers=controllers, workers=args.workers, executor=args.executor,
-                               first_seed=args.seed, operator=_suite_operator(args))
+                               first_seed=args.seed, operator=_suite_operator(args), clips=clips)
     else:
-        for flag, given in (("--mirror", args.mirror), ("--sensor-noise", args.sensor_noise != 1.0),
+        for flag, given in (("--clips", bool(args.clips)), ("--clips-only", args.clips_only),
+                            ("--mirror", args.mirror), ("--sensor-noise", args.sensor_noise != 1.0),
                             ("--follow-path", args.follow_path), ("--in-place", args.in_place),
                             ("--pelvis-joint", args.pelvis_joint)):
             if given:
@@ -537,6 +544,12 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--seeds", type=typed.integer(1, 1000), default=2,
                        help="dev suite: sensor seeds SEED .. SEED+N-1")
     bench.add_argument("--only", help="dev suite: comma-separated categories (default: all)")
+    bench.add_argument("--clips", action="append", metavar="INPUT",
+                       help="dev suite: also your own clips, as stylesync batch finds them (a folder searched "
+                            "recursively, a glob, a list file or a clip file; repeatable); a clip's category is the "
+                            "nearest folder named after one (e.g. mine/walk/a.bvh), otherwise 'other'")
+    bench.add_argument("--clips-only", action="store_true",
+                       help="dev suite: only the clips of --clips (not the humanoid3d and shared clips)")
     bench.add_argument("--mirror", action="store_true",
                        help="dev suite: every clip's mirror image (left and right swapped), a second sample of what "
                             "users bring")

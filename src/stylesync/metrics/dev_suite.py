@@ -60,6 +60,33 @@ PELVIS_JOINT_VERSION = "pelvis-joint"
 VERSION_SETTINGS = {FOLLOW_PATH_VERSION: follow_path, IN_PLACE_VERSION: in_place, PELVIS_JOINT_VERSION: pelvis_joint}
 
 
+def category_of_folder(name: str) -> str | None:
+    """The suite's category a folder's name gives (``walk``, ``styled_walk``, ``Styled-Walk``, ...), or None."""
+    key = " ".join(name.lower().replace("_", " ").replace("-", " ").split())
+    return key if key in ORDER else None
+
+
+def user_clip_specs(input_spec: str) -> list[tuple[str, str, str]]:
+    """(spec, name, category) of a user's own clips, found as `stylesync batch` finds them (batch/clips.find_clips:
+    a folder searched recursively, a glob pattern, a list file or one clip file; each file's source kind from its
+    suffix). Its name is its path without the suffix, relative to the folder the clips share; its category that of the
+    nearest folder around it, up to and including that shared folder, named after one (:func:`category_of_folder`:
+    ``mine/walk/a.bvh`` is a walk, and so is every clip of ``--clips mine/walk``), otherwise ``other``."""
+    import os
+
+    from stylesync.batch.clips import KIND_BY_SUFFIX, find_clips
+
+    files = find_clips(input_spec)
+    common = Path(os.path.commonpath([f.parent for f in files]))
+    out = []
+    for f in files:
+        rel = f.relative_to(common)
+        folders = (common.name, *rel.parts[:-1])  # outermost first
+        category = next((c for c in map(category_of_folder, reversed(folders)) if c is not None), "other")
+        out.append((f"{KIND_BY_SUFFIX[f.suffix.lower()]}:{f}", rel.with_suffix("").as_posix(), category))
+    return out
+
+
 def clip_specs(mocap: Path | None) -> list[tuple[str, str, str]]:
     """(spec, name, category) of every clip of the suite; ``mocap``: the shared mocap folder (or None)."""
     import pybullet_data
@@ -211,15 +238,17 @@ def table(rows: list[dict], versions: list[str]) -> str:
 
 def run_dev_suite(out: Path, seeds: int, duration_s: float, mocap: Path | None, only: tuple[str, ...] = (),
                   controllers: tuple[str, ...] = SUITE_CONTROLLERS, workers: int = 2,
-                  executor: str | None = None, first_seed: int = 0, operator: OperatorConfig | None = None) -> dict:
+                  executor: str | None = None, first_seed: int = 0, operator: OperatorConfig | None = None,
+                  clips: list[tuple[str, str, str]] | None = None) -> dict:
     """Run the suite on the sensor seeds ``first_seed`` .. ``first_seed + seeds - 1`` on the executors of
     parallel.py ("processes" by default, "ray", or "inline" when ``workers`` is 1), with ``operator``'s options if
-    given (every clip's mirror image, a noisier sensor: :func:`operator_variant`); writes dev_suite.md and
-    dev_suite.json under ``out`` and returns {"rows", "table"}."""
+    given (every clip's mirror image, a noisier sensor: :func:`operator_variant`), on ``clips`` ((spec, name,
+    category) each) if given instead of :func:`clip_specs`'s; writes dev_suite.md and dev_suite.json under ``out``
+    and returns {"rows", "table"}."""
     from stylesync.parallel import execute_all
 
     out.mkdir(parents=True, exist_ok=True)
-    clips = [c for c in clip_specs(mocap) if not only or c[2] in only]
+    clips = [c for c in (clip_specs(mocap) if clips is None else clips) if not only or c[2] in only]
     jobs = [(spec, name, cat, seed, ctrl, duration_s, operator) for spec, name, cat in clips
             for seed in range(first_seed, first_seed + seeds)
             for ctrl in controllers]
