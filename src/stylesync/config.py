@@ -787,6 +787,12 @@ class WholeBodyConfig:
     # the leg's posture (the operator's crouch or push-off, retargeted) drove the COM past the feet before jumps
     # (docs/decisions.md, "The supporting legs' posture")
     stance_leg_tracking_share: float = 0.1
+    # While the operator stands still (on both feet, his feet and his COM at rest) and the character stands on both
+    # soles, each sole is planned to bear at least this share of the body's weight (ramped down with its stance
+    # weight below the contacts' RAMP_WEIGHT). A sole his weight leaves all but unloaded otherwise pressed the ground
+    # on one control tick and not on the next, left the QP's contacts and came back, and slid; the character then
+    # stepped to put it back, again and again (docs/decisions.md, "A sole unloaded where he stands"). 0: off [-]
+    standing_sole_min_load_share: float = 0.1
     # The pelvis orientation task's weight in single stance, as a share of its weight on two feet. A swing leg driven
     # forward and up (a running stride) turns the pelvis the other way; a pelvis held level at full weight took that
     # acceleration from the swing leg, whose foot then went back instead of forward (docs/decisions.md, "The pelvis

@@ -109,6 +109,9 @@ class SoleContactBase(ABC):
         self.frame = SOLE_FRAMES[side]
         self.body_weight_n = body_weight_n
         self.stance_weight = 1.0  # set per tick: the share of the body this foot is meant to carry, [0, 1]
+        # set per tick: the least normal force planned for this sole, as a share of the body's weight at full stance
+        # weight (WholeBodyConfig.standing_sole_min_load_share) [-]
+        self.min_load_share = 0.0
         # Per tick, after update(): the generator (nv, n_forces), the sole's Jacobian (6, nv), drift (6,), corners
         # (4, 3).
         self.generator = np.zeros((0, 0))
@@ -148,6 +151,12 @@ class SoleContactBase(ABC):
     def max_normal_force_n(self) -> float:
         """Upper bound of the normal force [N], ramped down with the stance weight below RAMP_WEIGHT."""
         return MAX_NORMAL_FORCE_BODY_WEIGHTS * self.body_weight_n * min(1.0, self.stance_weight / RAMP_WEIGHT)
+
+    @property
+    def min_normal_force_n(self) -> float:
+        """Lower bound of the normal force [N]: ``min_load_share`` of the body's weight, ramped down with the stance
+        weight below RAMP_WEIGHT as the upper bound is."""
+        return self.min_load_share * self.body_weight_n * min(1.0, self.stance_weight / RAMP_WEIGHT)
 
     def constraint_rows(self, velocity_gain: float) -> tuple[np.ndarray, np.ndarray]:
         """The sole does not move: ``J q̈ = -J̇ q̇ - k_v J q̇`` (its residual velocity damped at ``velocity_gain``)."""

@@ -10,7 +10,8 @@ metric ``ε λᵀ (G Gᵀ)⁻¹ λ``). The problem is
            J_c q̈ + J̇_c q̇ = -k_v J_c q̇                          (each supporting sole stays where it is; a sole on
                                                                 its toes turns about its toe line, toe_contact.py)
            -τ_max <= M_j q̈ + h_j - (B λ)_j <= τ_max           (joint torque limits)
-           0 <= Σ n·f_c <= f_max(c)                            (each sole's normal force, ramped with its weight)
+           f_min(c) <= Σ n·f_c <= f_max(c)                     (each sole's normal force, ramped with its weight;
+                                                                f_min 0 but where he stands still)
            λ >= 0,  q̈_lo <= q̈_hinge <= q̈_hi                  (friction pyramids; hinge limits over a horizon)
 
 and the torques follow from the joint rows of the equations of motion, ``τ = M_j q̈ + h_j - (B λ)_j``.
@@ -172,6 +173,8 @@ class WholeBodyFormulation:
             normal = n_eq + n_tau + i
             rows[normal, sl] = c.normal_row
             upper[normal] = c.max_normal_force_n
+            if c.min_load_share > 0.0:
+                lower[normal] = c.min_normal_force_n
             k = len(c.force_rows)
             if not c.force_rows_constant:
                 rows[force_row:force_row + k, sl] = c.force_rows

@@ -213,6 +213,8 @@ class WholeBodyController(ControllerBase):
         contacts = [self.toe_contacts[s] if s in self.on_toes else self.contacts[s] for s in support]
         for c in contacts:
             c.stance_weight = w[c.side]
+            # Both soles loaded where he stands still (WholeBodyConfig.standing_sole_min_load_share)
+            c.min_load_share = wb.standing_sole_min_load_share if len(contacts) == 2 and ref.he_stands_still else 0.0
             c.update(model)  # its corners bound the force here; the formulation reads the rest of it
         force = feasible_horizontal_force(force, com, [c.corners_world for c in contacts], m, self.g)
         e_root = root_orientation_error(ref.root_quat_wxyz, state.root_quat_wxyz)

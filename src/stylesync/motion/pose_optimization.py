@@ -635,8 +635,7 @@ class MotionOptimizer:
                 pelvis_xy[:2] += pull
                 com_xy[:2] += pull
         tick.he_stands = self._he_stands(state, scale, tick.op_state)
-        if self.cfg.rest_step_min_m is not None:
-            tick.his_feet_still = self._his_feet_still(a_hs, scale)
+        tick.his_feet_still = self._his_feet_still(a_hs, scale)  # (the rest steps; ReferencePose.he_stands_still)
         tau = self.cfg.reference_follows_operator_s
         if tau > 0:
             # The targets advance at the operator's COM velocity (scaled), pulled towards the anchored ones with time
@@ -1435,6 +1434,7 @@ class MotionOptimizer:
         self.reading = MotionReading(tick.op_state, tick.analysis.features, self.char_fsm.hold_reference, tick.scale,
                                      tick.step_exceeded)
         own = tick.swing if self.char_fsm.recovery_step else None  # the swing side of a step of the character's own
+        his_speed = tick.scale * float(np.hypot(tick.com_vel_h[0], tick.com_vel_h[1]))  # his COM's, scaled [m/s]
         step = self.recovery.step
         return ReferencePose(
             time_s=state.time_s, joint_pos=joint_pos, root_quat_wxyz=tick.q_root_d, pelvis_world=tick.pelvis_d,
@@ -1444,8 +1444,8 @@ class MotionOptimizer:
             recovery_ankle_vel_world=None if own is None or step is None else {own: step.target_vel_world},
             recovery_while_he_stands=self.char_fsm.recovery_step and self._operator_stands(tick),
             pelvis_vel_z_mps=tick.pelvis_vel_z,
-            his_way_speed_mps=min(float(np.hypot(*self.way.velocity_world[:2])),
-                                  tick.scale * float(np.hypot(tick.com_vel_h[0], tick.com_vel_h[1]))),
+            his_way_speed_mps=min(float(np.hypot(*self.way.velocity_world[:2])), his_speed),
+            he_stands_still=tick.op_state is Stance.DS and tick.his_feet_still and his_speed < _STANDING_SPEED_MPS,
         )
 
     @staticmethod
