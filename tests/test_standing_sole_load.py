@@ -1,4 +1,4 @@
-"""Both soles loaded where he stands still (WholeBodyConfig.standing_sole_min_load_share).
+"""Both soles loaded where he stands still (WholeBodyConfig.standing_sole_min_load_share, opt-in).
 
 A person standing with his weight over one foot leaves the character's other sole all but unloaded: its contact force
 crossed the pressing threshold up and down from one control tick to the next, the sole left the QP's contacts and came
@@ -41,12 +41,13 @@ def _weight_on_one_foot(share: float, seed: int = 0, on_tick=None) -> dict:
 
 
 def test_a_sole_his_weight_leaves_stays_loaded_and_the_character_stands():
-    default = _weight_on_one_foot(SessionConfig().control.whole_body.standing_sole_min_load_share)
+    assert SessionConfig().control.whole_body.standing_sole_min_load_share == 0.0  # opt-in
+    loaded = _weight_on_one_foot(0.1)
     off = _weight_on_one_foot(0.0)
-    assert not default["fell"] and not off["fell"]
-    assert default["operator_steps"] == off["operator_steps"] == 0
+    assert not loaded["fell"] and not off["fell"]
+    assert loaded["operator_steps"] == off["operator_steps"] == 0
     assert off["character_steps"] >= 5  # without the bound: the unloaded sole slides, and is stepped back, again
-    assert default["character_steps"] <= 1
+    assert loaded["character_steps"] <= 1
 
 
 def test_the_planned_normal_forces_keep_the_bound_while_he_stands_still():

@@ -61,8 +61,8 @@ _REF, REF_WIDTH = row_layout([
     ("time_s", 1), ("joint_pos", 4 * _NJ), ("root_quat", 4), ("pelvis", 3), ("com", 3), ("com_vel", 3),
     ("stance", 1), ("weight", 2), ("ankle", 6), ("lipm", 9), ("press", 1), ("hand", 7),
     ("own_ankle", 9), ("own_ankle_vel", 9), ("while_he_stands", 1), ("pelvis_vel_z", 1), ("way_speed", 1),
-    ("op_stance", 1), ("features", len(ROW_NAMES)), ("held", 1), ("scale", 1), ("step_exceeded", 1),
-    ("bound_count", 1)])
+    ("stands_still", 1), ("op_stance", 1), ("features", len(ROW_NAMES)), ("held", 1), ("scale", 1),
+    ("step_exceeded", 1), ("bound_count", 1)])
 
 
 def pack_state(state: CharacterState) -> np.ndarray:
@@ -152,6 +152,7 @@ def pack_reference(ref: ReferencePose, reading: MotionReading, bound_count: int)
     row[_REF["while_he_stands"]] = float(ref.recovery_while_he_stands)
     row[_REF["pelvis_vel_z"]] = ref.pelvis_vel_z_mps
     row[_REF["way_speed"]] = ref.his_way_speed_mps
+    row[_REF["stands_still"]] = float(ref.he_stands_still)
     row[_REF["op_stance"]] = _STANCES.index(reading.operator_stance)
     row[_REF["features"]] = reading.operator_features.as_row()
     row[_REF["held"]] = float(reading.held)
@@ -185,6 +186,7 @@ def unpack_reference(row: np.ndarray) -> tuple[ReferencePose, MotionReading, int
         recovery_while_he_stands=bool(row[_REF["while_he_stands"]][0]),
         pelvis_vel_z_mps=float(row[_REF["pelvis_vel_z"]][0]),
         his_way_speed_mps=float(row[_REF["way_speed"]][0]),
+        he_stands_still=bool(row[_REF["stands_still"]][0]),
     )
     reading = MotionReading(_STANCES[int(row[_REF["op_stance"]][0])],
                             StyleFeatures.from_row(row[_REF["features"]].copy()), bool(row[_REF["held"]][0]),

@@ -67,14 +67,15 @@ def category_of_folder(name: str) -> str | None:
 
 
 def user_clip_specs(input_spec: str) -> list[tuple[str, str, str]]:
-    """(spec, name, category) of a user's own clips, found as `stylesync batch` finds them (batch/clips.find_clips:
-    a folder searched recursively, a glob pattern, a list file or one clip file; each file's source kind from its
-    suffix). Its name is its path without the suffix, relative to the folder the clips share; its category that of the
-    nearest folder around it, up to and including that shared folder, named after one (:func:`category_of_folder`:
-    ``mine/walk/a.bvh`` is a walk, and so is every clip of ``--clips mine/walk``), otherwise ``other``."""
+    """(spec, name, category) of a user's own clips, found as `stylesync batch` finds them
+    (sources/clip_files.find_clips: a folder searched recursively, a glob pattern, a list file or one clip file;
+    each file's source kind from its suffix). Its name is its path without the suffix, relative to the folder the
+    clips share; its category that of the nearest folder around it, up to and including that shared folder, named
+    after one (:func:`category_of_folder`: ``mine/walk/a.bvh`` is a walk, and so is every clip of ``--clips
+    mine/walk``), otherwise ``other``."""
     import os
 
-    from stylesync.batch.clips import KIND_BY_SUFFIX, find_clips
+    from stylesync.sources.clip_files import KIND_BY_SUFFIX, find_clips
 
     files = find_clips(input_spec)
     common = Path(os.path.commonpath([f.parent for f in files]))
