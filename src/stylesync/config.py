@@ -792,8 +792,8 @@ class WholeBodyConfig:
     # weight below the contacts' RAMP_WEIGHT). A sole his weight leaves all but unloaded otherwise pressed the ground
     # on one control tick and not on the next, left the QP's contacts and came back, and slid; the character then
     # stepped to put it back, again and again (docs/decisions.md, "A sole unloaded where he stands"). Off (0) by
-    # default: 0.1 measured as well as the default on the development suite, but it holds back weight shifts that a
-    # step to where he stands and a kick's lift-off begin from his stand with [-]
+    # default: 0.1 measured as well as the default on the development suite, but it holds back the character's own
+    # weight shift before a step to where he stands, which begins while he still stands [-]
     standing_sole_min_load_share: float = 0.0
     # The pelvis orientation task's weight in single stance, as a share of its weight on two feet. A swing leg driven
     # forward and up (a running stride) turns the pelvis the other way; a pelvis held level at full weight took that

@@ -11,7 +11,8 @@ end), runs without a UHC/PHC termination, mean fall time, MPJPE (global, root-re
 operator) and the median of the runs' largest transition delays; then, per category, the runs each version
 completes and the other does not, with the p-value of the difference (paired_outcomes.py). Written as
 dev_suite.md, dev_suite.json and report.html. The previous version of the code in the same run:
-``benchmarks/dev_suite.py --baseline REF`` (git worktrees).
+``benchmarks/dev_suite.py --baseline REF`` (git worktrees). A user's own clips beside them or alone
+(``--clips INPUT [--clips-only]``): :func:`user_clip_specs`.
 """
 
 from __future__ import annotations
