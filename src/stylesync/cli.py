@@ -307,7 +307,7 @@ def _bench(args: argparse.Namespace) -> int:
         unknown = [c for c in only if c not in ORDER]
         if unknown:
             raise ConfigError(f"unknown categories {', '.join(unknown)}; expected some of {', '.join(ORDER)}")
-        mocap = shared / "mocap"
+        mocap = shared / "mocap" if (shared / "mocap").is_dir() else None
         # the follow-path and in-place versions beside stylesync's (the first), before the baselines
         versions = tuple(v for v, given in ((FOLLOW_PATH_VERSION, args.follow_path), (IN_PLACE_VERSION, args.in_place),
                                             (PELVIS_JOINT_VERSION, args.pelvis_joint)) if given)
@@ -315,8 +315,8 @@ def _bench(args: argparse.Namespace) -> int:
         if args.clips_only and not args.clips:
             raise ConfigError("--clips-only needs --clips")
         own = [spec for given in args.clips or () for spec in user_clip_specs(given)]
-        clips = own if args.clips_only else [*clip_specs(mocap if mocap.is_dir() else None), *own]
-        report = run_dev_suite(Path(args.out), args.seeds, args.duration, mocap if mocap.is_dir() else None, only,
+        clips = own if args.clips_only else [*clip_specs(mocap), *own]
+        report = run_dev_suite(Path(args.out), args.seeds, args.duration, mocap, only,
                                controllers=controllers, workers=args.workers, executor=args.executor,
                                first_seed=args.seed, operator=_suite_operator(args), clips=clips)
     else:
