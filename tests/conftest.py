@@ -38,9 +38,11 @@ TRACED_DIFFERENCED = ControlConfig(whole_body=WholeBodyConfig(recovery_foot_targ
                                                               pelvis_rate_share=0.0, press_double_stance_feet=False,
                                                               own_step_push_bound="he_stands"))
 # Scenarios traced before a double stance's foot off the ground was pressed down whatever its stance weight
-# (WholeBodyConfig.press_double_stance_feet): their runs part from the traced ones where such a foot rose.
+# (WholeBodyConfig.press_double_stance_feet): their runs part from the traced ones where such a foot rose. (Traced
+# before the standing soles' load bound too: standing_sole_min_load_share 0.)
 TRACED_BEFORE_PRESS = ControlConfig(whole_body=WholeBodyConfig(press_double_stance_feet=False,
-                                                               own_step_push_bound="he_stands"))
+                                                               own_step_push_bound="he_stands",
+                                                               standing_sole_min_load_share=0.0))
 
 
 # Scenarios traced with his skeleton's pelvis joint as his pelvis and the pelvis target at his (scaled), the
@@ -53,6 +55,9 @@ TRACED_BEFORE_PRESS = ControlConfig(whole_body=WholeBodyConfig(press_double_stan
 # Scenarios traced while the operator's heading was his pelvis's forward axis's in every pose (rotations.yaw_from_quat,
 # before 2026-12-06; docs/decisions.md, "The operator's heading where his trunk bends over"): the tests that run them
 # carry the forward_heading marker.
+# Scenarios traced while a sole his weight leaves where he stands could be planned unloaded
+# (WholeBodyConfig.standing_sole_min_load_share 0, the default before 2026-12-07; docs/decisions.md, "A sole unloaded
+# where he stands"): the tests that run them carry the unloaded_standing_sole marker.
 
 
 def pytest_configure(config):
@@ -67,6 +72,9 @@ def pytest_configure(config):
                                        "MotionConfig made during the test defaults to that")
     config.addinivalue_line("markers", "forward_heading: a scenario traced while the operator's heading was his "
                                        "pelvis's forward axis's in every pose (rotations.yaw_from_quat)")
+    config.addinivalue_line("markers", "unloaded_standing_sole: a scenario traced while a standing sole could be "
+                                       "planned unloaded: every WholeBodyConfig made during the test defaults to "
+                                       "standing_sole_min_load_share 0")
 
 
 def _set_defaults(monkeypatch, cls: type, values: dict) -> None:
@@ -84,7 +92,8 @@ def _traced_defaults(request, monkeypatch):
     """Under the ``in_place`` marker, the defaults of MotionConfig, WholeBodyConfig and OperatorConfig are those of
     config.in_place (and PELVIS_JOINT_MOTION's) for the test's duration; under ``pelvis_joint``, MotionConfig's are
     PELVIS_JOINT_MOTION's too; under ``lowered_takeover``, its recovery_takeover_low_foot_m is None (what a test sets
-    explicitly stays as it sets it); under ``forward_heading``, the operator's heading is rotations.yaw_from_quat."""
+    explicitly stays as it sets it); under ``forward_heading``, the operator's heading is rotations.yaw_from_quat; under
+    ``unloaded_standing_sole``, WholeBodyConfig's standing_sole_min_load_share is 0."""
     motion: dict = {}
     if request.node.get_closest_marker("pelvis_joint") is not None:
         motion.update(PELVIS_JOINT_MOTION)
@@ -97,6 +106,8 @@ def _traced_defaults(request, monkeypatch):
         motion["recovery_takeover_low_foot_m"] = None
     if motion:
         _set_defaults(monkeypatch, MotionConfig, motion)
+    if request.node.get_closest_marker("unloaded_standing_sole") is not None:
+        _set_defaults(monkeypatch, WholeBodyConfig, {"standing_sole_min_load_share": 0.0})
     if request.node.get_closest_marker("forward_heading") is not None:
         # (the operator side's worker is forked from this process: it computes the heading so too)
         monkeypatch.setattr(rot, "heading_from_quat", rot.yaw_from_quat)

@@ -123,6 +123,7 @@ def test_a_free_swing_carries_the_kicks_strike_to_the_ball():
     assert not reach[False]["kicked"] and reach[False]["closest_foot_m"] > 0.25
 
 
+@pytest.mark.unloaded_standing_sole
 @pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_kick_does_not_lift_off_with_the_weight_already_beyond_the_stance_ankle():
@@ -139,6 +140,7 @@ def test_a_kick_does_not_lift_off_with_the_weight_already_beyond_the_stance_ankl
     assert out[0.01]["kicked"] and not out[0.01]["fell"]
 
 
+@pytest.mark.unloaded_standing_sole
 @pytest.mark.pelvis_joint
 @pytest.mark.in_place
 def test_a_stance_foot_off_the_ground_is_held_where_it_came_off():

@@ -81,6 +81,7 @@ def test_his_landings_come_when_his_foot_has_stopped():
 RUN = Path(__file__).resolve().parents[2] / "shared" / "mocap" / "cmu-dev" / "09_01.bvh"
 
 
+@pytest.mark.unloaded_standing_sole
 @pytest.mark.skipif(not RUN.exists(), reason="../shared/mocap/cmu-dev/09_01.bvh is not available")
 def test_own_steps_walk_on_only_while_he_moves():
     """CMU-dev 09_01 (a 1.2 s run), seed 13, with his landings read at his foot's rest: he holds his last pose from

@@ -292,10 +292,11 @@ def test_a_lift_off_waits_while_the_lifted_foot_is_the_only_one_down():
 TRACED = ControlConfig(whole_body=WholeBodyConfig(stance_leg_tracking_share=1.0, single_stance_pelvis_share=1.0,
                                                    recovery_foot_task_weight=0.0, pelvis_rate_share=0.0,
                                                    press_double_stance_feet=False, own_step_push_bound="he_stands"))
-# The default controller before WholeBodyConfig.single_stance_pelvis_share (and the recovery foot task), which
-# the scenarios of the stopping step and the overdue double stance were traced with.
+# The default controller before WholeBodyConfig.single_stance_pelvis_share (and the recovery foot task, and the
+# standing soles' load bound), which the scenarios of the stopping step and the overdue double stance were traced with.
 PELVIS_LEVEL = ControlConfig(whole_body=WholeBodyConfig(single_stance_pelvis_share=1.0, recovery_foot_task_weight=0.0,
-                                                        pelvis_rate_share=0.0, own_step_push_bound="he_stands"))
+                                                        pelvis_rate_share=0.0, own_step_push_bound="he_stands",
+                                                        standing_sole_min_load_share=0.0))
 # ... and the motion stage's balance layer as it was then: recovery steps of 0.6 leg lengths, and a swing the
 # operator stops on not yet landed at once (with either, several of the traced falls come later or not at all).
 TRACED_MOTION = {"recovery_step_reach_share": 0.6, "recovery_on_stopping_step": False,

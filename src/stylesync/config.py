@@ -439,6 +439,10 @@ class MotionConfig:
     # (capture_bound_sole_share); False: not while the operator walks from one foot onto the other
     # (double_stance_momentum.moves_between_feet), whose capture point runs ahead of his front foot.
     capture_bound_in_his_gait: bool = False
+    # ... nor while he starts a walk: on both feet, his weight gone onto one of them (his COM at least this share of
+    # the way from his other ankle) and his capture point outside his soles (he falls into his first step); a jump's
+    # crouch and lean keeps his weight between his feet. None: off [-]
+    capture_bound_his_start_share: float | None = None
     # ... and where it is False: in his gait's double stance the COM target's capture point runs ahead of the
     # soles by at most what a step this long from now catches within a recovery step's reach
     # (capture_bound.gait_capture_margin_m: reach e^(-ω T)); None: unbounded there [s].
@@ -788,13 +792,14 @@ class WholeBodyConfig:
     # (docs/decisions.md, "The supporting legs' posture")
     stance_leg_tracking_share: float = 0.1
     # While the operator stands still (on both feet, his feet and his COM at rest) and the character stands on both
-    # soles, each sole is planned to bear at least this share of the body's weight (ramped down with its stance
-    # weight below the contacts' RAMP_WEIGHT). A sole his weight leaves all but unloaded otherwise pressed the ground
-    # on one control tick and not on the next, left the QP's contacts and came back, and slid; the character then
-    # stepped to put it back, again and again (docs/decisions.md, "A sole unloaded where he stands"). Off (0) by
-    # default: 0.1 measured as well as the default on the development suite, but it holds back the character's own
-    # weight shift before a step to where he stands, which begins while he still stands [-]
-    standing_sole_min_load_share: float = 0.0
+    # soles (its COM below 0.2 m/s, no weight shift of its own for a step to where he stands: ReferencePose.
+    # he_stands_still), both soles stay contacts whatever their stance weight (at least the contacts' MIN_WEIGHT) and
+    # each is planned to bear at least this share of the body's weight (ramped down with its stance weight below the
+    # contacts' RAMP_WEIGHT). A sole his weight leaves all but unloaded otherwise pressed the ground on one control
+    # tick and not on the next, left the QP's contacts and came back, and slid; the character then stepped to put it
+    # back, again and again (docs/decisions.md, "A sole unloaded where he stands", "The standing soles' load by
+    # default"). 0: off [-]
+    standing_sole_min_load_share: float = 0.1
     # The pelvis orientation task's weight in single stance, as a share of its weight on two feet. A swing leg driven
     # forward and up (a running stride) turns the pelvis the other way; a pelvis held level at full weight took that
     # acceleration from the swing leg, whose foot then went back instead of forward (docs/decisions.md, "The pelvis

@@ -34,7 +34,7 @@ import numpy as np
 
 from stylesync import rotations as rot
 from stylesync.config import ControlConfig
-from stylesync.control.contacts import SoleContact, feasible_horizontal_force, sole_touches
+from stylesync.control.contacts import MIN_WEIGHT, SoleContact, feasible_horizontal_force, sole_touches
 from stylesync.control.controller import TORQUE_LIMIT, ControllerBase, ControlTelemetry, supporting_weights
 from stylesync.control.crvc import com_virtual_force, root_orientation_error, root_pd
 from stylesync.control.formulation import QpProblem, WholeBodyFormulation, hinge_limits
@@ -64,7 +64,7 @@ from stylesync.model.character_model import HAND_FRAMES, CharacterModel
 from stylesync.model.state import CharacterState, JointFeedback, MassProperties, Torques
 from stylesync.motion import bounds as bnd
 from stylesync.motion.reference import ReferencePose
-from stylesync.motion.stance_fsm import swing_side
+from stylesync.motion.stance_fsm import Stance, swing_side
 
 log = logging.getLogger("stylesync.control")
 _FOOT_LINK = {s: LINK_NAMES.index(f"{s}_ankle") for s in SIDES}
@@ -182,6 +182,12 @@ class WholeBodyController(ControllerBase):
         touching = {s: sole_touches(state.link_origin_world[_FOOT_LINK[s]], state.link_quat_wxyz[_FOOT_LINK[s]], p,
                                     wb.sole_contact_gap_m) for s, p in state.feet_pressing().items()}
         w = supporting_weights(ref.stance_weight, touching)
+        if (wb.standing_sole_min_load_share > 0.0 and ref.he_stands_still and ref.character_stance is Stance.DS
+                and all(touching.values())):
+            # Where he stands still both soles on the ground stay contacts, though his weight (and the COM target)
+            # be over one foot: a sole of no stance weight left the QP's contacts while it bore 50 N, was free to
+            # the tasks and slid (standing_sole_min_load_share)
+            w = {s: min(max(v, MIN_WEIGHT), 1.0 - MIN_WEIGHT) for s, v in w.items()}
         com, com_vel = model.com_world, model.com_vel_world
 
         # Centroidal momentum rate: Eq. 16 (first line) horizontally; vertically the pelvis height of Eq. 9.

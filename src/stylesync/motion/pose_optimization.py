@@ -108,6 +108,10 @@ _STANDING_LEAD_M = 0.005
 # goes 0.4-1.2 m/s
 _FEET_STILL_MPS = 0.1
 _FEET_SPEED_SMOOTHING_S = 0.1
+# The character's COM speed below which it stands, for ReferencePose.he_stands_still [m/s]: standing, it sways at up to
+# 0.17 m/s; a body that brakes from a run on a long last step still travels at 0.3-0.6 m/s over its front foot, and
+# loading its rear sole then (WholeBodyConfig.standing_sole_min_load_share) folded its front leg (CMU-dev 02_03).
+_CHARACTER_STANDS_MPS = 0.2
 _GAIT_AXIS_COS = math.cos(math.radians(GAIT_AXIS_DEG))
 _SIDE_UP = {"left": "LEFT", "right": "RIGHT"}
 # A crouch: his trunk (pelvis to neck) within this of the vertical. Lying, crawling, rolling, it is further [deg]
@@ -954,6 +958,15 @@ class MotionOptimizer:
                                                  yaw_h, tick.scale)
         return tick.stands[sides]
 
+    def _his_walk_start(self, tick: _Tick) -> bool:
+        """Whether he starts a walk from both feet (MotionConfig.capture_bound_his_start_share): his weight gone onto
+        one foot and his capture point outside his soles."""
+        share = self.cfg.capture_bound_his_start_share
+        if share is None:
+            return False
+        left = self._ds_left_share(tick.com_h, tick.a_h)
+        return max(left, 1.0 - left) >= share and not self._operator_stands(tick)
+
     def _capture_bounded(self, tick: _Tick) -> bool:
         """Whether the COM target's capture point is bounded to the character's soles this tick (capture_bound.py):
         in the character's double stance (but, with the opt-outs, not in his gait's double stance, nor while he is on
@@ -964,7 +977,8 @@ class MotionOptimizer:
             if tick.op_state is Stance.DS:
                 # Opt-out: not while he walks from one foot onto the other (his gait's capture point runs ahead of
                 # his front foot, and the character's, bounded within its soles, was braked at every double stance).
-                return self.cfg.capture_bound_in_his_gait or not self._his_gait(tick, tick.sample.support_ankle_world)
+                return self.cfg.capture_bound_in_his_gait or not (self._his_gait(tick, tick.sample.support_ankle_world)
+                                                                  or self._his_walk_start(tick))
             # He is on one foot, the character on both (its step landed before his): bounded; with the opt-out, still
             # while he does not walk his way, and while he does as in his single stance below.
             if self.cfg.capture_bound_before_his_landing or not self.way.goes_along(
@@ -1445,7 +1459,9 @@ class MotionOptimizer:
             recovery_while_he_stands=self.char_fsm.recovery_step and self._operator_stands(tick),
             pelvis_vel_z_mps=tick.pelvis_vel_z,
             his_way_speed_mps=min(float(np.hypot(*self.way.velocity_world[:2])), his_speed),
-            he_stands_still=tick.op_state is Stance.DS and tick.his_feet_still and his_speed < _STANDING_SPEED_MPS,
+            he_stands_still=(tick.op_state is Stance.DS and tick.his_feet_still and his_speed < _STANDING_SPEED_MPS
+                             and self._rest_stance is None
+                             and float(np.hypot(tick.com_vel_c[0], tick.com_vel_c[1])) < _CHARACTER_STANDS_MPS),
         )
 
     @staticmethod
