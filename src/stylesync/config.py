@@ -439,10 +439,6 @@ class MotionConfig:
     # (capture_bound_sole_share); False: not while the operator walks from one foot onto the other
     # (double_stance_momentum.moves_between_feet), whose capture point runs ahead of his front foot.
     capture_bound_in_his_gait: bool = False
-    # ... nor while he starts a walk: on both feet, his weight gone onto one of them (his COM at least this share of
-    # the way from his other ankle) and his capture point outside his soles (he falls into his first step); a jump's
-    # crouch and lean keeps his weight between his feet. None: off [-]
-    capture_bound_his_start_share: float | None = None
     # ... and where it is False: in his gait's double stance the COM target's capture point runs ahead of the
     # soles by at most what a step this long from now catches within a recovery step's reach
     # (capture_bound.gait_capture_margin_m: reach e^(-ω T)); None: unbounded there [s].

@@ -958,15 +958,6 @@ class MotionOptimizer:
                                                  yaw_h, tick.scale)
         return tick.stands[sides]
 
-    def _his_walk_start(self, tick: _Tick) -> bool:
-        """Whether he starts a walk from both feet (MotionConfig.capture_bound_his_start_share): his weight gone onto
-        one foot and his capture point outside his soles."""
-        share = self.cfg.capture_bound_his_start_share
-        if share is None:
-            return False
-        left = self._ds_left_share(tick.com_h, tick.a_h)
-        return max(left, 1.0 - left) >= share and not self._operator_stands(tick)
-
     def _capture_bounded(self, tick: _Tick) -> bool:
         """Whether the COM target's capture point is bounded to the character's soles this tick (capture_bound.py):
         in the character's double stance (but, with the opt-outs, not in his gait's double stance, nor while he is on
@@ -977,8 +968,7 @@ class MotionOptimizer:
             if tick.op_state is Stance.DS:
                 # Opt-out: not while he walks from one foot onto the other (his gait's capture point runs ahead of
                 # his front foot, and the character's, bounded within its soles, was braked at every double stance).
-                return self.cfg.capture_bound_in_his_gait or not (self._his_gait(tick, tick.sample.support_ankle_world)
-                                                                  or self._his_walk_start(tick))
+                return self.cfg.capture_bound_in_his_gait or not self._his_gait(tick, tick.sample.support_ankle_world)
             # He is on one foot, the character on both (its step landed before his): bounded; with the opt-out, still
             # while he does not walk his way, and while he does as in his single stance below.
             if self.cfg.capture_bound_before_his_landing or not self.way.goes_along(
