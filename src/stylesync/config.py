@@ -788,7 +788,7 @@ class WholeBodyConfig:
     # (docs/decisions.md, "The supporting legs' posture")
     stance_leg_tracking_share: float = 0.1
     # While the operator stands still (on both feet, his feet and his COM at rest) and the character stands on both
-    # soles (its COM below 0.2 m/s, no weight shift of its own for a step to where he stands: ReferencePose.
+    # soles (its COM below 0.25 m/s, no weight shift of its own for a step to where he stands: ReferencePose.
     # he_stands_still), both soles stay contacts whatever their stance weight (at least the contacts' MIN_WEIGHT) and
     # each is planned to bear at least this share of the body's weight (ramped down with its stance weight below the
     # contacts' RAMP_WEIGHT). A sole his weight leaves all but unloaded otherwise pressed the ground on one control

@@ -111,7 +111,8 @@ _FEET_SPEED_SMOOTHING_S = 0.1
 # The character's COM speed below which it stands, for ReferencePose.he_stands_still [m/s]: standing, it sways at up to
 # 0.17 m/s; a body that brakes from a run on a long last step still travels at 0.3-0.6 m/s over its front foot, and
 # loading its rear sole then (WholeBodyConfig.standing_sole_min_load_share) folded its front leg (CMU-dev 02_03).
-_CHARACTER_STANDS_MPS = 0.2
+# Between the two (docs/decisions.md, "The standing soles' load by default").
+CHARACTER_STANDS_MPS = 0.25
 _GAIT_AXIS_COS = math.cos(math.radians(GAIT_AXIS_DEG))
 _SIDE_UP = {"left": "LEFT", "right": "RIGHT"}
 # A crouch: his trunk (pelvis to neck) within this of the vertical. Lying, crawling, rolling, it is further [deg]
@@ -1451,7 +1452,7 @@ class MotionOptimizer:
             his_way_speed_mps=min(float(np.hypot(*self.way.velocity_world[:2])), his_speed),
             he_stands_still=(tick.op_state is Stance.DS and tick.his_feet_still and his_speed < _STANDING_SPEED_MPS
                              and self._rest_stance is None
-                             and float(np.hypot(tick.com_vel_c[0], tick.com_vel_c[1])) < _CHARACTER_STANDS_MPS),
+                             and float(np.hypot(tick.com_vel_c[0], tick.com_vel_c[1])) < CHARACTER_STANDS_MPS),
         )
 
     @staticmethod

@@ -53,7 +53,7 @@ class ReferencePose:
     # and his COM's horizontal speed now, scaled (a gait, not a stand, a sway or a jump in place) [m/s]
     his_way_speed_mps: float = 0.0
     # He stands still: on both feet, his feet at rest and his COM's horizontal speed now, scaled, below 5 cm/s; and
-    # the character stands too (its COM below 0.2 m/s) and does not shift its weight for a step to where he stands
+    # the character stands too (its COM below 0.25 m/s) and does not shift its weight for a step to where he stands
     he_stands_still: bool = False
 
 
