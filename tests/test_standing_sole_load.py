@@ -64,10 +64,10 @@ def test_the_planned_normal_forces_keep_the_bound_while_he_stands_still():
     def check(session, state, ref):
         if session.motion._rest_stance is not None:  # a step to where he stands: its weight shift is not held back
             seen["rest_shift"] += 1
-            assert not ref.he_stands_still
+            assert not ref.both_stand_still
         if float(np.hypot(*session.mass.com_velocity(state)[:2])) >= CHARACTER_STANDS_MPS:  # (a body still braking)
             seen["travels"] += 1
-            assert not ref.he_stands_still
+            assert not ref.both_stand_still
         c = session.controller
         if c._last_qp is None or state.time_s < 3.0:
             return
@@ -78,9 +78,9 @@ def test_the_planned_normal_forces_keep_the_bound_while_he_stands_still():
             normal = float(sole.normal_row @ x[start:start + sole.n_forces])
             start += sole.n_forces
             pressing = state.feet_pressing()
-            if ref.he_stands_still and ref.character_stance is Stance.DS and all(pressing.values()):
+            if ref.both_stand_still and ref.character_stance is Stance.DS and all(pressing.values()):
                 assert len(contacts) == 2  # both soles on the ground stay contacts, whatever their stance weight
-            if len(contacts) == 2 and ref.he_stands_still:
+            if len(contacts) == 2 and ref.both_stand_still:
                 seen["bound"] += 1
                 assert sole.min_normal_force_n == pytest.approx(
                     0.1 * sole.body_weight_n * min(1.0, sole.stance_weight / 0.1))

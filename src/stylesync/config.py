@@ -789,7 +789,7 @@ class WholeBodyConfig:
     stance_leg_tracking_share: float = 0.1
     # While the operator stands still (on both feet, his feet and his COM at rest) and the character stands on both
     # soles (its COM below 0.25 m/s, no weight shift of its own for a step to where he stands: ReferencePose.
-    # he_stands_still), both soles stay contacts whatever their stance weight (at least the contacts' MIN_WEIGHT) and
+    # both_stand_still), both soles stay contacts whatever their stance weight (at least the contacts' MIN_WEIGHT) and
     # each is planned to bear at least this share of the body's weight (ramped down with its stance weight below the
     # contacts' RAMP_WEIGHT). A sole his weight leaves all but unloaded otherwise pressed the ground on one control
     # tick and not on the next, left the QP's contacts and came back, and slid; the character then stepped to put it

@@ -152,7 +152,7 @@ def pack_reference(ref: ReferencePose, reading: MotionReading, bound_count: int)
     row[_REF["while_he_stands"]] = float(ref.recovery_while_he_stands)
     row[_REF["pelvis_vel_z"]] = ref.pelvis_vel_z_mps
     row[_REF["way_speed"]] = ref.his_way_speed_mps
-    row[_REF["stands_still"]] = float(ref.he_stands_still)
+    row[_REF["stands_still"]] = float(ref.both_stand_still)
     row[_REF["op_stance"]] = _STANCES.index(reading.operator_stance)
     row[_REF["features"]] = reading.operator_features.as_row()
     row[_REF["held"]] = float(reading.held)
@@ -186,7 +186,7 @@ def unpack_reference(row: np.ndarray) -> tuple[ReferencePose, MotionReading, int
         recovery_while_he_stands=bool(row[_REF["while_he_stands"]][0]),
         pelvis_vel_z_mps=float(row[_REF["pelvis_vel_z"]][0]),
         his_way_speed_mps=float(row[_REF["way_speed"]][0]),
-        he_stands_still=bool(row[_REF["stands_still"]][0]),
+        both_stand_still=bool(row[_REF["stands_still"]][0]),
     )
     reading = MotionReading(_STANCES[int(row[_REF["op_stance"]][0])],
                             StyleFeatures.from_row(row[_REF["features"]].copy()), bool(row[_REF["held"]][0]),

@@ -182,11 +182,11 @@ class WholeBodyController(ControllerBase):
         touching = {s: sole_touches(state.link_origin_world[_FOOT_LINK[s]], state.link_quat_wxyz[_FOOT_LINK[s]], p,
                                     wb.sole_contact_gap_m) for s, p in state.feet_pressing().items()}
         w = supporting_weights(ref.stance_weight, touching)
-        if (wb.standing_sole_min_load_share > 0.0 and ref.he_stands_still and ref.character_stance is Stance.DS
+        if (wb.standing_sole_min_load_share > 0.0 and ref.both_stand_still and ref.character_stance is Stance.DS
                 and all(touching.values())):
-            # Where he stands still both soles on the ground stay contacts, though his weight (and the COM target)
-            # be over one foot: a sole of no stance weight left the QP's contacts while it bore 50 N, was free to
-            # the tasks and slid (standing_sole_min_load_share)
+            # Where both stand still both soles on the ground stay contacts, even with his weight (and the COM
+            # target) over one foot: a sole of no stance weight left the QP's contacts while it bore 50 N, was free
+            # to the tasks and slid (standing_sole_min_load_share)
             w = {s: min(max(v, MIN_WEIGHT), 1.0 - MIN_WEIGHT) for s, v in w.items()}
         com, com_vel = model.com_world, model.com_vel_world
 
@@ -220,7 +220,7 @@ class WholeBodyController(ControllerBase):
         for c in contacts:
             c.stance_weight = w[c.side]
             # Both soles loaded where he stands still (WholeBodyConfig.standing_sole_min_load_share)
-            c.min_load_share = wb.standing_sole_min_load_share if len(contacts) == 2 and ref.he_stands_still else 0.0
+            c.min_load_share = wb.standing_sole_min_load_share if len(contacts) == 2 and ref.both_stand_still else 0.0
             c.update(model)  # its corners bound the force here; the formulation reads the rest of it
         force = feasible_horizontal_force(force, com, [c.corners_world for c in contacts], m, self.g)
         e_root = root_orientation_error(ref.root_quat_wxyz, state.root_quat_wxyz)

@@ -108,7 +108,7 @@ _STANDING_LEAD_M = 0.005
 # goes 0.4-1.2 m/s
 _FEET_STILL_MPS = 0.1
 _FEET_SPEED_SMOOTHING_S = 0.1
-# The character's COM speed below which it stands, for ReferencePose.he_stands_still [m/s]: standing, it sways at up to
+# The character's COM speed below which it stands, for ReferencePose.both_stand_still [m/s]: standing, it sways at up to
 # 0.17 m/s; a body that brakes from a run on a long last step still travels at 0.3-0.6 m/s over its front foot, and
 # loading its rear sole then (WholeBodyConfig.standing_sole_min_load_share) folded its front leg (CMU-dev 02_03).
 # Between the two (docs/decisions.md, "The standing soles' load by default").
@@ -640,7 +640,7 @@ class MotionOptimizer:
                 pelvis_xy[:2] += pull
                 com_xy[:2] += pull
         tick.he_stands = self._he_stands(state, scale, tick.op_state)
-        tick.his_feet_still = self._his_feet_still(a_hs, scale)  # (the rest steps; ReferencePose.he_stands_still)
+        tick.his_feet_still = self._his_feet_still(a_hs, scale)  # (the rest steps; ReferencePose.both_stand_still)
         tau = self.cfg.reference_follows_operator_s
         if tau > 0:
             # The targets advance at the operator's COM velocity (scaled), pulled towards the anchored ones with time
@@ -1450,7 +1450,7 @@ class MotionOptimizer:
             recovery_while_he_stands=self.char_fsm.recovery_step and self._operator_stands(tick),
             pelvis_vel_z_mps=tick.pelvis_vel_z,
             his_way_speed_mps=min(float(np.hypot(*self.way.velocity_world[:2])), his_speed),
-            he_stands_still=(tick.op_state is Stance.DS and tick.his_feet_still and his_speed < _STANDING_SPEED_MPS
+            both_stand_still=(tick.op_state is Stance.DS and tick.his_feet_still and his_speed < _STANDING_SPEED_MPS
                              and self._rest_stance is None
                              and float(np.hypot(tick.com_vel_c[0], tick.com_vel_c[1])) < CHARACTER_STANDS_MPS),
         )

@@ -52,9 +52,9 @@ class ReferencePose:
     # How fast the operator goes somewhere over the ground: the lower of his way's average speed (operator_way.py)
     # and his COM's horizontal speed now, scaled (a gait, not a stand, a sway or a jump in place) [m/s]
     his_way_speed_mps: float = 0.0
-    # He stands still: on both feet, his feet at rest and his COM's horizontal speed now, scaled, below 5 cm/s; and
-    # the character stands too (its COM below 0.25 m/s) and does not shift its weight for a step to where he stands
-    he_stands_still: bool = False
+    # He and the character stand still: he on both feet, his feet at rest and his COM's horizontal speed now, scaled,
+    # below 5 cm/s; the character's COM below 0.25 m/s and no weight shift of its own for a step to where he stands
+    both_stand_still: bool = False
 
 
 @dataclass(frozen=True)
