@@ -541,6 +541,12 @@ class MotionConfig:
     # 0.4 m up, scaled) was counted fallen while it stood on both feet (docs/decisions.md, "A crouch deeper than the
     # fall height"). None: as deep as he goes [m]
     pelvis_min_height_m: float | None = 0.6
+    # A recording started standing (both feet down, slower than gait_min_way_speed_mps) with the character's capture
+    # point outside its soles shrunk to this share of their size about their centres (model/sole.sole_corners_in_foot):
+    # its feet are set down under it, his pelvis kept (motion/initial_state.standing_start_shift; docs/decisions.md, "A
+    # standing start over the toes"). Well inside the capture bound's (capture_bound_sole_share): a start at that edge
+    # drifted over it. None: his ankles' places from his pelvis, wherever that leaves the capture point [-]
+    standing_start_sole_share: float | None = 0.5
     # His pelvis for Eq. 9-10 (the pelvis height and the pelvis target over the ground, the swing foot's and the
     # hands' places relative to it): the midpoint of his hip joints, where the character's root is on its own body
     # (processing/body_parameters.hip_centre_world), whichever place his skeleton gives its pelvis joint; False: that
@@ -596,6 +602,8 @@ class MotionConfig:
         if self.recovery_cross_clear_m is not None:
             _non_negative("MotionConfig.recovery_cross_clear_m", self.recovery_cross_clear_m)
         _within("MotionConfig.capture_bound_sole_share", self.capture_bound_sole_share, 0.0, 1.0)
+        if self.standing_start_sole_share is not None:
+            _within("MotionConfig.standing_start_sole_share", self.standing_start_sole_share, 0.0, 1.0)
         _positive("MotionConfig.recovery_swing_s", self.recovery_swing_s)
         if self.gait_capture_step_s is not None:
             _positive("MotionConfig.gait_capture_step_s", self.gait_capture_step_s)

@@ -31,9 +31,10 @@ from stylesync.model.character import (
     STANDING_ROOT_HEIGHT_M,
 )
 from stylesync.model.character_model import CharacterModel
+from stylesync.model.sole import sole_corner_points, sole_points_xy
 from stylesync.model.state import CharacterState
 from stylesync.motion.bounds import BoundsMonitor
-from stylesync.motion.initial_state import initial_state, start_velocity_share
+from stylesync.motion.initial_state import InitialState, initial_state, standing_start_shift, start_velocity_share
 from stylesync.motion.operator_analysis import analyse_operator
 from stylesync.motion.pose_optimization import MotionOptimizer
 from stylesync.motion.reference import MotionReading
@@ -61,6 +62,10 @@ DIVERGED_ROOT_HEIGHT_M = 2.5
 # ground, the motion diverged. The development suite counts falls by these (metrics/dev_suite.fall_endings).
 FALL_REASON_PREFIXES = ("pelvis at", "a link other than a foot", "the motion diverged")
 FIRST_FRAME_TIMEOUT_S = 10.0
+# A standing start (Session._standing_start_shift): both ankles within this of one height [m], and the feet's shift
+# found again this many times (the legs' own mass moves the COM a little with them)
+STANDING_START_ANKLE_GAP_M = 0.03
+STANDING_START_ITERATIONS = 3
 
 
 def _all_tracked(frame: OperatorFrame) -> bool:
@@ -269,20 +274,56 @@ class Session:
                 return False
             samples.append(processing.step(f.timestamp_s))
         s0, s1 = samples
-        init = initial_state(s0, analyse_operator(s0), s1, analyse_operator(s1), self.cfg.motion.pelvis_from_hip_joints,
-                             self.cfg.motion.pelvis_min_height_m)
-        self.backend.reset(init.root_pos_world, init.root_quat_wxyz, init.joint_pos)
-        ankle_z = self.backend.read_state(0.0).link_origin_world[_LEG_LINKS[:, 2], 2]
-        root = init.root_pos_world + np.array([0.0, 0.0, ANKLE_HEIGHT_M + 0.002 - float(ankle_z.min())])
-        self.backend.reset(root, init.root_quat_wxyz, init.joint_pos)
+        a0, a1 = analyse_operator(s0), analyse_operator(s1)
+        motion = self.cfg.motion
+        init = initial_state(s0, a0, s1, a1, motion.pelvis_from_hip_joints, motion.pelvis_min_height_m)
+        share = (start_velocity_share(init.root_lin_vel_world, self.cfg.operator.start_speed_max_mps)
+                 if self.cfg.operator.start_with_clip_velocity else 0.0)
+        state = self._reset_on_ground(init)
+        shift = np.zeros(3)
+        for _ in range(STANDING_START_ITERATIONS if motion.standing_start_sole_share is not None else 0):
+            more = self._standing_start_shift(state, share * init.root_lin_vel_world)
+            if more is None:
+                break
+            shift += more
+            init = initial_state(s0, a0, s1, a1, motion.pelvis_from_hip_joints, motion.pelvis_min_height_m, shift)
+            state = self._reset_on_ground(init)
+        if shift.any():
+            log.info("a standing start: the character's feet set %.3f m further under its capture point",
+                     float(np.hypot(shift[0], shift[1])))
         if self.cfg.operator.start_with_clip_velocity:
-            share = start_velocity_share(init.root_lin_vel_world, self.cfg.operator.start_speed_max_mps)
             self.backend.set_velocities(share * init.root_lin_vel_world, share * init.root_ang_vel_world,
                                         share * init.joint_vel)
             self.processing.prime_rates(f0, f1)
             com_vel_h = (s1.com_world - s0.com_world) / (s1.time_s - s0.time_s)
             self.motion.prime_rates(com_vel_h, share * init.root_lin_vel_world)
         return True
+
+    def _reset_on_ground(self, init: InitialState) -> CharacterState:
+        """The character reset to ``init`` at rest, its lower ankle at its standing height over the ground."""
+        self.backend.reset(init.root_pos_world, init.root_quat_wxyz, init.joint_pos)
+        ankle_z = self.backend.read_state(0.0).link_origin_world[_LEG_LINKS[:, 2], 2]
+        root = init.root_pos_world + np.array([0.0, 0.0, ANKLE_HEIGHT_M + 0.002 - float(ankle_z.min())])
+        self.backend.reset(root, init.root_quat_wxyz, init.joint_pos)
+        return self.backend.read_state(0.0)
+
+    def _standing_start_shift(self, state: CharacterState, root_vel_world: np.ndarray) -> np.ndarray | None:
+        """motion/initial_state.standing_start_shift for the character at rest in ``state`` about to start with the
+        root velocity ``root_vel_world`` [m/s] (its COM's, near enough at a standing start), where it starts standing:
+        both ankles on the ground and that velocity below ``MotionConfig.gait_min_way_speed_mps`` over the ground (a
+        clip started mid-stride has its capture point ahead of its feet, and steps). None otherwise."""
+        motion = self.cfg.motion
+        assert motion.standing_start_sole_share is not None
+        standing_mps = motion.gait_min_way_speed_mps if motion.gait_min_way_speed_mps is not None else 0.0
+        ankles = state.link_origin_world[_LEG_LINKS[:, 2]]
+        if (float(np.hypot(root_vel_world[0], root_vel_world[1])) >= standing_mps
+                or float(np.ptp(ankles[:, 2])) > STANDING_START_ANKLE_GAP_M):
+            return None
+        corners = sole_corner_points(motion.standing_start_sole_share)
+        soles = [sole_points_xy(ankles[k], state.link_quat_wxyz[_LEG_LINKS[k, 2]], corners) for k in range(2)]
+        ground_z = float(ankles[:, 2].min()) - ANKLE_HEIGHT_M
+        com_vel = np.array([root_vel_world[0], root_vel_world[1], 0.0])
+        return standing_start_shift(self.mass.com(state), com_vel, self.cfg.world.gravity_mps2, ground_z, soles)
 
     def run(self, progress: Callable[[float, float], None] | None = None,
             render_every_s: float | None = None) -> SessionResult:

@@ -33,6 +33,7 @@ from stylesync.model.character import (
     THIGH_LENGTH_M,
     JointKind,
 )
+from stylesync.model.sole import Point, convex_hull_points, outside_distance_points
 from stylesync.motion.leg_ik import solve_leg
 from stylesync.motion.operator_analysis import OperatorAnalysis
 from stylesync.motion.pose_optimization import CHAR_LEG_LENGTH_M, below_crouch_floor, joint_targets, map_upper_body
@@ -57,14 +58,15 @@ class InitialState:
 
 
 def retargeted_pose(s: OperatorSample, analysis: OperatorAnalysis, scale: float | None = None,
-                    from_hip_joints: bool = False, pelvis_min_height_m: float | None = None
-                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                    from_hip_joints: bool = False, pelvis_min_height_m: float | None = None,
+                    ankle_shift_world: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(root position [m], root quaternion, joint positions) of the character for one operator sample, the pelvis
     over the ground at the operator's, scaled by ``scale`` (default h_C / h_H of this sample, Eq. 9) from the world
     origin (differences of poses at one scale give velocities). His pelvis is the midpoint of his hip joints with
     ``from_hip_joints`` (MotionConfig.pelvis_from_hip_joints), else his skeleton's pelvis joint. While his trunk is
     upright the pelvis is no lower than ``pelvis_min_height_m`` (None: as low as his) [m], the ankles then where his
-    are over the ground (the legs stretched instead of the feet lifted)."""
+    are over the ground (the legs stretched instead of the feet lifted). ``ankle_shift_world`` (3,) [m] moves both
+    ankles' targets from where his are, the pelvis staying (:func:`standing_start_shift`)."""
     if scale is None:
         scale = CHAR_LEG_LENGTH_M / analysis.leg_m  # Eq. 9
     q_root = analysis.root_quat_wxyz
@@ -84,6 +86,8 @@ def retargeted_pose(s: OperatorSample, analysis: OperatorAnalysis, scale: float 
         target = pelvis + scale * (ankles[side] - p_h)
         if raised:
             target[2] = ANKLE_HEIGHT_M + scale * (ankles[side][2] - ankle_h_z)  # where his is above the ground
+        if ankle_shift_world is not None:
+            target = target + ankle_shift_world
         target[2] = max(target[2], ANKLE_HEIGHT_M)
         N = analysis.features.N_l if side == "left" else analysis.features.N_r
         ik = solve_leg(hip, target, THIGH_LENGTH_M, SHANK_LENGTH_M, N)
@@ -96,9 +100,10 @@ def retargeted_pose(s: OperatorSample, analysis: OperatorAnalysis, scale: float 
 
 
 def initial_state(s0: OperatorSample, a0: OperatorAnalysis, s1: OperatorSample, a1: OperatorAnalysis,
-                  from_hip_joints: bool = False, pelvis_min_height_m: float | None = None) -> InitialState:
-    """The character's state at ``s0``, with velocities from the forward difference to ``s1`` (later); his pelvis
-    and the pelvis's floor as :func:`retargeted_pose` takes them."""
+                  from_hip_joints: bool = False, pelvis_min_height_m: float | None = None,
+                  ankle_shift_world: np.ndarray | None = None) -> InitialState:
+    """The character's state at ``s0``, with velocities from the forward difference to ``s1`` (later); his pelvis,
+    the pelvis's floor and the ankles' shift as :func:`retargeted_pose` takes them (the same shift in both poses)."""
     dt = s1.time_s - s0.time_s
     if not dt > 0:
         raise ValueError("initial_state needs a second sample later than the first")
@@ -106,8 +111,8 @@ def initial_state(s0: OperatorSample, a0: OperatorAnalysis, s1: OperatorSample, 
     # operator's leg length (Eq. 1) changes the scale from sample to sample by about 1 %, which alone would add some
     # 0.3 m/s to a forward difference over a 16 Hz frame.
     scale = CHAR_LEG_LENGTH_M / a0.leg_m
-    p0, q0, j0 = retargeted_pose(s0, a0, scale, from_hip_joints, pelvis_min_height_m)
-    p1, q1, j1 = retargeted_pose(s1, a1, scale, from_hip_joints, pelvis_min_height_m)
+    p0, q0, j0 = retargeted_pose(s0, a0, scale, from_hip_joints, pelvis_min_height_m, ankle_shift_world)
+    p1, q1, j1 = retargeted_pose(s1, a1, scale, from_hip_joints, pelvis_min_height_m, ankle_shift_world)
     q1 = rot.align_sign(q1, q0)
     ang_root = rot.rotvec_from_quat(rot.multiply(q1, rot.conjugate(q0))) / dt
     joint_vel = np.zeros((len(JOINTS), 3))
@@ -127,3 +132,28 @@ def start_velocity_share(root_lin_vel_world: np.ndarray, max_speed_mps: float | 
         return 1.0
     speed = float(np.hypot(root_lin_vel_world[0], root_lin_vel_world[1]))
     return 1.0 if speed <= max_speed_mps else max_speed_mps / speed
+
+
+def standing_start_shift(com_world: np.ndarray, com_vel_world: np.ndarray, gravity_mps2: float, ground_z_m: float,
+                         soles_xy: list[list[Point]]) -> np.ndarray | None:
+    """Where a standing start puts the character's capture point ξ = c + ċ / ω (Eq. 21's pendulum; COM ``com_world``
+    and ``com_vel_world``, world [m, m/s], ω from the COM's height over ``ground_z_m``) outside the support polygon of
+    its soles ``soles_xy`` (each its corners' world horizontal positions, shrunk as MotionConfig.
+    standing_start_sole_share says): the horizontal shift (3,) [m] of both ankles that puts ξ back on that polygon,
+    None where it is within.
+
+    His pose is mapped pelvis to ankles, and his centre of mass lies otherwise over his feet than the character's over
+    its own (other proportions, another mass distribution, a marker-based skeleton's ankle): a person standing with
+    his weight over the balls of his feet started the character with its capture point at the front edge of what the
+    capture bound allows, the COM drifting over it, its centre of pressure at the soles' edge unable to hold it back,
+    and a step of its own before his first (docs/decisions.md, "A standing start over the toes"). The feet are moved,
+    not the pelvis: his pelvis stays where he is, and a standing body's feet are set down under its weight."""
+    height = float(com_world[2]) - ground_z_m
+    if not height > 0.0:
+        return None
+    omega = (gravity_mps2 / height) ** 0.5
+    xi = (float(com_world[0] + com_vel_world[0] / omega), float(com_world[1] + com_vel_world[1] / omega))
+    distance, (nx, ny) = outside_distance_points(xi, convex_hull_points([p for sole in soles_xy for p in sole]))
+    if distance <= 0.0:
+        return None
+    return np.array([xi[0] - nx, xi[1] - ny, 0.0])
