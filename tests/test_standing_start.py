@@ -17,7 +17,9 @@ from stylesync.motion.initial_state import standing_start_shift
 from stylesync.motion.stance_fsm import Stance
 from stylesync.session import STANCE_CODE
 
-_CLIP = Path(__file__).resolve().parents[2] / "shared" / "mocap" / "cmu-dev" / "10_04.bvh"
+_MOCAP = Path(__file__).resolve().parents[2] / "shared" / "mocap"
+_CLIP = _MOCAP / "cmu-dev" / "10_04.bvh"
+_MID_STRIDE = _MOCAP / "cmu" / "02_01.bvh"
 _G = 9.81
 
 
@@ -43,11 +45,11 @@ def test_the_shift_puts_the_capture_point_on_the_soles():
     assert shift is not None and shift[0] == pytest.approx(0.2 / np.sqrt(_G / 0.85) - 0.01, abs=1e-9)
 
 
-def _first_single_stances(share: float | None) -> tuple[float, float]:
+def _first_single_stances(share: float | None, at_rest: bool) -> tuple[float, float]:
     """CMU-dev 10_04 (a walk from standing, seed 0), its first 1.0 s: when he and the character first stand on one
     foot [s]."""
     control, motion = CONTROLLERS["stylesync"]
-    motion = dataclasses.replace(motion, standing_start_sole_share=share)
+    motion = dataclasses.replace(motion, standing_start_sole_share=share, standing_start_at_rest=at_rest)
     result = suite_run(f"bvh:{_CLIP}", 0, motion, control, configure=lambda cfg: cfg.replace(duration_s=1.0))
     log = result.log
     t, ds = log.array("t"), STANCE_CODE[Stance.DS]
@@ -60,9 +62,33 @@ def _first_single_stances(share: float | None) -> tuple[float, float]:
 def test_a_standing_start_over_the_toes_waits_for_his_first_step():
     """Traced: he stands with his COM, as the pipeline reads it, 0.13 m ahead of his ankles (scaled); started so, the
     character's COM drifted over the front edge of its soles and it stepped on its own at 0.63 s, before his first
-    lift-off (0.74 s), its feet out of his order after it. With its feet set 4 cm further under it, it lifts a foot
-    with him."""
-    his, its = _first_single_stances(None)
+    lift-off (0.74 s), its feet out of his order after it. With its feet set 4 cm further under it, or started at rest
+    (its start velocity of 0.20 m/s is the sensor's noise), it lifts a foot with him, and with both (the defaults)."""
+    his, its = _first_single_stances(None, False)
     assert its < his - 0.05
-    his, its = _first_single_stances(CONTROLLERS["stylesync"][1].standing_start_sole_share)
-    assert its >= his - 0.02
+    for share, at_rest in ((0.5, False), (None, True), (0.5, True)):
+        his, its = _first_single_stances(share, at_rest)
+        assert its >= his - 0.02, (share, at_rest)
+    defaults = CONTROLLERS["stylesync"][1]
+    assert (defaults.standing_start_sole_share, defaults.standing_start_at_rest) == (0.5, True)
+
+
+def _start_speed(path: Path, at_rest: bool) -> float:
+    """The character's root speed over the ground [m/s] at the first control tick of ``path`` (seed 0)."""
+    control, motion = CONTROLLERS["stylesync"]
+    motion = dataclasses.replace(motion, standing_start_at_rest=at_rest)
+    speeds: list[float] = []
+    suite_run(f"bvh:{path}", 0, motion, control, on_tick=lambda state, ref: speeds.append(
+        float(np.hypot(*state.root_lin_vel_world[:2]))), configure=lambda cfg: cfg.replace(duration_s=0.01))
+    return speeds[0]
+
+
+@pytest.mark.skipif(not (_CLIP.is_file() and _MID_STRIDE.is_file()),
+                    reason="../shared/mocap (CMU 02_01, CMU-dev 10_04) is not present")
+def test_a_standing_start_is_at_rest_and_a_walk_started_mid_stride_moves():
+    """A standing start's velocity over its first two frames is the sensor's noise (10_04, seed 0: 0.20 m/s): the
+    character starts at rest (MotionConfig.standing_start_at_rest). A recording started mid-stride (CMU 02_01, 0.86
+    m/s scaled) keeps its velocities."""
+    assert _start_speed(_CLIP, False) > 0.1
+    assert _start_speed(_CLIP, True) < 1e-6
+    assert _start_speed(_MID_STRIDE, True) > 0.5

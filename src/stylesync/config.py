@@ -547,6 +547,10 @@ class MotionConfig:
     # standing start over the toes"). Well inside the capture bound's (capture_bound_sole_share): a start at that edge
     # drifted over it. None: his ankles' places from his pelvis, wherever that leaves the capture point [-]
     standing_start_sole_share: float | None = 0.5
+    # ... and such a start at rest: over its first two frames a standing person's velocity is the sensor's noise
+    # (5 mm at 16 Hz, about 0.1 m/s; CMU-dev 10_04, seed 0: 0.20 m/s). False: with the velocities of its first two
+    # frames as any recording (docs/decisions.md, "A standing start over the toes")
+    standing_start_at_rest: bool = True
     # His pelvis for Eq. 9-10 (the pelvis height and the pelvis target over the ground, the swing foot's and the
     # hands' places relative to it): the midpoint of his hip joints, where the character's root is on its own body
     # (processing/body_parameters.hip_centre_world), whichever place his skeleton gives its pelvis joint; False: that

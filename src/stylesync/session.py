@@ -280,6 +280,8 @@ class Session:
         share = (start_velocity_share(init.root_lin_vel_world, self.cfg.operator.start_speed_max_mps)
                  if self.cfg.operator.start_with_clip_velocity else 0.0)
         state = self._reset_on_ground(init)
+        if motion.standing_start_at_rest and self._starts_standing(state, share * init.root_lin_vel_world):
+            share = 0.0
         shift = np.zeros(3)
         for _ in range(STANDING_START_ITERATIONS if motion.standing_start_sole_share is not None else 0):
             more = self._standing_start_shift(state, share * init.root_lin_vel_world)
@@ -307,18 +309,26 @@ class Session:
         self.backend.reset(root, init.root_quat_wxyz, init.joint_pos)
         return self.backend.read_state(0.0)
 
+    def _starts_standing(self, state: CharacterState, root_vel_world: np.ndarray) -> bool:
+        """Whether the character at rest in ``state``, about to start with the root velocity ``root_vel_world``
+        [m/s], starts standing: both ankles on the ground and that velocity below
+        ``MotionConfig.gait_min_way_speed_mps`` over the ground (a clip started mid-stride is not)."""
+        motion = self.cfg.motion
+        standing_mps = motion.gait_min_way_speed_mps if motion.gait_min_way_speed_mps is not None else 0.0
+        ankles_z = state.link_origin_world[_LEG_LINKS[:, 2], 2]
+        return (float(np.hypot(root_vel_world[0], root_vel_world[1])) < standing_mps
+                and float(np.ptp(ankles_z)) <= STANDING_START_ANKLE_GAP_M)
+
     def _standing_start_shift(self, state: CharacterState, root_vel_world: np.ndarray) -> np.ndarray | None:
         """motion/initial_state.standing_start_shift for the character at rest in ``state`` about to start with the
-        root velocity ``root_vel_world`` [m/s] (its COM's, near enough at a standing start), where it starts standing:
-        both ankles on the ground and that velocity below ``MotionConfig.gait_min_way_speed_mps`` over the ground (a
-        clip started mid-stride has its capture point ahead of its feet, and steps). None otherwise."""
+        root velocity ``root_vel_world`` [m/s] (its COM's, near enough at a standing start), where it starts standing
+        (:meth:`_starts_standing`; a clip started mid-stride has its capture point ahead of its feet, and steps). None
+        otherwise."""
         motion = self.cfg.motion
         assert motion.standing_start_sole_share is not None
-        standing_mps = motion.gait_min_way_speed_mps if motion.gait_min_way_speed_mps is not None else 0.0
-        ankles = state.link_origin_world[_LEG_LINKS[:, 2]]
-        if (float(np.hypot(root_vel_world[0], root_vel_world[1])) >= standing_mps
-                or float(np.ptp(ankles[:, 2])) > STANDING_START_ANKLE_GAP_M):
+        if not self._starts_standing(state, root_vel_world):
             return None
+        ankles = state.link_origin_world[_LEG_LINKS[:, 2]]
         corners = sole_corner_points(motion.standing_start_sole_share)
         soles = [sole_points_xy(ankles[k], state.link_quat_wxyz[_LEG_LINKS[k, 2]], corners) for k in range(2)]
         ground_z = float(ankles[:, 2].min()) - ANKLE_HEIGHT_M
