@@ -58,6 +58,10 @@ TRACED_BEFORE_PRESS = ControlConfig(whole_body=WholeBodyConfig(press_double_stan
 # Scenarios traced while a sole his weight leaves where he stands could be planned unloaded
 # (WholeBodyConfig.standing_sole_min_load_share 0, the default before 2026-12-07; docs/decisions.md, "A sole unloaded
 # where he stands"): the tests that run them carry the unloaded_standing_sole marker.
+# Scenarios traced while a recording that starts standing started with its first two frames' velocity and its feet
+# where his are from his pelvis (MotionConfig.standing_start_at_rest False, standing_start_sole_share None, the defaults
+# before 2026-12-07; docs/decisions.md, "A standing start over the toes"): the tests that run them carry the
+# moving_standing_start marker.
 
 
 def pytest_configure(config):
@@ -75,6 +79,9 @@ def pytest_configure(config):
     config.addinivalue_line("markers", "unloaded_standing_sole: a scenario traced while a standing sole could be "
                                        "planned unloaded: every WholeBodyConfig made during the test defaults to "
                                        "standing_sole_min_load_share 0")
+    config.addinivalue_line("markers", "moving_standing_start: a scenario traced while a recording started standing "
+                                       "with its first frames' velocity and its feet where his are: every "
+                                       "MotionConfig made during the test defaults to that")
 
 
 def _set_defaults(monkeypatch, cls: type, values: dict) -> None:
@@ -93,7 +100,8 @@ def _traced_defaults(request, monkeypatch):
     config.in_place (and PELVIS_JOINT_MOTION's) for the test's duration; under ``pelvis_joint``, MotionConfig's are
     PELVIS_JOINT_MOTION's too; under ``lowered_takeover``, its recovery_takeover_low_foot_m is None (what a test sets
     explicitly stays as it sets it); under ``forward_heading``, the operator's heading is rotations.yaw_from_quat; under
-    ``unloaded_standing_sole``, WholeBodyConfig's standing_sole_min_load_share is 0."""
+    ``unloaded_standing_sole``, WholeBodyConfig's standing_sole_min_load_share is 0; under ``moving_standing_start``,
+    MotionConfig's standing_start_at_rest is False and standing_start_sole_share None."""
     motion: dict = {}
     if request.node.get_closest_marker("pelvis_joint") is not None:
         motion.update(PELVIS_JOINT_MOTION)
@@ -104,6 +112,8 @@ def _traced_defaults(request, monkeypatch):
         _set_defaults(monkeypatch, OperatorConfig, IN_PLACE_OPERATOR)
     if request.node.get_closest_marker("lowered_takeover") is not None:
         motion["recovery_takeover_low_foot_m"] = None
+    if request.node.get_closest_marker("moving_standing_start") is not None:
+        motion.update(standing_start_at_rest=False, standing_start_sole_share=None)
     if motion:
         _set_defaults(monkeypatch, MotionConfig, motion)
     if request.node.get_closest_marker("unloaded_standing_sole") is not None:

@@ -294,6 +294,7 @@ _CMU_DEV = Path(__file__).resolve().parents[2] / "shared" / "mocap" / "cmu-dev"
 
 @pytest.mark.lowered_takeover
 @pytest.mark.pelvis_joint
+@pytest.mark.moving_standing_start
 @pytest.mark.skipif(not (_CMU_DEV / "12_01.bvh").is_file(), reason="../shared/mocap/cmu-dev is not present")
 @pytest.mark.parametrize(("clip", "seed", "fall_s"), [("12_01", 6, 4.30), ("08_08", 1, 2.42), ("10_04", 0, 4.85)])
 def test_a_gait_double_stance_bounded_by_what_a_step_catches_keeps_fast_walks_up(clip, seed, fall_s):
