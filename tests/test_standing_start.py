@@ -35,13 +35,13 @@ def test_the_shift_puts_the_capture_point_on_the_soles():
     soles = _soles(0.5)
     front = max(x for sole in soles for x, _ in sole)
     com = np.array([front + 0.03, 0.0, 0.85])
-    shift = standing_start_shift(com, np.zeros(3), _G, 0.0, soles)
+    shift = standing_start_shift(com, np.zeros(3), _G, soles)
     assert shift is not None and shift == pytest.approx([0.03, 0.0, 0.0], abs=1e-9)
     moved = [[(x + shift[0], y + shift[1]) for x, y in sole] for sole in soles]
-    assert standing_start_shift(com, np.zeros(3), _G, 0.0, moved) is None
-    assert standing_start_shift(np.array([front - 0.01, 0.0, 0.85]), np.zeros(3), _G, 0.0, soles) is None
+    assert standing_start_shift(com, np.zeros(3), _G, moved) is None
+    assert standing_start_shift(np.array([front - 0.01, 0.0, 0.85]), np.zeros(3), _G, soles) is None
     # ... the velocity counts: ξ = c + ċ / ω, a COM 1 cm inside moving forwards at 0.2 m/s is 5 cm beyond
-    shift = standing_start_shift(np.array([front - 0.01, 0.0, 0.85]), np.array([0.2, 0.0, 0.0]), _G, 0.0, soles)
+    shift = standing_start_shift(np.array([front - 0.01, 0.0, 0.85]), np.array([0.2, 0.0, 0.0]), _G, soles)
     assert shift is not None and shift[0] == pytest.approx(0.2 / np.sqrt(_G / 0.85) - 0.01, abs=1e-9)
 
 

@@ -62,7 +62,7 @@ DIVERGED_ROOT_HEIGHT_M = 2.5
 # ground, the motion diverged. The development suite counts falls by these (metrics/dev_suite.fall_endings).
 FALL_REASON_PREFIXES = ("pelvis at", "a link other than a foot", "the motion diverged")
 FIRST_FRAME_TIMEOUT_S = 10.0
-# A standing start (Session._standing_start_shift): both ankles within this of one height [m], and the feet's shift
+# A standing start (Session._starts_standing): both ankles within this of one height [m], and the feet's shift
 # found again this many times (the legs' own mass moves the COM a little with them)
 STANDING_START_ANKLE_GAP_M = 0.03
 STANDING_START_ITERATIONS = 3
@@ -280,16 +280,18 @@ class Session:
         share = (start_velocity_share(init.root_lin_vel_world, self.cfg.operator.start_speed_max_mps)
                  if self.cfg.operator.start_with_clip_velocity else 0.0)
         state = self._reset_on_ground(init)
-        if motion.standing_start_at_rest and self._starts_standing(state, share * init.root_lin_vel_world):
+        standing = self._starts_standing(state, share * init.root_lin_vel_world)
+        if standing and motion.standing_start_at_rest:
             share = 0.0
-        shift = np.zeros(3)
-        for _ in range(STANDING_START_ITERATIONS if motion.standing_start_sole_share is not None else 0):
-            more = self._standing_start_shift(state, share * init.root_lin_vel_world)
-            if more is None:
-                break
-            shift += more
-            init = initial_state(s0, a0, s1, a1, motion.pelvis_from_hip_joints, motion.pelvis_min_height_m, shift)
-            state = self._reset_on_ground(init)
+        shift, sole_share = np.zeros(3), motion.standing_start_sole_share
+        if standing and sole_share is not None:
+            for _ in range(STANDING_START_ITERATIONS):
+                more = self._standing_start_shift(state, share * init.root_lin_vel_world, sole_share)
+                if more is None:
+                    break
+                shift += more
+                init = initial_state(s0, a0, s1, a1, motion.pelvis_from_hip_joints, motion.pelvis_min_height_m, shift)
+                state = self._reset_on_ground(init)
         if shift.any():
             log.info("a standing start: the character's feet set %.3f m further under its capture point",
                      float(np.hypot(shift[0], shift[1])))
@@ -319,21 +321,15 @@ class Session:
         return (float(np.hypot(root_vel_world[0], root_vel_world[1])) < standing_mps
                 and float(np.ptp(ankles_z)) <= STANDING_START_ANKLE_GAP_M)
 
-    def _standing_start_shift(self, state: CharacterState, root_vel_world: np.ndarray) -> np.ndarray | None:
-        """motion/initial_state.standing_start_shift for the character at rest in ``state`` about to start with the
-        root velocity ``root_vel_world`` [m/s] (its COM's, near enough at a standing start), where it starts standing
-        (:meth:`_starts_standing`; a clip started mid-stride has its capture point ahead of its feet, and steps). None
-        otherwise."""
-        motion = self.cfg.motion
-        assert motion.standing_start_sole_share is not None
-        if not self._starts_standing(state, root_vel_world):
-            return None
-        ankles = state.link_origin_world[_LEG_LINKS[:, 2]]
-        corners = sole_corner_points(motion.standing_start_sole_share)
-        soles = [sole_points_xy(ankles[k], state.link_quat_wxyz[_LEG_LINKS[k, 2]], corners) for k in range(2)]
-        ground_z = float(ankles[:, 2].min()) - ANKLE_HEIGHT_M
-        com_vel = np.array([root_vel_world[0], root_vel_world[1], 0.0])
-        return standing_start_shift(self.mass.com(state), com_vel, self.cfg.world.gravity_mps2, ground_z, soles)
+    def _standing_start_shift(self, state: CharacterState, com_vel_world: np.ndarray,
+                              sole_share: float) -> np.ndarray | None:
+        """motion/initial_state.standing_start_shift for the character at rest in ``state``, standing
+        (:meth:`_starts_standing`), about to start with the COM velocity ``com_vel_world`` [m/s] (its root's, near
+        enough at a standing start), its soles shrunk to ``sole_share`` (MotionConfig.standing_start_sole_share)."""
+        corners = sole_corner_points(sole_share)
+        soles = [sole_points_xy(state.link_origin_world[ankle], state.link_quat_wxyz[ankle], corners)
+                 for ankle in _LEG_LINKS[:, 2]]
+        return standing_start_shift(self.mass.com(state), com_vel_world, self.cfg.world.gravity_mps2, soles)
 
     def run(self, progress: Callable[[float, float], None] | None = None,
             render_every_s: float | None = None) -> SessionResult:

@@ -37,6 +37,7 @@ from stylesync.model.sole import Point, convex_hull_points, outside_distance_poi
 from stylesync.motion.leg_ik import solve_leg
 from stylesync.motion.operator_analysis import OperatorAnalysis
 from stylesync.motion.pose_optimization import CHAR_LEG_LENGTH_M, below_crouch_floor, joint_targets, map_upper_body
+from stylesync.motion.recovery_step import capture_point
 from stylesync.processing.body_parameters import operator_pelvis_world
 from stylesync.processing.operator_processing import OperatorSample
 
@@ -134,10 +135,10 @@ def start_velocity_share(root_lin_vel_world: np.ndarray, max_speed_mps: float | 
     return 1.0 if speed <= max_speed_mps else max_speed_mps / speed
 
 
-def standing_start_shift(com_world: np.ndarray, com_vel_world: np.ndarray, gravity_mps2: float, ground_z_m: float,
+def standing_start_shift(com_world: np.ndarray, com_vel_world: np.ndarray, gravity_mps2: float,
                          soles_xy: list[list[Point]]) -> np.ndarray | None:
-    """Where a standing start puts the character's capture point ξ = c + ċ / ω (Eq. 21's pendulum; COM ``com_world``
-    and ``com_vel_world``, world [m, m/s], ω from the COM's height over ``ground_z_m``) outside the support polygon of
+    """Where a standing start puts the character's capture point ξ = c + ċ / ω (recovery_step.capture_point, Eq. 21's
+    pendulum; COM ``com_world`` and ``com_vel_world``, world [m, m/s]) outside the support polygon of
     its soles ``soles_xy`` (each its corners' world horizontal positions, shrunk as MotionConfig.
     standing_start_sole_share says): the horizontal shift (3,) [m] of both ankles that puts ξ back on that polygon,
     None where it is within.
@@ -148,12 +149,9 @@ def standing_start_shift(com_world: np.ndarray, com_vel_world: np.ndarray, gravi
     capture bound allows, the COM drifting over it, its centre of pressure at the soles' edge unable to hold it back,
     and a step of its own before his first (docs/decisions.md, "A standing start over the toes"). The feet are moved,
     not the pelvis: his pelvis stays where he is, and a standing body's feet are set down under its weight."""
-    height = float(com_world[2]) - ground_z_m
-    if not height > 0.0:
-        return None
-    omega = (gravity_mps2 / height) ** 0.5
-    xi = (float(com_world[0] + com_vel_world[0] / omega), float(com_world[1] + com_vel_world[1] / omega))
-    distance, (nx, ny) = outside_distance_points(xi, convex_hull_points([p for sole in soles_xy for p in sole]))
+    xi, _ = capture_point(com_world, com_vel_world, gravity_mps2)
+    distance, (nx, ny) = outside_distance_points((float(xi[0]), float(xi[1])),
+                                                 convex_hull_points([p for sole in soles_xy for p in sole]))
     if distance <= 0.0:
         return None
     return np.array([xi[0] - nx, xi[1] - ny, 0.0])
