@@ -103,6 +103,31 @@ def test_uhc_termination_and_operator_scaling():
     np.testing.assert_allclose(scaled[0, 1], [0.0, 0.0, 0.0])
 
 
+def test_a_termination_is_split_into_the_pelvis_offset_and_the_pose():
+    """His pelvis walks along +y at 1 m/s with a leg below it: a character 0.5 m behind him, 0.55 m to his side, 0.6 m
+    lower, or with its leg bent 1.2 m out, ends for each of those; where he stands, a pelvis offset is 'in place'."""
+    t = np.arange(200) * 0.01
+    ref = np.zeros((200, 2, 3))
+    ref[:, 0] = np.column_stack([np.zeros(200), t, np.full(200, 0.9)])
+    ref[:, 1] = ref[:, 0] - [0.0, 0.0, 0.8]
+    cases = {"behind": [0.0, -0.5, 0.0], "ahead": [0.0, 0.5, 0.0], "aside": [0.55, 0.1, 0.0], "height": [0, 0, -0.6]}
+    for cause, offset in cases.items():
+        split = im.termination_split(t, ref + np.array(offset, dtype=float), ref, 150)
+        assert split["cause"] == cause
+        assert split["along"] == pytest.approx(offset[1]) and split["across"] == pytest.approx(abs(offset[0]))
+        assert split["height"] == pytest.approx(offset[2]) and split["pose"] == pytest.approx(0.0, abs=1e-12)
+        assert split["distance"] == pytest.approx(float(np.linalg.norm(offset)))
+        assert split["his_mps"] == pytest.approx(1.0) and split["its_mps"] == pytest.approx(1.0)
+    bent = ref.copy()
+    bent[:, 1, 0] += 1.2
+    split = im.termination_split(t, bent, ref, 150)
+    assert split["cause"] == "pose" and split["pose"] == pytest.approx(0.6) and split["distance"] == pytest.approx(0.6)
+    standing = ref.copy()
+    standing[:, :, 1] = 0.0  # he stands where he started
+    split = im.termination_split(t, standing + np.array([0.0, -0.5, 0.0]), standing, 150)
+    assert split["cause"] == "in place" and split["his_mps"] == pytest.approx(0.0)
+
+
 def test_mpjpe_before_the_termination_leaves_out_what_follows_it():
     ref = _walker()
     char = ref + np.array([0.12, 0.16, 0.0])  # 20 cm everywhere ...

@@ -72,6 +72,44 @@ def ticks_before_termination(termination_tick: int | None, n_ticks: int) -> int:
     return n_ticks if termination_tick is None else max(termination_tick, 1)
 
 
+TERMINATION_WAY_WINDOW_S = 0.5  # his way at a termination: his pelvis's displacement over this time [s]
+TERMINATION_IN_PLACE_M = 0.1  # ... less than this: he goes nowhere [m]
+
+
+def termination_split(t_s: np.ndarray, char_pos: np.ndarray, ref_pos: np.ndarray, tick: int,
+                      speed_window_s: float = 1.0) -> dict:
+    """The mean joint distance of ``char_pos`` from ``ref_pos`` ((T, J, 3), world, metres, joint 0 the pelvis; times
+    ``t_s`` (T,) [s]) at ``tick`` (a UHC/PHC termination, :func:`uhc_fall_index`), split into where the character's
+    pelvis is from his and how its pose differs: ``along`` his way over the ground (his pelvis's displacement over the
+    last TERMINATION_WAY_WINDOW_S; < 0 behind him), ``across`` it (a distance), ``height`` (its less his) [m] and
+    ``pose``, the mean distance with both pelvises put together [m]; with ``distance``, both pelvises' straight-line
+    speeds over ``speed_window_s`` before (``his_mps``, ``its_mps``) and ``cause``, the largest of the four parts:
+    ``behind`` or ``ahead`` along his way, ``aside``, ``height`` or ``pose``, and ``in place`` for a pelvis offset
+    where he went less than TERMINATION_IN_PLACE_M (his way is then no direction). The parts do not add up to the
+    distance (a mean of lengths): the largest says what it mostly is."""
+    t = np.asarray(t_s, dtype=float)
+    ch, ref = np.asarray(char_pos, dtype=float), np.asarray(ref_pos, dtype=float)
+    k0 = int(np.searchsorted(t, t[tick] - TERMINATION_WAY_WINDOW_S))
+    way = ref[tick, 0, :2] - ref[k0, 0, :2]
+    moved = float(np.hypot(way[0], way[1]))
+    e = way / moved if moved > 1e-9 else np.array([1.0, 0.0])
+    off = ch[tick, 0] - ref[tick, 0]
+    along = float(off[:2] @ e)
+    across = abs(float(off[1] * e[0] - off[0] * e[1]))
+    pose = float(np.linalg.norm((ch[tick] - ch[tick, :1]) - (ref[tick] - ref[tick, :1]), axis=1).mean())
+    parts = {"along": abs(along), "across": across, "height": abs(float(off[2])), "pose": pose}
+    cause = max(parts, key=lambda p: parts[p])
+    if cause in ("along", "across"):
+        cause = ("in place" if moved < TERMINATION_IN_PLACE_M
+                 else "aside" if cause == "across" else "behind" if along < 0.0 else "ahead")
+    ks = int(np.searchsorted(t, t[tick] - speed_window_s))
+    span = max(float(t[tick] - t[ks]), 1e-9)
+    return {"distance": float(np.linalg.norm(ch[tick] - ref[tick], axis=1).mean()), "along": along,
+            "across": across, "height": float(off[2]), "pose": pose, "cause": cause,
+            "his_mps": float(np.hypot(*(ref[tick, 0, :2] - ref[ks, 0, :2]))) / span,
+            "its_mps": float(np.hypot(*(ch[tick, 0, :2] - ch[ks, 0, :2]))) / span}
+
+
 PATH_MIN_DISTANCE_M = 0.5  # an operator who moves less than this over the ground has no path to follow [m]
 
 
