@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from stylesync.cli import main as cli_main
-from stylesync.metrics.dev_suite import CATEGORIES, clip_specs, fall_endings, table
+from stylesync.metrics.dev_suite import CATEGORIES, clip_specs, fall_endings, table, termination_causes
 
 
 def test_every_shared_clip_has_a_category(tmp_path):
@@ -88,6 +88,23 @@ def test_falls_are_counted_by_how_they_ended():
     header, rule, row = table(rows, ["v"]).splitlines()
     assert header.count("|") == rule.count("|") == row.count("|")
     assert "| 2/1/1 |" in row
+
+
+def test_terminations_are_counted_by_their_cause():
+    """The table's UHC terminations come from each run's cause (imitation.termination_split); a run that fell, or
+    one without a termination, is not counted, nor one whose cause was not recorded."""
+    base = {"category": "walk", "version": "v", "clip_end_s": 5.0, "mpjpe_global_mm": 1.0, "mpjpe_root_mm": 1.0,
+            "character_steps": 1, "operator_steps": 1, "path_progress": None, "fall_time_s": None,
+            "state_transition_delay_s": {"count": 0}, "fell": False}
+    causes = ["behind", "behind", "aside", "height", "in place"]
+    rows = [{**base, "uhc_fall_time_s": 1.0, "uhc_cause": c} for c in causes]
+    rows += [{**base, "uhc_fall_time_s": None, "uhc_cause": None},
+             {**base, "uhc_fall_time_s": 1.0, "uhc_cause": "behind", "fell": True, "fall_time_s": 2.0},
+             {**base, "uhc_fall_time_s": 1.0}]  # a version that did not record the cause
+    assert termination_causes(rows) == "2/0/1/1/0/1"
+    header, rule, row = table(rows, ["v"]).splitlines()
+    assert header.count("|") == rule.count("|") == row.count("|")
+    assert "| 2/0/1/1/0/1 |" in row and "behind / ahead / aside / height / pose / in place" in header
 
 
 def test_the_dev_suite_runs_the_follow_path_and_in_place_settings_beside_the_default(tmp_path, capsys):

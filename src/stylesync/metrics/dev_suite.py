@@ -28,6 +28,7 @@ import numpy as np
 from stylesync.config import OperatorConfig, SessionConfig, follow_path, in_place, pelvis_joint
 from stylesync.errors import StylesyncError
 from stylesync.metrics.bench import CONTROLLERS
+from stylesync.metrics.imitation import TERMINATION_CAUSES
 from stylesync.metrics.paired_outcomes import paired_table
 from stylesync.metrics.summary import summarize
 from stylesync.session import FALL_REASON_PREFIXES
@@ -141,8 +142,8 @@ def run_clip(spec: str, seed: int, duration_s: float, controller: str,
     m = summarize(result)
     keys = ("fell", "fall_time_s", "sim_duration_s", "operator_steps", "character_steps",
             "state_transition_delay_s", "mpjpe_global_mm", "mpjpe_root_mm", "mpjpe_global_before_uhc_mm",
-            "mpjpe_root_before_uhc_mm", "uhc_fall_time_s", "path_progress", "realtime_factor", "fall_reason",
-            "step_width_m")
+            "mpjpe_root_before_uhc_mm", "uhc_fall_time_s", "uhc_cause", "path_progress", "realtime_factor",
+            "fall_reason", "step_width_m")
     return {"clip_end_s": clip_end, **{k: m.get(k) for k in keys}}
 
 
@@ -187,6 +188,14 @@ def fall_endings(rs: list[dict]) -> str:
     return "/".join(str(sum(reason.startswith(prefix) for reason in reasons)) for prefix in FALL_REASON_PREFIXES)
 
 
+def termination_causes(rs: list[dict]) -> str:
+    """The UHC terminations of the runs of ``rs`` that did not fall, counted by their cause
+    (imitation.termination_split), as ``behind/ahead/aside/height/pose/in place``; a termination whose cause was
+    not recorded (a version before it was kept) is counted nowhere."""
+    causes = [r.get("uhc_cause") for r in rs if not r.get("fell") and r.get("uhc_fall_time_s") is not None]
+    return "/".join(str(causes.count(c)) for c in TERMINATION_CAUSES)
+
+
 def category_row(cat: str, version: str, rs: list[dict]) -> str:
     """One row of the per-category table (runs that could not be opened are counted, not averaged)."""
     ok = [r for r in rs if "error" not in r]
@@ -197,7 +206,7 @@ def category_row(cat: str, version: str, rs: list[dict]) -> str:
     falls = [r["fall_time_s"] for r in ok if r["fell"]]
     delays = [r["state_transition_delay_s"]["max"] for r in ok if r["state_transition_delay_s"]["count"]]
     cells = [cat, version, str(len(rs)), str(n), _share(complete, n), _share(through_clip, n), _share(no_uhc, n),
-             _mean(falls, ".2f"), fall_endings(ok),
+             termination_causes(ok), _mean(falls, ".2f"), fall_endings(ok),
              _mean([r["mpjpe_global_mm"] for r in ok if r.get("mpjpe_global_mm") is not None], ".0f"),
              _mean([r["mpjpe_root_mm"] for r in ok if r.get("mpjpe_root_mm") is not None], ".0f"),
              _before_termination(ok),
@@ -226,10 +235,11 @@ def _step_widths(rs: list[dict]) -> str:
 def table(rows: list[dict], versions: list[str]) -> str:
     """The per-category Markdown table, one row per category and version (controller or code version)."""
     lines = ["| category | version | runs | opened | complete (no fall) | through the clip (no fall before its end) | "
-             "no UHC termination | mean fall time [s] | falls: pelvis low / other link down / diverged | "
+             "no UHC termination | UHC terminations: behind / ahead / aside / height / pose / in place | "
+             "mean fall time [s] | falls: pelvis low / other link down / diverged | "
              "MPJPE global [mm] | MPJPE root-rel. [mm] | MPJPE global / root-rel. before the termination [mm] | "
              "steps char/op | along his path, median | max delay median [s] | step width char / op, median [m] |",
-             "|" + "---|" * 16]
+             "|" + "---|" * 17]
     for cat in ORDER:
         for v in versions:
             rs = [r for r in rows if r["category"] == cat and r["version"] == v]

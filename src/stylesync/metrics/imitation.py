@@ -74,6 +74,7 @@ def ticks_before_termination(termination_tick: int | None, n_ticks: int) -> int:
 
 TERMINATION_WAY_WINDOW_S = 0.5  # his way at a termination: his pelvis's displacement over this time [s]
 TERMINATION_IN_PLACE_M = 0.1  # ... less than this: he goes nowhere [m]
+TERMINATION_CAUSES = ("behind", "ahead", "aside", "height", "pose", "in place")  # termination_split's causes
 
 
 def termination_split(t_s: np.ndarray, char_pos: np.ndarray, ref_pos: np.ndarray, tick: int,

@@ -100,6 +100,7 @@ def imitation_metrics(result: SessionResult) -> dict:
         "mpjpe_global_before_uhc_mm": round(im.mpjpe_mm(ch[:imitating], ref[:imitating]), 1),
         "mpjpe_root_before_uhc_mm": round(im.mpjpe_mm(ch[:imitating], ref[:imitating], root_relative=True), 1),
         "uhc_fall_time_s": None if uhc is None else float(t[uhc]),
+        "uhc_cause": None if uhc is None else im.termination_split(t, ch, ref, uhc)["cause"],
         "path_progress": None if progress is None else round(progress, 3),
         "path_sideways_m": None if sideways is None else round(sideways, 3),
         "foot_skate_mm": round(im.foot_skate_mm(ch[:, feet], foot_down), 3),
