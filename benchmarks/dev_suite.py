@@ -92,9 +92,29 @@ if "mpjpe_global_before_uhc_mm" not in m and len(result.log.array("t")) >= 3:
     end = len(ch) if uhc is None else max(uhc, 1)
     m["mpjpe_global_before_uhc_mm"] = round(im.mpjpe_mm(ch[:end], ref[:end]), 1)
     m["mpjpe_root_before_uhc_mm"] = round(im.mpjpe_mm(ch[:end], ref[:end], root_relative=True), 1)
+if "uhc_cause" not in m and m.get("uhc_fall_time_s") is not None:
+    # a version before metrics/imitation.termination_split: the same definition, here
+    import numpy as np
+    from stylesync.metrics import imitation as im
+    lg = result.log
+    t, ch = lg.array("t"), lg.array("ch_joints")
+    ref = im.scale_operator_to_character(lg.array("op_joints"), lg.array("scale"), ch[0, 0])
+    k = im.uhc_fall_index(ch, ref)
+    way = ref[k, 0, :2] - ref[int(np.searchsorted(t, t[k] - 0.5)), 0, :2]
+    moved = float(np.hypot(way[0], way[1]))
+    e = way / moved if moved > 1e-9 else np.array([1.0, 0.0])
+    off = ch[k, 0] - ref[k, 0]
+    parts = {"along": abs(float(off[:2] @ e)), "across": abs(float(off[1] * e[0] - off[0] * e[1])),
+             "height": abs(float(off[2])),
+             "pose": float(np.linalg.norm((ch[k] - ch[k, :1]) - (ref[k] - ref[k, :1]), axis=1).mean())}
+    cause = max(parts, key=lambda p: parts[p])
+    if cause in ("along", "across"):
+        cause = ("in place" if moved < 0.1 else "aside" if cause == "across"
+                 else "behind" if float(off[:2] @ e) < 0.0 else "ahead")
+    m["uhc_cause"] = cause
 keys = ("fell", "fall_time_s", "sim_duration_s", "operator_steps", "character_steps", "state_transition_delay_s",
         "mpjpe_global_mm", "mpjpe_root_mm", "mpjpe_global_before_uhc_mm", "mpjpe_root_before_uhc_mm",
-        "uhc_fall_time_s", "path_progress", "realtime_factor", "fall_reason", "step_width_m")
+        "uhc_fall_time_s", "uhc_cause", "path_progress", "realtime_factor", "fall_reason", "step_width_m")
 print(json.dumps({"clip_end_s": clip_end, **{k: m.get(k) for k in keys}}))
 '''
 
