@@ -100,9 +100,12 @@ def termination_split(t_s: np.ndarray, char_pos: np.ndarray, ref_pos: np.ndarray
     pose = float(np.linalg.norm((ch[tick] - ch[tick, :1]) - (ref[tick] - ref[tick, :1]), axis=1).mean())
     parts = {"along": abs(along), "across": across, "height": abs(float(off[2])), "pose": pose}
     cause = max(parts, key=lambda p: parts[p])
-    if cause in ("along", "across"):
-        cause = ("in place" if moved < TERMINATION_IN_PLACE_M
-                 else "aside" if cause == "across" else "behind" if along < 0.0 else "ahead")
+    if cause in ("along", "across") and moved < TERMINATION_IN_PLACE_M:
+        cause = "in place"  # his way is no direction
+    elif cause == "across":
+        cause = "aside"
+    elif cause == "along":
+        cause = "behind" if along < 0.0 else "ahead"
     ks = int(np.searchsorted(t, t[tick] - speed_window_s))
     span = max(float(t[tick] - t[ks]), 1e-9)
     return {"distance": float(np.linalg.norm(ch[tick] - ref[tick], axis=1).mean()), "along": along,
