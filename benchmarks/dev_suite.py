@@ -19,6 +19,7 @@ Writes dev_suite.md and dev_suite.json under --out.
 from __future__ import annotations
 
 import argparse
+import inspect
 import json
 import sys
 from concurrent.futures import ThreadPoolExecutor
@@ -26,6 +27,7 @@ from pathlib import Path
 
 from versions import REPO, checkouts, probe
 
+from stylesync.metrics import imitation
 from stylesync.metrics.dev_suite import ORDER, table
 from stylesync.metrics.dev_suite import clip_specs as suite_clips
 from stylesync.metrics.paired_outcomes import paired_table
@@ -41,6 +43,7 @@ from stylesync.errors import StylesyncError
 from stylesync.metrics.summary import summarize
 from stylesync.session import Session
 from stylesync.sources.registry import open_source
+# <termination_split>
 spec, seed, duration = sys.argv[1], int(sys.argv[2]), float(sys.argv[3])
 try:
     opened = open_source(spec, seed=seed, duration_s=duration)
@@ -93,30 +96,21 @@ if "mpjpe_global_before_uhc_mm" not in m and len(result.log.array("t")) >= 3:
     m["mpjpe_global_before_uhc_mm"] = round(im.mpjpe_mm(ch[:end], ref[:end]), 1)
     m["mpjpe_root_before_uhc_mm"] = round(im.mpjpe_mm(ch[:end], ref[:end], root_relative=True), 1)
 if "uhc_cause" not in m and m.get("uhc_fall_time_s") is not None:
-    # a version before metrics/imitation.termination_split: the same definition, here
-    import numpy as np
+    # a version before metrics/imitation.termination_split: this checkout's definition, its source put in below
     from stylesync.metrics import imitation as im
     lg = result.log
     t, ch = lg.array("t"), lg.array("ch_joints")
     ref = im.scale_operator_to_character(lg.array("op_joints"), lg.array("scale"), ch[0, 0])
-    k = im.uhc_fall_index(ch, ref)
-    way = ref[k, 0, :2] - ref[int(np.searchsorted(t, t[k] - 0.5)), 0, :2]
-    moved = float(np.hypot(way[0], way[1]))
-    e = way / moved if moved > 1e-9 else np.array([1.0, 0.0])
-    off = ch[k, 0] - ref[k, 0]
-    parts = {"along": abs(float(off[:2] @ e)), "across": abs(float(off[1] * e[0] - off[0] * e[1])),
-             "height": abs(float(off[2])),
-             "pose": float(np.linalg.norm((ch[k] - ch[k, :1]) - (ref[k] - ref[k, :1]), axis=1).mean())}
-    cause = max(parts, key=lambda p: parts[p])
-    if cause in ("along", "across"):
-        cause = ("in place" if moved < 0.1 else "aside" if cause == "across"
-                 else "behind" if float(off[:2] @ e) < 0.0 else "ahead")
-    m["uhc_cause"] = cause
+    m["uhc_cause"] = termination_split(t, ch, ref, im.uhc_fall_index(ch, ref))["cause"]
 keys = ("fell", "fall_time_s", "sim_duration_s", "operator_steps", "character_steps", "state_transition_delay_s",
         "mpjpe_global_mm", "mpjpe_root_mm", "mpjpe_global_before_uhc_mm", "mpjpe_root_before_uhc_mm",
         "uhc_fall_time_s", "uhc_cause", "path_progress", "realtime_factor", "fall_reason", "step_width_m")
 print(json.dumps({"clip_end_s": clip_end, **{k: m.get(k) for k in keys}}))
 '''
+# termination_split's source (and its constants) for the versions before it: one definition, not a copy of it
+_PROBE = _PROBE.replace("# <termination_split>\n", "import numpy as np\n" + "".join(
+    f"{name} = {getattr(imitation, name)!r}\n" for name in ("TERMINATION_WAY_WINDOW_S", "TERMINATION_IN_PLACE_M"))
+    + inspect.getsource(imitation.termination_split))
 
 
 def clip_specs() -> list[tuple[str, str, str]]:
