@@ -174,11 +174,14 @@ def test_follow_path_and_in_place_are_taken_and_recorded(tmp_path, capsys):
 @pytest.mark.parametrize("flag, settings, section", [("--free-swing", "FREE_SWING_MOTION", ("motion",)),
                                                      ("--late-contact-steps", "LATE_CONTACT_STEPS_MOTION", ("motion",)),
                                                      ("--no-track-rise", "NO_TRACK_RISE_WHOLE_BODY",
+                                                      ("control", "whole_body")),
+                                                     ("--damp-angular-momentum", "DAMP_ANGULAR_MOMENTUM_WHOLE_BODY",
                                                       ("control", "whole_body"))])
 def test_a_flag_is_taken_and_recorded(tmp_path, capsys, flag, settings, section):
-    """``--free-swing``, ``--late-contact-steps`` and ``--no-track-rise`` set their settings (config.FREE_SWING_MOTION,
-    LATE_CONTACT_STEPS_MOTION, NO_TRACK_RISE_WHOLE_BODY), and the run's session file records them; without the flag
-    the defaults differ."""
+    """``--free-swing``, ``--late-contact-steps``, ``--no-track-rise`` and ``--damp-angular-momentum`` set their
+    settings (config.FREE_SWING_MOTION, LATE_CONTACT_STEPS_MOTION, NO_TRACK_RISE_WHOLE_BODY,
+    DAMP_ANGULAR_MOMENTUM_WHOLE_BODY), and the run's session file records them; without the flag the defaults
+    differ."""
     from stylesync import config
     from stylesync.export.session_file import read_session
 

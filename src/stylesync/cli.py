@@ -22,6 +22,7 @@ from stylesync.config import (
     ControlConfig,
     OperatorConfig,
     SessionConfig,
+    damp_angular_momentum,
     follow_path,
     free_swing,
     in_place,
@@ -197,7 +198,7 @@ def _suite_operator(args: argparse.Namespace) -> OperatorConfig:
 
 def _motion_options(cfg: SessionConfig, args: argparse.Namespace) -> SessionConfig:
     """``cfg`` with the options asked for on the command line (--in-place, --follow-path, --free-swing,
-    --late-contact-steps, --pelvis-joint, --no-track-rise)."""
+    --late-contact-steps, --pelvis-joint, --no-track-rise, --damp-angular-momentum)."""
     if args.in_place and args.follow_path:
         raise ConfigError("--in-place and --follow-path contradict each other: give one of them")
     if args.in_place:
@@ -212,6 +213,8 @@ def _motion_options(cfg: SessionConfig, args: argparse.Namespace) -> SessionConf
         cfg = pelvis_joint(cfg)
     if args.no_track_rise:
         cfg = no_track_rise(cfg)
+    if getattr(args, "damp_angular_momentum", False):
+        cfg = damp_angular_momentum(cfg)
     return cfg
 
 
@@ -400,6 +403,9 @@ def _add_session_args(p: argparse.ArgumentParser, out_default: str, realtime_hel
     p.add_argument("--no-track-rise", action="store_true",
                    help="the pelvis height's law damps every vertical speed, a jump's push included (by default it "
                         "tracks half the operator's rise begun and kept on both feet; docs/status-log.md)")
+    p.add_argument("--damp-angular-momentum", action="store_true",
+                   help="the whole body's angular momentum about its COM damped at 5 1/s: looping dances and spins "
+                        "stand longer, the walks keep to his path less often (docs/decisions.md)")
     p.add_argument("--motion-ahead", action="store_true",
                    help="the motion stage on the last control tick's state, computed a tick ahead in a second process "
                         "(offline runs about 1.1 times as fast; another simulation: docs/decisions.md)")

@@ -7,7 +7,8 @@ The same parts as the paper's controller (controller.py), composed as tasks of o
 * pelvis orientation (the root virtual torque's PD law, per unit inertia);
 * centroidal momentum: the COM virtual force of Eq. 16 (first line, Eq. 19 errors; gains of a capture-point
   tracking law, ControlConfig.momentum_com_kp/kd, docs/decisions.md), the pelvis height of Eq. 9 vertically, the
-  LIPM time-sync force (Eq. 21-23, bounded by Eq. 26), and the root virtual torque (Eq. 16, second line);
+  LIPM time-sync force (Eq. 21-23, bounded by Eq. 26), and the root virtual torque (Eq. 16, second line) less a
+  damping of the whole body's angular momentum about its COM (WholeBodyConfig.angular_momentum_damping_1ps);
 * a stance foot that has not touched down yet (or a swing foot held for a late contact, Sec. 5.1) pressed onto the
   ground; the swing ankle of a recovery step (motion/recovery_step.py) following its target in world space;
   optionally the hands following the operator's hands (ControlConfig.hand_tasks);
@@ -226,6 +227,8 @@ class WholeBodyController(ControllerBase):
         e_root = root_orientation_error(ref.root_quat_wxyz, state.root_quat_wxyz)
         moment = root_pd(e_root, state.root_ang_vel_world, wb.momentum_root_kp, wb.momentum_root_kd,
                          cfg.root_yaw_gain_scale)
+        if wb.angular_momentum_damping_1ps > 0.0:  # the body's angular momentum about its COM damped (config.py)
+            moment = moment - wb.angular_momentum_damping_1ps * model.centroidal_angular_momentum
         self.momentum.force_n, self.momentum.moment_nm = force, moment
 
         # Joint posture: Eq. 13 per unit inertia, saturated (a jump of the reference, a stance change or a landing,

@@ -228,6 +228,12 @@ class CharacterModel:
         self.com_vel_world = (d.Ag[:3] @ v) / self.total_mass_kg  # (3,) [m/s]
 
     @property
+    def centroidal_angular_momentum(self) -> np.ndarray:
+        """(3,) the whole body's angular momentum about its COM at the last update, world axes [kg·m²/s]: the
+        angular rows of A_g v."""
+        return (self.centroidal_map @ self.v)[3:]
+
+    @property
     def gravity_forces(self) -> np.ndarray:
         """(nv,) generalised gravity g(q) at the last update [N, N·m]."""
         return pin.computeGeneralizedGravity(self.model, self.data, self.q)[self._perm]
