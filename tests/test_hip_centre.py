@@ -124,7 +124,7 @@ def test_pelvis_joint_on_the_command_line_sets_both():
 
     from stylesync.cli import _motion_options
 
-    names = ("in_place", "follow_path", "free_swing", "late_contact_steps", "no_track_rise")
+    names = ("in_place", "follow_path", "free_swing", "late_contact_steps", "no_track_rise", "damp_angular_momentum")
     args = argparse.Namespace(**dict.fromkeys(names, False), pelvis_joint=True)
     motion = _motion_options(SessionConfig(), args).motion
     assert not motion.pelvis_from_hip_joints and motion.pelvis_height_offset_m == 0.0

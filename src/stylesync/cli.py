@@ -213,7 +213,7 @@ def _motion_options(cfg: SessionConfig, args: argparse.Namespace) -> SessionConf
         cfg = pelvis_joint(cfg)
     if args.no_track_rise:
         cfg = no_track_rise(cfg)
-    if getattr(args, "damp_angular_momentum", False):
+    if args.damp_angular_momentum:
         cfg = damp_angular_momentum(cfg)
     return cfg
 
