@@ -14,12 +14,13 @@ from stylesync.session import Session
 from stylesync.sources.builtin_operator import builtin_operator
 
 
-def _session(clip: str, damping_1ps: float, duration_s: float, on_tick) -> Session:
-    cfg = SessionConfig(duration_s=duration_s, seed=0, operator=OperatorConfig(clip=clip),
+def _session(clip: str, damping_1ps: float, duration_s: float, seed: int = 0, on_tick=None) -> Session:
+    cfg = SessionConfig(duration_s=duration_s, seed=seed, operator=OperatorConfig(clip=clip),
                         control=ControlConfig(whole_body=WholeBodyConfig(angular_momentum_damping_1ps=damping_1ps)))
     source, _ = builtin_operator(cfg.operator, cfg.clocks, duration_s + 1.0, cfg.seed)
     session = Session(cfg, source)
-    session.on_tick = lambda state, ref: on_tick(session, state, ref)
+    if on_tick is not None:
+        session.on_tick = lambda state, ref: on_tick(session, state, ref)
     return session
 
 
@@ -35,16 +36,13 @@ def test_the_moment_asked_is_the_root_pd_less_the_damped_angular_momentum():
         np.testing.assert_allclose(session.controller.momentum.moment_nm, pd - k * l_ang, rtol=1e-12, atol=1e-9)
         checked.append(float(np.linalg.norm(l_ang)))
 
-    result = _session("walk", k, 3.0, tick).run()
+    result = _session("walk", k, 3.0, on_tick=tick).run()
     assert not result.fell
     assert len(checked) > 300 and max(checked) > 0.5  # a walk's angular momentum, not a body at rest
 
 
 def _dance(damping_1ps: float) -> tuple[bool, float | None]:
-    cfg = SessionConfig(duration_s=12.0, seed=3, operator=OperatorConfig(clip="dance_a"),
-                        control=ControlConfig(whole_body=WholeBodyConfig(angular_momentum_damping_1ps=damping_1ps)))
-    source, _ = builtin_operator(cfg.operator, cfg.clocks, cfg.duration_s + 1.0, cfg.seed)
-    result = Session(cfg, source).run()
+    result = _session("dance_a", damping_1ps, 12.0, seed=3).run()
     return result.fell, result.fall_time_s
 
 
